@@ -1,0 +1,213 @@
+"""The Scene: plain data holding torch tensors.
+
+A Scene is what the SVG reader produces, what the renderer draws and what the optimiser
+changes. Every float that a user may want to optimise is a torch tensor; structure
+(segment degrees, fill rules, caps, ...) is plain Python.
+
+Coordinates: each shape's geometry is in its own user space. ``Shape.transform`` maps it
+into the user space of its group, each ``Group.transform`` into its parent's, and
+``Scene.view`` maps the root user space to canvas pixels at the native size
+``Scene.width`` x ``Scene.height``. All transforms are 3x3 affine matrices (last row
+0 0 1).
+
+Colours are straight (not premultiplied) RGBA in [0, 1].
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Optional, Union
+
+import numpy as np
+import torch
+
+LINE, QUADRATIC, CUBIC = 1, 2, 3
+
+
+def identity() -> torch.Tensor:
+    return torch.eye(3, dtype=torch.float32)
+
+
+def as_tensor(x, shape=None) -> torch.Tensor:
+    t = torch.as_tensor(x, dtype=torch.float32).clone()
+    if shape is not None:
+        t = t.reshape(shape)
+    return t
+
+
+# ----------------------------------------------------------------------------- paints
+
+@dataclass
+class Solid:
+    color: torch.Tensor  # [4] straight RGBA
+
+
+@dataclass
+class LinearGradient:
+    start: torch.Tensor    # [2] x1, y1
+    end: torch.Tensor      # [2] x2, y2
+    offsets: torch.Tensor  # [K] stop offsets, non-decreasing in [0, 1]
+    colors: torch.Tensor   # [K, 4] stop colours (stop-opacity folded into alpha)
+    transform: torch.Tensor = field(default_factory=identity)  # gradientTransform [3, 3]
+    units: str = "objectBoundingBox"  # or "userSpaceOnUse"
+    source: Any = None     # id of the <linearGradient> element, for write-back
+
+
+@dataclass
+class RadialGradient:
+    center: torch.Tensor   # [2] cx, cy
+    radius: torch.Tensor   # [] r
+    focal: torch.Tensor    # [2] fx, fy (equal to center when not given)
+    offsets: torch.Tensor  # [K]
+    colors: torch.Tensor   # [K, 4]
+    transform: torch.Tensor = field(default_factory=identity)
+    units: str = "objectBoundingBox"
+    source: Any = None
+
+
+Paint = Union[Solid, LinearGradient, RadialGradient]
+
+
+# -------------------------------------------------------------------------- geometry
+
+@dataclass
+class Path:
+    """Subpaths of line, quadratic and cubic segments, kept as curves.
+
+    ``points`` holds the subpaths one after the other. A subpath of n segments stores its
+    start point, then for each segment its control points and end point (``degree``
+    points per segment). A closed subpath's last segment ends at the subpath's start
+    point, which is not stored again, so an open subpath stores sum(degrees) + 1 points
+    and a closed one sum(degrees). SVG's ``Z`` is an explicit line segment back to the
+    start (of zero length when the path already returned there).
+    """
+    points: torch.Tensor                 # [P, 2]
+    degrees: np.ndarray                  # [G] int: 1 line, 2 quadratic, 3 cubic
+    subpaths: list[tuple[int, int, bool]]  # (first segment, segment count, closed)
+
+    def subpath_point_ranges(self) -> list[tuple[int, int]]:
+        """(first point, point count) of each subpath in ``points``."""
+        out, p = [], 0
+        for first, count, closed in self.subpaths:
+            n = int(self.degrees[first:first + count].sum()) + (0 if closed else 1)
+            out.append((p, n))
+            p += n
+        return out
+
+
+@dataclass
+class Circle:
+    center: torch.Tensor  # [2]
+    radius: torch.Tensor  # []
+
+
+@dataclass
+class Ellipse:
+    center: torch.Tensor  # [2]
+    radii: torch.Tensor   # [2] rx, ry
+
+
+@dataclass
+class Rect:
+    p_min: torch.Tensor    # [2] x, y
+    p_max: torch.Tensor    # [2] x + width, y + height
+    corner_radii: torch.Tensor = field(default_factory=lambda: torch.zeros(2))  # [2] rx, ry
+
+
+Geometry = Union[Path, Circle, Ellipse, Rect]
+
+
+# ----------------------------------------------------------------------- structure
+
+@dataclass
+class Group:
+    """An SVG <g> (or the root <svg>): a transform and an opacity applied to the
+    composite of its children (group opacity is a layer, not a per-shape alpha)."""
+    transform: torch.Tensor = field(default_factory=identity)  # [3, 3] to parent's space
+    opacity: torch.Tensor = field(default_factory=lambda: torch.tensor(1.0))
+    parent: int = -1          # index into Scene.groups, -1 for the root
+    source: Any = None        # id (or other handle) of the element, for write-back
+
+
+@dataclass
+class Shape:
+    """One drawn element: geometry with an optional fill and an optional stroke."""
+    geometry: Geometry
+    fill: Optional[Paint] = None
+    stroke: Optional[Paint] = None
+    stroke_width: torch.Tensor = field(default_factory=lambda: torch.tensor(1.0))
+    fill_rule: str = "nonzero"     # or "evenodd"
+    linecap: str = "butt"          # butt | round | square
+    linejoin: str = "miter"        # miter | round | bevel
+    miter_limit: float = 4.0
+    opacity: torch.Tensor = field(default_factory=lambda: torch.tensor(1.0))
+    fill_opacity: torch.Tensor = field(default_factory=lambda: torch.tensor(1.0))
+    stroke_opacity: torch.Tensor = field(default_factory=lambda: torch.tensor(1.0))
+    transform: torch.Tensor = field(default_factory=identity)  # [3, 3] to group's space
+    group: int = -1                # index into Scene.groups, -1 for the root
+    source: Any = None             # id (or other handle) of the element, for write-back
+
+
+@dataclass
+class Scene:
+    width: float                   # native canvas size in pixels
+    height: float
+    shapes: list[Shape] = field(default_factory=list)
+    groups: list[Group] = field(default_factory=list)
+    view: torch.Tensor = field(default_factory=identity)  # root user space -> pixels
+    skipped: dict[str, list[str]] = field(default_factory=dict)  # kind -> element names
+
+    def parameters(self) -> dict[str, list[torch.Tensor]]:
+        """Every optimisable tensor, grouped by parameter kind."""
+        kinds: dict[str, list[torch.Tensor]] = {
+            "points": [], "radii": [], "colors": [], "stroke_widths": [],
+            "opacities": [], "gradient_points": [], "gradient_radii": [],
+            "stop_offsets": [], "transforms": [],
+        }
+        seen: set[int] = set()
+
+        def add(kind, t):
+            if id(t) not in seen:
+                seen.add(id(t))
+                kinds[kind].append(t)
+
+        def add_paint(paint):
+            if isinstance(paint, Solid):
+                add("colors", paint.color)
+            elif isinstance(paint, (LinearGradient, RadialGradient)):
+                if isinstance(paint, LinearGradient):
+                    add("gradient_points", paint.start)
+                    add("gradient_points", paint.end)
+                else:
+                    add("gradient_points", paint.center)
+                    add("gradient_points", paint.focal)
+                    add("gradient_radii", paint.radius)
+                add("stop_offsets", paint.offsets)
+                add("colors", paint.colors)
+                add("transforms", paint.transform)
+
+        for shape in self.shapes:
+            g = shape.geometry
+            if isinstance(g, Path):
+                add("points", g.points)
+            elif isinstance(g, Circle):
+                add("points", g.center)
+                add("radii", g.radius)
+            elif isinstance(g, Ellipse):
+                add("points", g.center)
+                add("radii", g.radii)
+            elif isinstance(g, Rect):
+                add("points", g.p_min)
+                add("points", g.p_max)
+                add("radii", g.corner_radii)
+            add_paint(shape.fill)
+            add_paint(shape.stroke)
+            if shape.stroke is not None:
+                add("stroke_widths", shape.stroke_width)
+            add("opacities", shape.opacity)
+            add("opacities", shape.fill_opacity)
+            add("opacities", shape.stroke_opacity)
+            add("transforms", shape.transform)
+        for group in self.groups:
+            add("opacities", group.opacity)
+            add("transforms", group.transform)
+        return kinds
