@@ -1,5 +1,6 @@
 """vecfit: vectorize raster images and refine vector graphics against them."""
 from .errors import SvgError, VecfitError
+from .render import render
 from .scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient, Rect,
                     Scene, Shape, Solid)
 
@@ -12,7 +13,7 @@ def load_svg(path) -> Scene:
     return _load(path)
 
 
-def render(*args, **kwargs):
-    """Render a Scene to an [H, W, 4] straight-RGBA tensor (see vecfit.render)."""
-    from .render import render as _render
-    return _render(*args, **kwargs)
+def has_cuda() -> bool:
+    """Whether this build of the core has the CUDA kernels."""
+    from . import _core
+    return bool(_core.has_cuda())

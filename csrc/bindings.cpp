@@ -1,0 +1,178 @@
+// Python bindings: numpy buffers in and out, the GIL released while the core works.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <stdexcept>
+#include <string>
+
+#include "coverage.h"
+#include "render.h"
+#include "scene.h"
+#include "thread_pool.h"
+
+namespace py = pybind11;
+using namespace vf;
+
+namespace {
+
+template <typename T>
+using Array = py::array_t<T, py::array::c_style | py::array::forcecast>;
+
+template <typename T>
+const T* rows(const Array<T>& a, int cols, int& n, const char* name) {
+    if (a.size() == 0) {
+        n = 0;
+        return nullptr;
+    }
+    if (a.size() % cols != 0) throw std::invalid_argument(std::string("vecfit core: ") + name + " has the wrong shape");
+    n = (int)(a.size() / cols);
+    return a.data();
+}
+
+int parse_mode(const std::string& m) {
+    if (m == "mc") return MODE_MC;
+    if (m == "analytic") return MODE_ANALYTIC;
+    throw std::invalid_argument("mode must be 'mc' or 'analytic', not '" + m + "'");
+}
+
+int parse_filter(const std::string& f) {
+    if (f == "box") return 0;
+    if (f == "tent") return 1;
+    if (f == "gaussian") return 2;
+    throw std::invalid_argument("filter must be 'box', 'tent' or 'gaussian', not '" + f + "'");
+}
+
+py::array_t<float> render(Array<float> points, Array<int32_t> segments, Array<int32_t> subpaths,
+                          Array<int32_t> shapes, Array<float> ellipses, Array<int32_t> draws,
+                          Array<float> draw_params, Array<int32_t> paints, Array<float> paint_params,
+                          Array<float> stop_offsets, Array<float> stop_colors, Array<int32_t> layer_parents,
+                          Array<float> layer_opacity, int width, int height, int samples,
+                          const std::string& mode, const std::string& filter, double filter_radius,
+                          uint64_t seed, int threads, py::object background) {
+    if (width <= 0 || height <= 0) throw std::invalid_argument("width and height must be positive");
+    if (samples <= 0) throw std::invalid_argument("samples must be positive");
+    SceneArrays a;
+    a.points = rows(points, 2, a.n_points, "points");
+    a.segments = rows(segments, SEGMENT_COLS, a.n_segments, "segments");
+    a.subpaths = rows(subpaths, SUBPATH_COLS, a.n_subpaths, "subpaths");
+    a.shapes = rows(shapes, SHAPE_COLS, a.n_shapes, "shapes");
+    a.ellipses = rows(ellipses, ELLIPSE_COLS, a.n_ellipses, "ellipses");
+    a.draws = rows(draws, DRAW_COLS, a.n_draws, "draws");
+    int n;
+    a.draw_params = rows(draw_params, DRAW_FCOLS, n, "draw_params");
+    if (n != a.n_draws) throw std::invalid_argument("vecfit core: draw_params does not match draws");
+    a.paints = rows(paints, PAINT_COLS, a.n_paints, "paints");
+    a.paint_params = rows(paint_params, PAINT_FCOLS, n, "paint_params");
+    if (n != a.n_paints) throw std::invalid_argument("vecfit core: paint_params does not match paints");
+    a.stop_offsets = rows(stop_offsets, 1, a.n_stops, "stop_offsets");
+    a.stop_colors = rows(stop_colors, 4, n, "stop_colors");
+    if (n != a.n_stops) throw std::invalid_argument("vecfit core: stop_colors does not match stop_offsets");
+    a.layer_parents = rows(layer_parents, 1, a.n_layers, "layer_parents");
+    a.layer_opacity = rows(layer_opacity, 1, n, "layer_opacity");
+    if (n != a.n_layers) throw std::invalid_argument("vecfit core: layer_opacity does not match layer_parents");
+
+    RenderOptions o;
+    o.width = width;
+    o.height = height;
+    o.samples = samples;
+    o.mode = parse_mode(mode);
+    o.filter = parse_filter(filter);
+    o.filter_radius = filter_radius;
+    o.seed = seed;
+    o.threads = threads;
+    if (!background.is_none()) {
+        auto bg = background.cast<std::vector<double>>();
+        if (bg.size() != 4) throw std::invalid_argument("background must be 4 numbers (RGBA)");
+        o.has_background = true;
+        for (int i = 0; i < 4; ++i) o.background[i] = bg[i];
+    }
+    py::array_t<float> image({height, width, 4});
+    float* out = image.mutable_data();
+    {
+        py::gil_scoped_release release;
+        PreparedScene scene = prepare_scene(a);
+        render_forward(scene, o, out);
+    }
+    return image;
+}
+
+Segment segment_from(const Array<double>& pts) {
+    if (pts.ndim() != 2 || pts.shape(1) != 2 || pts.shape(0) < 2 || pts.shape(0) > 4)
+        throw std::invalid_argument("points must be an [n, 2] array with n in 2..4");
+    Segment s;
+    s.degree = (int)pts.shape(0) - 1;
+    for (int i = 0; i <= s.degree; ++i) s.p[i] = {pts.at(i, 0), pts.at(i, 1)};
+    return s;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+    m.doc() = "vecfit's compiled core: geometry and rendering on flat arrays";
+    m.def("render", &render, "Render the scene arrays into a [H, W, 4] straight-RGBA image");
+    m.def("hardware_threads", &ThreadPool::hardware_threads);
+    m.def("has_cuda", [] { return false; });
+
+    m.def("polynomial_roots", [](std::vector<double> coeffs, double lo, double hi) {
+        if (coeffs.empty() || coeffs.size() > 6) throw std::invalid_argument("degree must be 0..5");
+        double roots[5];
+        int n = poly_roots(coeffs.data(), (int)coeffs.size() - 1, lo, hi, roots);
+        return std::vector<double>(roots, roots + n);
+    }, py::arg("coeffs"), py::arg("lo"), py::arg("hi"));
+
+    m.def("closest_point_on_segment", [](Array<double> pts, std::pair<double, double> p) {
+        Closest c = seg_closest(segment_from(pts), {p.first, p.second});
+        return py::make_tuple(c.t, c.dist);
+    }, py::arg("points"), py::arg("p"));
+
+    m.def("closest_point_on_ellipse", [](std::pair<double, double> center, Array<double> axes,
+                                         std::pair<double, double> p) {
+        if (axes.size() != 4) throw std::invalid_argument("axes must be a 2x2 matrix");
+        Mat2 A{axes.data()[0], axes.data()[1], axes.data()[2], axes.data()[3]};
+        EllipseFrame f = ellipse_frame({center.first, center.second}, A);
+        Vec2 q;
+        double d = ellipse_closest(f, {p.first, p.second}, q);
+        return py::make_tuple(py::make_tuple(q.x, q.y), d);
+    }, py::arg("center"), py::arg("axes"), py::arg("p"));
+
+    m.def("winding_number", [](Array<double> points, Array<int32_t> degrees, Array<int32_t> subpaths,
+                               std::pair<double, double> p) {
+        // Same layout as scene.Path; every subpath closed for filling.
+        const double* P = points.data();
+        int np = (int)(points.size() / 2);
+        int nb = (int)(subpaths.size() / 3);
+        const int32_t* sp = subpaths.data();
+        const int32_t* deg = degrees.data();
+        int w = 0, base = 0;
+        Vec2 q{p.first, p.second};
+        for (int b = 0; b < nb; ++b) {
+            int first = sp[3 * b], count = sp[3 * b + 1];
+            bool closed = sp[3 * b + 2] != 0;
+            int n_pts = closed ? 0 : 1;
+            for (int g = first; g < first + count; ++g) n_pts += deg[g];
+            int k = base;
+            auto pt = [&](int i) {
+                int j = i - base >= n_pts ? base : i;  // a closed subpath wraps to its start
+                if (j >= np) throw std::invalid_argument("points too short for the segments");
+                return Vec2{P[2 * j], P[2 * j + 1]};
+            };
+            for (int g = first; g < first + count; ++g) {
+                Segment s;
+                s.degree = deg[g];
+                for (int i = 0; i <= s.degree; ++i) s.p[i] = pt(k + i);
+                k += s.degree;
+                w += ray_crossings(prepare_segment(s, nullptr), q);
+            }
+            if (!closed && count > 0) {
+                Segment line;
+                line.degree = 1;
+                line.p[0] = pt(k);
+                line.p[1] = pt(base);
+                w += ray_crossings(prepare_segment(line, nullptr), q);
+            }
+            base += n_pts;
+        }
+        return w;
+    }, py::arg("points"), py::arg("degrees"), py::arg("subpaths"), py::arg("p"));
+}

@@ -1,0 +1,239 @@
+// Point queries against prepared draws: is a point covered (Monte Carlo), and its signed
+// distance to the covered region (analytical prefilter; negative inside).
+//
+// Strokes follow the SVG model as a union of simple pieces, each in stroke space (pixel
+// space mapped by the draw's metric, so that a stroke under a non-uniform transform is
+// exact):
+//   * per segment, the sweep of its normals of length w: p is inside when some critical
+//     point t* of |B(t) - p| on [0, 1] (a root of the quintic for cubics) lies within w/2;
+//   * per interior vertex, the join: a disk (round), the triangle between the two offset
+//     end points (bevel), or that quadrilateral reaching to the miter tip (miter, falling
+//     back to bevel past the miter limit);
+//   * per free end, the cap: nothing (butt: the sweep ends at its end normal), a disk
+//     (round) or a square of side w centred on the end point (square; its back half lies
+//     inside the sweep).
+// Why this form: each piece has a simple inside test and a signed distance, and the
+// union's boundary is a set of curves with known normals (offset curves, disk arcs,
+// polygon edges, butt end lines), which is what boundary sampling needs for gradients.
+// A boundary point of one piece that lies inside another is not on the union's boundary;
+// the gradient pass finds that out by evaluating the stroke with and without the piece.
+#pragma once
+
+#include "geometry.h"
+#include "scene.h"
+
+namespace vf {
+
+// Signed crossings of the ray from p towards +x with the segment; each y-monotone piece
+// counts on the half-open range [y_low, y_high) so that pieces meeting at a vertex are
+// counted once.
+inline int ray_crossings(const PreparedSegment& s, Vec2 p) {
+    if (p.y < s.box.y0 || p.y > s.box.y1 || p.x > s.box.x1) return 0;
+    int w = 0;
+    for (int k = 0; k + 1 < s.n_split; ++k) {
+        double ya = s.split_y[k], yb = s.split_y[k + 1];
+        int dir;
+        if (ya <= p.y && p.y < yb) dir = 1;
+        else if (yb <= p.y && p.y < ya) dir = -1;
+        else continue;
+        if (p.x < s.box.x0) {
+            w += dir;
+            continue;
+        }
+        double t = seg_solve_monotone(s.seg, 1, p.y, s.split[k], s.split[k + 1]);
+        if (seg_eval(s.seg, t).x > p.x) w += dir;
+    }
+    return w;
+}
+
+inline bool winding_inside(int winding, int rule) {
+    return rule == EVENODD ? (winding & 1) != 0 : winding != 0;
+}
+
+// Distance from p to the closest of the segments, or `limit` if none is closer.
+inline double segments_distance(const PreparedSegment* segs, int n, Vec2 p, double limit) {
+    double best = limit;
+    for (int i = 0; i < n; ++i) {
+        if (distance2(segs[i].box, p) >= best * best) continue;
+        if (segs[i].seg.degree == 1) {
+            Vec2 a = segs[i].seg.p[0], d = segs[i].seg.p[1] - a;
+            double l2 = dot(d, d);
+            double t = l2 > 0 ? std::clamp(dot(p - a, d) / l2, 0.0, 1.0) : 0.0;
+            best = std::min(best, distance(a + t * d, p));
+        } else {
+            best = std::min(best, seg_closest(segs[i].seg, p).dist);
+        }
+    }
+    return best;
+}
+
+// ----------------------------------------------------------------------- strokes
+
+inline double point_line_segment_distance(Vec2 p, Vec2 a, Vec2 b) {
+    Vec2 d = b - a;
+    double l2 = dot(d, d);
+    double t = l2 > 0 ? std::clamp(dot(p - a, d) / l2, 0.0, 1.0) : 0.0;
+    return distance(a + t * d, p);
+}
+
+inline bool convex_contains(const Vec2* v, int n, Vec2 q) {
+    bool pos = false, neg = false;
+    for (int i = 0; i < n; ++i) {
+        double c = cross(v[(i + 1) % n] - v[i], q - v[i]);
+        pos |= c > 0;
+        neg |= c < 0;
+    }
+    return !(pos && neg);
+}
+
+inline double convex_sdf(const Vec2* v, int n, Vec2 q) {
+    double d = 1e300;
+    for (int i = 0; i < n; ++i) d = std::min(d, point_line_segment_distance(q, v[i], v[(i + 1) % n]));
+    return convex_contains(v, n, q) ? -d : d;
+}
+
+inline double square_sdf(const StrokeEnd& e, Vec2 q, double hw) {
+    Vec2 r = q - e.center;
+    double u = std::fabs(dot(r, e.axis)) - hw, v = std::fabs(cross(e.axis, r)) - hw;
+    double ou = std::max(u, 0.0), ov = std::max(v, 0.0);
+    return std::sqrt(ou * ou + ov * ov) + std::min(std::max(u, v), 0.0);
+}
+
+inline bool end_contains(const StrokeEnd& e, Vec2 q, double hw) {
+    switch (e.kind) {
+        case StrokeEnd::DISK: return dot(q - e.center, q - e.center) <= hw * hw;
+        case StrokeEnd::SQUARE: {
+            Vec2 r = q - e.center;
+            return std::fabs(dot(r, e.axis)) <= hw && std::fabs(cross(e.axis, r)) <= hw;
+        }
+        case StrokeEnd::POLYGON: return convex_contains(e.poly, e.n_poly, q);
+        default: return false;
+    }
+}
+
+inline double end_sdf(const StrokeEnd& e, Vec2 q, double hw) {
+    switch (e.kind) {
+        case StrokeEnd::DISK: return distance(q, e.center) - hw;
+        case StrokeEnd::SQUARE: return square_sdf(e, q, hw);
+        case StrokeEnd::POLYGON: return convex_sdf(e.poly, e.n_poly, q);
+        default: return 1e300;
+    }
+}
+
+// Signed distance to the sweep's boundary from its critical points alone (offset curves):
+// min over critical points of (|B(t*) - q| - w/2); +huge when there are none.
+inline double sweep_sdf(const Segment& s, Vec2 q, double hw) {
+    double ts[5];
+    int n = seg_critical_points(s, q, ts);
+    double best = 1e300;
+    for (int i = 0; i < n; ++i) best = std::min(best, distance(seg_eval(s, ts[i]), q) - hw);
+    return best;
+}
+
+inline bool sweep_contains(const Segment& s, Vec2 q, double hw) {
+    if (distance2(seg_bbox(s), q) > hw * hw) return false;
+    if (s.degree == 1) {  // the rectangle around the line
+        Vec2 d = s.p[1] - s.p[0];
+        double l2 = dot(d, d);
+        if (l2 <= 0) return false;
+        double t = dot(q - s.p[0], d) / l2;
+        return t >= 0 && t <= 1 && std::fabs(cross(d, q - s.p[0])) <= hw * std::sqrt(l2);
+    }
+    double ts[5];
+    int n = seg_critical_points(s, q, ts);
+    for (int i = 0; i < n; ++i)
+        if (dot(seg_eval(s, ts[i]) - q, seg_eval(s, ts[i]) - q) <= hw * hw) return true;
+    return false;
+}
+
+inline bool stroke_item_contains(const StrokeSegment& s, Vec2 q, double hw) {
+    return end_contains(s.end, q, hw) || end_contains(s.start, q, hw) || sweep_contains(s.seg, q, hw);
+}
+
+// Signed distance (stroke space) to this item's pieces. The butt end lines of free ends
+// bound the sweep; other end normals are interior seams covered by a join or cap.
+inline double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double hw) {
+    double sd = sweep_sdf(s.seg, q, hw);
+    if (s.butt_start || s.butt_end) {
+        double dl = 1e300;
+        for (int k = 0; k < 2; ++k) {
+            if (!(k == 0 ? s.butt_start : s.butt_end)) continue;
+            Vec2 at = k == 0 ? s.seg.p[0] : seg_end(s.seg);
+            Vec2 n = perp(seg_end_tangent(s.seg, k == 1));
+            dl = std::min(dl, point_line_segment_distance(q, at - hw * n, at + hw * n));
+        }
+        sd = sd <= 0 ? std::max(sd, -dl) : std::min(sd, dl);
+    }
+    sd = std::min(sd, end_sdf(s.start, q, hw));
+    sd = std::min(sd, end_sdf(s.end, q, hw));
+    return sd;
+}
+
+// ----------------------------------------------------------------- whole draws
+
+inline Vec2 to_stroke_space(const PreparedDraw& d, Vec2 p) {
+    return d.metric_identity ? p : d.metric * p;
+}
+
+// Monte Carlo coverage: is p (pixel space) inside the draw?
+inline bool draw_contains(const PreparedScene& sc, const PreparedDraw& d, Vec2 p) {
+    if (p.x < d.box.x0 || p.x > d.box.x1 || p.y < d.box.y0 || p.y > d.box.y1) return false;
+    if (d.kind == DRAW_FILL) {
+        if (d.is_ellipse) return ellipse_contains(d.ellipse, p);
+        int w = 0;
+        const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
+        for (int i = 0; i < d.n_items; ++i) w += ray_crossings(segs[i], p);
+        return winding_inside(w, d.fill_rule);
+    }
+    Vec2 q = to_stroke_space(d, p);
+    double hw = d.half_width;
+    if (d.is_ellipse) {
+        Vec2 c;
+        return ellipse_closest(d.ellipse, q, c) <= hw;
+    }
+    const StrokeSegment* items = sc.stroke_items.data() + d.first_item;
+    for (int i = 0; i < d.n_items; ++i) {
+        const Box& b = items[i].box;
+        if (p.x < b.x0 || p.x > b.x1 || p.y < b.y0 || p.y > b.y1) continue;
+        if (stroke_item_contains(items[i], q, hw)) return true;
+    }
+    return false;
+}
+
+// Signed distance in pixels from p to the draw's boundary (negative inside), clamped to
+// [-limit, limit]: only its value within the prefilter radius matters.
+inline double draw_sdf(const PreparedScene& sc, const PreparedDraw& d, Vec2 p, double limit) {
+    Box near = grown(d.box, limit);
+    if (p.x < near.x0 || p.x > near.x1 || p.y < near.y0 || p.y > near.y1) return limit;
+    if (d.kind == DRAW_FILL) {
+        if (d.is_ellipse) {
+            Vec2 c;
+            double dist = std::min(ellipse_closest(d.ellipse, p, c), limit);
+            return ellipse_contains(d.ellipse, p) ? -dist : dist;
+        }
+        const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
+        double dist = segments_distance(segs, d.n_items, p, limit);
+        int w = 0;
+        for (int i = 0; i < d.n_items; ++i) w += ray_crossings(segs[i], p);
+        return winding_inside(w, d.fill_rule) ? -dist : dist;
+    }
+    Vec2 q = to_stroke_space(d, p);
+    double hw = d.half_width;
+    double sd;
+    if (d.is_ellipse) {
+        Vec2 c;
+        sd = ellipse_closest(d.ellipse, q, c) - hw;
+    } else {
+        sd = 1e300;
+        const StrokeSegment* items = sc.stroke_items.data() + d.first_item;
+        for (int i = 0; i < d.n_items; ++i) {
+            Box b = grown(items[i].box, limit);
+            if (p.x < b.x0 || p.x > b.x1 || p.y < b.y0 || p.y > b.y1) continue;
+            sd = std::min(sd, stroke_item_sdf(items[i], q, hw));
+        }
+    }
+    sd *= d.metric_scale;
+    return std::clamp(sd, -limit, limit);
+}
+
+}  // namespace vf

@@ -1,0 +1,414 @@
+// Geometry on doubles: vectors, polynomial roots, Bézier segments, closest points.
+// Everything here is inline and free of allocation so that a CUDA build can compile the
+// same functions for the device.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#ifndef VF_HD
+#define VF_HD inline
+#endif
+
+namespace vf {
+
+struct Vec2 {
+    double x = 0, y = 0;
+};
+VF_HD Vec2 operator+(Vec2 a, Vec2 b) { return {a.x + b.x, a.y + b.y}; }
+VF_HD Vec2 operator-(Vec2 a, Vec2 b) { return {a.x - b.x, a.y - b.y}; }
+VF_HD Vec2 operator-(Vec2 a) { return {-a.x, -a.y}; }
+VF_HD Vec2 operator*(double s, Vec2 a) { return {s * a.x, s * a.y}; }
+VF_HD Vec2 operator*(Vec2 a, double s) { return {s * a.x, s * a.y}; }
+VF_HD double dot(Vec2 a, Vec2 b) { return a.x * b.x + a.y * b.y; }
+VF_HD double cross(Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; }
+VF_HD double length(Vec2 a) { return std::sqrt(dot(a, a)); }
+VF_HD double distance(Vec2 a, Vec2 b) { return length(a - b); }
+VF_HD Vec2 perp(Vec2 a) { return {-a.y, a.x}; }
+VF_HD Vec2 normalized(Vec2 a) {
+    double l = length(a);
+    return l > 0 ? Vec2{a.x / l, a.y / l} : Vec2{0, 0};
+}
+
+// 2x2 linear map, row-major: (a b; c d).
+struct Mat2 {
+    double a = 1, b = 0, c = 0, d = 1;
+};
+VF_HD Vec2 operator*(const Mat2& m, Vec2 v) { return {m.a * v.x + m.b * v.y, m.c * v.x + m.d * v.y}; }
+VF_HD double det(const Mat2& m) { return m.a * m.d - m.b * m.c; }
+VF_HD Mat2 inverse(const Mat2& m) {
+    double k = det(m);
+    k = k != 0 ? 1.0 / k : 0.0;
+    return {m.d * k, -m.b * k, -m.c * k, m.a * k};
+}
+
+// 2-D affine map, row-major 2x3: x' = m00 x + m01 y + m02, y' = m10 x + m11 y + m12.
+struct Affine {
+    double m00 = 1, m01 = 0, m02 = 0, m10 = 0, m11 = 1, m12 = 0;
+};
+VF_HD Vec2 apply(const Affine& m, Vec2 p) {
+    return {m.m00 * p.x + m.m01 * p.y + m.m02, m.m10 * p.x + m.m11 * p.y + m.m12};
+}
+
+struct Box {
+    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+};
+VF_HD void expand(Box& b, Vec2 p) {
+    b.x0 = std::min(b.x0, p.x);
+    b.y0 = std::min(b.y0, p.y);
+    b.x1 = std::max(b.x1, p.x);
+    b.y1 = std::max(b.y1, p.y);
+}
+VF_HD Box grown(Box b, double m) { return {b.x0 - m, b.y0 - m, b.x1 + m, b.y1 + m}; }
+VF_HD bool overlaps(const Box& a, const Box& b) {
+    return a.x0 <= b.x1 && b.x0 <= a.x1 && a.y0 <= b.y1 && b.y0 <= a.y1;
+}
+VF_HD bool valid(const Box& b) { return b.x0 <= b.x1 && b.y0 <= b.y1; }
+// Squared distance from p to the box (0 inside).
+VF_HD double distance2(const Box& b, Vec2 p) {
+    double dx = std::max(std::max(b.x0 - p.x, 0.0), p.x - b.x1);
+    double dy = std::max(std::max(b.y0 - p.y, 0.0), p.y - b.y1);
+    return dx * dx + dy * dy;
+}
+
+// ------------------------------------------------------------------ polynomials
+
+VF_HD double poly_eval(const double* c, int n, double t) {  // sum c[i] t^i, i <= n
+    double v = c[n];
+    for (int i = n - 1; i >= 0; --i) v = v * t + c[i];
+    return v;
+}
+
+// Root of p in [a, b] where p(a) and p(b) have opposite signs: Newton steps, falling back
+// to bisection whenever a step leaves the bracket, so it always converges.
+VF_HD double refine_root(const double* c, int n, double a, double b, double pa) {
+    double d[5];
+    for (int i = 0; i < n; ++i) d[i] = (i + 1) * c[i + 1];
+    double t = 0.5 * (a + b);
+    for (int it = 0; it < 60; ++it) {
+        double p = poly_eval(c, n, t);
+        if (p == 0) return t;
+        if ((p < 0) == (pa < 0)) {
+            a = t;
+            pa = p;
+        } else {
+            b = t;
+        }
+        double dp = n > 0 ? poly_eval(d, n - 1, t) : 0;
+        double next = dp != 0 ? t - p / dp : 0.5 * (a + b);
+        if (!(next > a && next < b)) next = 0.5 * (a + b);
+        if (std::fabs(next - t) <= 1e-15 * (1 + std::fabs(t)) || b - a <= 1e-15) return next;
+        t = next;
+    }
+    return t;
+}
+
+// Real roots of sum c[i] t^i (degree <= 5) in [lo, hi], sorted; returns their count.
+// Isolation by derivatives: the roots of p' cut [lo, hi] into pieces on which p is
+// monotone, so each piece holds at most one root, found by refine_root. Double roots
+// (p and p' vanish together) are caught at the critical points. A leading coefficient
+// that is negligible next to the others is dropped.
+VF_HD int poly_roots(const double* coeffs, int degree, double lo, double hi, double* roots) {
+    double c[6];
+    double scale = 0;
+    for (int i = 0; i <= degree; ++i) {
+        c[i] = coeffs[i];
+        scale = std::max(scale, std::fabs(c[i]));
+    }
+    if (scale == 0) return 0;
+    int n = degree;
+    while (n > 0 && std::fabs(c[n]) <= 1e-13 * scale) --n;
+    if (n == 0) return 0;
+    if (n == 1) {
+        double t = -c[0] / c[1];
+        if (t >= lo && t <= hi) {
+            roots[0] = t;
+            return 1;
+        }
+        return 0;
+    }
+    double d[5];
+    for (int i = 0; i < n; ++i) d[i] = (i + 1) * c[i + 1];
+    double crit[5];
+    int nc = poly_roots(d, n - 1, lo, hi, crit);
+    double knots[7];
+    int nk = 0;
+    knots[nk++] = lo;
+    for (int i = 0; i < nc; ++i)
+        if (crit[i] > knots[nk - 1]) knots[nk++] = crit[i];
+    if (hi > knots[nk - 1]) knots[nk++] = hi;
+    // Walk the knots in order: a knot where p vanishes (to rounding) is a root — this
+    // catches double roots, which show no sign change — and a sign change strictly
+    // inside a piece brackets exactly one root.
+    int count = 0;
+    auto vanishes = [&](double t, double pt) {
+        double at = std::fabs(t) + 1;
+        return std::fabs(pt) <= 1e-12 * scale * at * at * at * at * at;
+    };
+    double pk[7];
+    for (int k = 0; k < nk; ++k) pk[k] = poly_eval(c, n, knots[k]);
+    for (int k = 0; k < nk; ++k) {
+        if (vanishes(knots[k], pk[k]) &&
+            (count == 0 || knots[k] - roots[count - 1] > 1e-12 * (1 + std::fabs(knots[k]))))
+            roots[count++] = knots[k];
+        if (k + 1 < nk && !vanishes(knots[k], pk[k]) && !vanishes(knots[k + 1], pk[k + 1]) &&
+            (pk[k] < 0) != (pk[k + 1] < 0))
+            roots[count++] = refine_root(c, n, knots[k], knots[k + 1], pk[k]);
+    }
+    return count;
+}
+
+// ------------------------------------------------------------- Bézier segments
+
+// A segment of degree 1..3 given by its control points.
+struct Segment {
+    int degree = 1;
+    Vec2 p[4];
+};
+
+VF_HD Vec2 seg_eval(const Segment& s, double t) {
+    double u = 1 - t;
+    switch (s.degree) {
+        case 1: return u * s.p[0] + t * s.p[1];
+        case 2: return (u * u) * s.p[0] + (2 * u * t) * s.p[1] + (t * t) * s.p[2];
+        default:
+            return (u * u * u) * s.p[0] + (3 * u * u * t) * s.p[1] + (3 * u * t * t) * s.p[2] +
+                   (t * t * t) * s.p[3];
+    }
+}
+
+VF_HD Vec2 seg_deriv(const Segment& s, double t) {
+    double u = 1 - t;
+    switch (s.degree) {
+        case 1: return s.p[1] - s.p[0];
+        case 2: return (2 * u) * (s.p[1] - s.p[0]) + (2 * t) * (s.p[2] - s.p[1]);
+        default:
+            return (3 * u * u) * (s.p[1] - s.p[0]) + (6 * u * t) * (s.p[2] - s.p[1]) +
+                   (3 * t * t) * (s.p[3] - s.p[2]);
+    }
+}
+
+VF_HD Vec2 seg_end(const Segment& s) { return s.p[s.degree]; }
+
+// Power-basis coefficients a[k] of the segment relative to an origin o: B(t) - o = sum a[k] t^k.
+VF_HD void seg_power_basis(const Segment& s, Vec2 o, Vec2* a) {
+    Vec2 p0 = s.p[0] - o;
+    if (s.degree == 1) {
+        a[0] = p0;
+        a[1] = s.p[1] - s.p[0];
+    } else if (s.degree == 2) {
+        a[0] = p0;
+        a[1] = 2.0 * (s.p[1] - s.p[0]);
+        a[2] = s.p[0] - 2.0 * s.p[1] + s.p[2];
+    } else {
+        a[0] = p0;
+        a[1] = 3.0 * (s.p[1] - s.p[0]);
+        a[2] = 3.0 * (s.p[0] - 2.0 * s.p[1] + s.p[2]);
+        a[3] = (s.p[3] - s.p[0]) + 3.0 * (s.p[1] - s.p[2]);
+    }
+}
+
+// Critical points of |B(t) - p|^2 on [0, 1]: the roots of (B(t) - p) . B'(t), a
+// polynomial of degree 2n - 1 (a quintic for cubics). Returns their count.
+VF_HD int seg_critical_points(const Segment& s, Vec2 p, double* ts) {
+    Vec2 a[4];
+    seg_power_basis(s, p, a);
+    int n = s.degree;
+    double c[6] = {0, 0, 0, 0, 0, 0};
+    for (int i = 0; i <= n; ++i)
+        for (int j = 1; j <= n; ++j) c[i + j - 1] += j * dot(a[i], a[j]);
+    return poly_roots(c, 2 * n - 1, 0.0, 1.0, ts);
+}
+
+// Global closest point: the best of the critical points and the two end points.
+struct Closest {
+    double t = 0, dist = 1e300;
+};
+VF_HD Closest seg_closest(const Segment& s, Vec2 p) {
+    Closest best;
+    best.t = 0;
+    best.dist = distance(s.p[0], p);
+    double d1 = distance(seg_end(s), p);
+    if (d1 < best.dist) best = {1.0, d1};
+    double ts[5];
+    int n = seg_critical_points(s, p, ts);
+    for (int i = 0; i < n; ++i) {
+        double d = distance(seg_eval(s, ts[i]), p);
+        if (d < best.dist) best = {ts[i], d};
+    }
+    return best;
+}
+
+VF_HD Box seg_bbox(const Segment& s) {  // of the control polygon (contains the curve)
+    Box b;
+    for (int i = 0; i <= s.degree; ++i) expand(b, s.p[i]);
+    return b;
+}
+
+// Tangent direction at t = 0 (end = false) or t = 1 (end = true), skipping coincident
+// control points; zero for a segment that is a single point.
+VF_HD Vec2 seg_end_tangent(const Segment& s, bool end) {
+    int n = s.degree;
+    if (!end) {
+        for (int i = 1; i <= n; ++i) {
+            Vec2 d = s.p[i] - s.p[0];
+            if (dot(d, d) > 1e-24) return normalized(d);
+        }
+    } else {
+        for (int i = n - 1; i >= 0; --i) {
+            Vec2 d = s.p[n] - s.p[i];
+            if (dot(d, d) > 1e-24) return normalized(d);
+        }
+    }
+    return {0, 0};
+}
+
+// Parameter values in (0, 1) where the coordinate (axis 0: x, 1: y) has an extremum.
+VF_HD int seg_extrema(const Segment& s, int axis, double* ts) {
+    auto v = [&](int i) { return axis == 0 ? s.p[i].x : s.p[i].y; };
+    if (s.degree == 1) return 0;
+    double c[3];
+    if (s.degree == 2) {  // B' = 2 (p1 - p0) + 2 t (p0 - 2 p1 + p2)
+        c[0] = v(1) - v(0);
+        c[1] = v(0) - 2 * v(1) + v(2);
+        int n = poly_roots(c, 1, 0.0, 1.0, ts);
+        int m = 0;
+        for (int i = 0; i < n; ++i)
+            if (ts[i] > 0 && ts[i] < 1) ts[m++] = ts[i];
+        return m;
+    }
+    double a = v(1) - v(0), b = v(2) - v(1), d = v(3) - v(2);
+    c[0] = a;
+    c[1] = 2 * (b - a);
+    c[2] = a - 2 * b + d;
+    int n = poly_roots(c, 2, 0.0, 1.0, ts);
+    int m = 0;
+    for (int i = 0; i < n; ++i)
+        if (ts[i] > 0 && ts[i] < 1) ts[m++] = ts[i];
+    return m;
+}
+
+// t in [t0, t1] where the coordinate `axis` of a segment monotone on that interval
+// equals `value` (value lies between the coordinates at t0 and t1).
+VF_HD double seg_solve_monotone(const Segment& s, int axis, double value, double t0, double t1) {
+    auto coord = [&](double t) {
+        Vec2 q = seg_eval(s, t);
+        return axis == 0 ? q.x : q.y;
+    };
+    if (s.degree == 1) {
+        double a = axis == 0 ? s.p[0].x : s.p[0].y, b = axis == 0 ? s.p[1].x : s.p[1].y;
+        return b != a ? (value - a) / (b - a) : t0;
+    }
+    double f0 = coord(t0) - value;
+    double a = t0, b = t1;
+    double t = 0.5 * (a + b);
+    for (int it = 0; it < 50; ++it) {
+        double f = coord(t) - value;
+        if (f == 0) return t;
+        if ((f < 0) == (f0 < 0)) a = t; else b = t;
+        Vec2 dv = seg_deriv(s, t);
+        double df = axis == 0 ? dv.x : dv.y;
+        double next = df != 0 ? t - f / df : 0.5 * (a + b);
+        if (!(next > a && next < b)) next = 0.5 * (a + b);
+        if (std::fabs(next - t) < 1e-13 || b - a < 1e-13) return next;
+        t = next;
+    }
+    return t;
+}
+
+// ---------------------------------------------------------------------- ellipses
+
+// Closest point on the axis-aligned ellipse (x/e0)^2 + (y/e1)^2 = 1 to (y0, y1), for
+// e0 >= e1 > 0 and y0, y1 >= 0: Eberly's robust bisection on the Lagrange parameter.
+VF_HD double ellipse_closest_quadrant(double e0, double e1, double y0, double y1, double& x0, double& x1) {
+    if (y1 > 0) {
+        if (y0 > 0) {
+            double z0 = y0 / e0, z1 = y1 / e1;
+            double g = z0 * z0 + z1 * z1 - 1;
+            if (g != 0) {
+                double r0 = (e0 / e1) * (e0 / e1);
+                double n0 = r0 * z0;
+                double s0 = z1 - 1;
+                double s1 = g < 0 ? 0 : std::hypot(n0, z1) - 1;
+                double s = 0;
+                for (int i = 0; i < 200; ++i) {
+                    s = 0.5 * (s0 + s1);
+                    if (s == s0 || s == s1) break;
+                    double q0 = n0 / (s + r0), q1 = z1 / (s + 1);
+                    double gs = q0 * q0 + q1 * q1 - 1;
+                    if (gs > 0) s0 = s;
+                    else if (gs < 0) s1 = s;
+                    else break;
+                }
+                x0 = r0 * y0 / (s + r0);
+                x1 = y1 / (s + 1);
+                return std::hypot(x0 - y0, x1 - y1);
+            }
+            x0 = y0;
+            x1 = y1;
+            return 0;
+        }
+        x0 = 0;
+        x1 = e1;
+        return std::fabs(y1 - e1);
+    }
+    double numer0 = e0 * y0, denom0 = e0 * e0 - e1 * e1;
+    if (numer0 < denom0) {
+        double xde0 = numer0 / denom0;
+        x0 = e0 * xde0;
+        x1 = e1 * std::sqrt(std::max(0.0, 1 - xde0 * xde0));
+        return std::hypot(x0 - y0, x1);
+    }
+    x0 = e0;
+    x1 = 0;
+    return std::fabs(y0 - e0);
+}
+
+// An ellipse {c + A (cos a, sin a)} in principal form: rotation (cs, sn) and semi-axes.
+struct EllipseFrame {
+    Vec2 c;
+    double cs = 1, sn = 0;  // columns of U: (cs, sn) and (-sn, cs)
+    double r0 = 0, r1 = 0;  // semi-axes along those directions
+};
+
+// SVD of the 2x2 axes matrix: A = U diag(r0, r1) V^T; the ellipse is c + U diag(r) w.
+VF_HD EllipseFrame ellipse_frame(Vec2 c, const Mat2& A) {
+    // A A^T = U diag(r^2) U^T
+    double p = A.a * A.a + A.b * A.b, q = A.a * A.c + A.b * A.d, r = A.c * A.c + A.d * A.d;
+    double theta = 0.5 * std::atan2(2 * q, p - r);
+    double mid = 0.5 * (p + r), rad = std::hypot(0.5 * (p - r), q);
+    EllipseFrame f;
+    f.c = c;
+    f.cs = std::cos(theta);
+    f.sn = std::sin(theta);
+    f.r0 = std::sqrt(std::max(0.0, mid + rad));
+    f.r1 = std::sqrt(std::max(0.0, mid - rad));
+    return f;
+}
+
+// Closest point on the ellipse and its distance.
+VF_HD double ellipse_closest(const EllipseFrame& f, Vec2 p, Vec2& closest) {
+    Vec2 d = p - f.c;
+    double u = f.cs * d.x + f.sn * d.y, v = -f.sn * d.x + f.cs * d.y;
+    double e0 = f.r0, e1 = f.r1;
+    if (e1 <= 0) {  // degenerate: a line segment of half-length e0 along the first axis
+        double x = std::clamp(u, -e0, e0);
+        closest = f.c + Vec2{f.cs * x, f.sn * x};
+        return std::hypot(u - x, v);
+    }
+    double x0, x1, dist;
+    dist = ellipse_closest_quadrant(e0, e1, std::fabs(u), std::fabs(v), x0, x1);
+    x0 = std::copysign(x0, u);
+    x1 = std::copysign(x1, v);
+    closest = f.c + Vec2{f.cs * x0 - f.sn * x1, f.sn * x0 + f.cs * x1};
+    return dist;
+}
+
+VF_HD bool ellipse_contains(const EllipseFrame& f, Vec2 p) {
+    if (f.r0 <= 0 || f.r1 <= 0) return false;
+    Vec2 d = p - f.c;
+    double u = (f.cs * d.x + f.sn * d.y) / f.r0, v = (-f.sn * d.x + f.cs * d.y) / f.r1;
+    return u * u + v * v <= 1;
+}
+
+}  // namespace vf

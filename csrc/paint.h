@@ -1,0 +1,63 @@
+// Paint evaluation: solid colours and linear / radial gradients (pad spread), returned
+// premultiplied.
+#pragma once
+
+#include "geometry.h"
+#include "scene.h"
+
+namespace vf {
+
+// Colour of the stops at t (straight RGBA interpolated, as SVG does), premultiplied.
+inline void stop_color(const PreparedScene& sc, const PreparedPaint& p, double t, double out[4]) {
+    const double* off = sc.stop_offsets.data() + p.first_stop;
+    const double* col = sc.stop_colors.data() + 4 * p.first_stop;
+    int n = p.n_stops;
+    double c[4];
+    if (!(t > off[0])) {  // also catches NaN
+        for (int i = 0; i < 4; ++i) c[i] = col[i];
+    } else if (t >= off[n - 1]) {
+        for (int i = 0; i < 4; ++i) c[i] = col[4 * (n - 1) + i];
+    } else {
+        int k = 0;
+        while (k + 2 < n && t >= off[k + 1]) ++k;
+        double span = off[k + 1] - off[k];
+        double u = span > 0 ? (t - off[k]) / span : 1.0;
+        for (int i = 0; i < 4; ++i) c[i] = (1 - u) * col[4 * k + i] + u * col[4 * (k + 1) + i];
+    }
+    double a = std::clamp(c[3], 0.0, 1.0);
+    for (int i = 0; i < 3; ++i) out[i] = std::clamp(c[i], 0.0, 1.0) * a;
+    out[3] = a;
+}
+
+// Gradient parameter of a radial gradient with focal point f inside the circle (c, r):
+// the t >= 0 for which q lies on the circle of centre f + t (c - f) and radius t r.
+inline double radial_t(Vec2 q, Vec2 c, double r, Vec2 f) {
+    Vec2 d = c - f, e = q - f;
+    double a = dot(d, d) - r * r, b = dot(e, d), cc = dot(e, e);
+    if (std::fabs(a) <= 1e-12 * r * r) return b > 0 ? cc / (2 * b) : 1e30;
+    double disc = b * b - a * cc;
+    if (disc < 0) return 1e30;
+    return (b - std::sqrt(disc)) / a;
+}
+
+inline void paint_color(const PreparedScene& sc, const PreparedPaint& p, Vec2 pixel, double out[4]) {
+    if (p.kind == PAINT_SOLID) {
+        double a = std::clamp(p.rgba[3], 0.0, 1.0);
+        for (int i = 0; i < 3; ++i) out[i] = std::clamp(p.rgba[i], 0.0, 1.0) * a;
+        out[3] = a;
+        return;
+    }
+    Vec2 q = apply(p.to_paint, pixel);
+    double t;
+    if (p.kind == PAINT_LINEAR) {
+        Vec2 a{p.g[0], p.g[1]}, d = Vec2{p.g[2], p.g[3]} - a;
+        double l2 = dot(d, d);
+        t = l2 > 0 ? dot(q - a, d) / l2 : 1.0;  // degenerate: the last stop's colour
+    } else {
+        double r = p.g[2];
+        t = r > 0 ? radial_t(q, {p.g[0], p.g[1]}, r, {p.g[3], p.g[4]}) : 1.0;
+    }
+    stop_color(sc, p, t, out);
+}
+
+}  // namespace vf

@@ -1,0 +1,310 @@
+// Builds the PreparedScene from the flat arrays: control points per segment, bounds,
+// y-monotone pieces for ray crossings, stroke pieces (joins and caps), paints, layers.
+#include <stdexcept>
+#include <string>
+
+#include "scene.h"
+
+namespace vf {
+namespace {
+
+void check(bool ok, const std::string& what) {
+    if (!ok) throw std::invalid_argument("vecfit core: " + what);
+}
+
+bool finite(double v) { return std::isfinite(v); }
+
+}  // namespace
+
+PreparedSegment prepare_segment(const Segment& s, const int32_t* idx) {
+    PreparedSegment ps;
+    ps.seg = s;
+    for (int i = 0; i < 4; ++i) ps.point_index[i] = idx ? idx[i] : -1;
+    ps.box = seg_bbox(s);
+    double ext[2];
+    int n = seg_extrema(s, 1, ext);
+    ps.n_split = 0;
+    ps.split[ps.n_split++] = 0;
+    for (int i = 0; i < n; ++i)
+        if (ext[i] > ps.split[ps.n_split - 1]) ps.split[ps.n_split++] = ext[i];
+    ps.split[ps.n_split++] = 1;
+    for (int i = 0; i < ps.n_split; ++i) ps.split_y[i] = seg_eval(s, ps.split[i]).y;
+    return ps;
+}
+
+namespace {
+
+bool is_point(const Segment& s) {
+    for (int i = 1; i <= s.degree; ++i)
+        if (dot(s.p[i] - s.p[0], s.p[i] - s.p[0]) > 1e-24) return false;
+    return true;
+}
+
+Segment transformed(const Segment& s, const Mat2& m) {
+    Segment out = s;
+    for (int i = 0; i <= s.degree; ++i) out.p[i] = m * s.p[i];
+    return out;
+}
+
+// Pixel-space bounds of a stroke-space box.
+Box to_pixel_box(const Box& b, const Mat2& inv) {
+    Box out;
+    expand(out, inv * Vec2{b.x0, b.y0});
+    expand(out, inv * Vec2{b.x1, b.y0});
+    expand(out, inv * Vec2{b.x0, b.y1});
+    expand(out, inv * Vec2{b.x1, b.y1});
+    return out;
+}
+
+void add_end_to_box(Box& b, const StrokeEnd& e, double hw) {
+    switch (e.kind) {
+        case StrokeEnd::DISK:
+            expand(b, e.center + Vec2{-hw, -hw});
+            expand(b, e.center + Vec2{hw, hw});
+            break;
+        case StrokeEnd::SQUARE:
+            expand(b, e.center + Vec2{-hw * 1.5, -hw * 1.5});
+            expand(b, e.center + Vec2{hw * 1.5, hw * 1.5});
+            break;
+        case StrokeEnd::POLYGON:
+            for (int i = 0; i < e.n_poly; ++i) expand(b, e.poly[i]);
+            break;
+        default: break;
+    }
+}
+
+// The join at vertex v between a segment leaving along t_in and one leaving along t_out.
+StrokeEnd make_join(Vec2 v, Vec2 t_in, Vec2 t_out, int join, double hw, double miter_limit) {
+    StrokeEnd e;
+    double c = cross(t_in, t_out), d = dot(t_in, t_out);
+    if (std::fabs(c) < 1e-12 && d > 0) return e;  // no turn: the sweeps already meet
+    if (join == JOIN_ROUND) {
+        e.kind = StrokeEnd::DISK;
+        e.center = v;
+        return e;
+    }
+    // The outer side of the turn is opposite to the direction it turns towards.
+    double s = c >= 0 ? 1.0 : -1.0;
+    Vec2 n_in = -s * perp(t_in), n_out = -s * perp(t_out);
+    e.kind = StrokeEnd::POLYGON;
+    double cos_half = std::sqrt(std::max(0.0, 0.5 * (1 + d)));  // cos of half the turn
+    // Miter length / stroke width = 1 / sin(interior angle / 2) = 1 / cos(turn / 2).
+    if (join == JOIN_MITER && cos_half > 1e-12 && 1.0 / cos_half <= miter_limit) {
+        Vec2 dir = normalized(n_in + n_out);
+        e.poly[0] = v;
+        e.poly[1] = v + hw * n_in;
+        e.poly[2] = v + (hw / cos_half) * dir;
+        e.poly[3] = v + hw * n_out;
+        e.n_poly = 4;
+    } else {
+        e.poly[0] = v;
+        e.poly[1] = v + hw * n_in;
+        e.poly[2] = v + hw * n_out;
+        e.n_poly = 3;
+    }
+    return e;
+}
+
+StrokeEnd make_cap(Vec2 at, Vec2 outward, int cap) {
+    StrokeEnd e;
+    if (cap == CAP_ROUND) {
+        e.kind = StrokeEnd::DISK;
+        e.center = at;
+    } else if (cap == CAP_SQUARE) {
+        e.kind = StrokeEnd::SQUARE;
+        e.center = at;
+        e.axis = outward;
+    }
+    return e;
+}
+
+// Stroke pieces of one subpath of a stroke draw, appended to out.
+void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool closed,
+                          const PreparedDraw& d, std::vector<StrokeSegment>& out) {
+    std::vector<StrokeSegment> segs;
+    for (int g = first; g < first + count; ++g) {
+        Segment s = sc.segments[g].seg;
+        if (!d.metric_identity) s = transformed(s, d.metric);
+        if (is_point(s)) continue;  // zero-length: no sweep, no direction
+        StrokeSegment ss;
+        ss.seg = s;
+        ss.source = g;
+        segs.push_back(ss);
+    }
+    double hw = d.half_width;
+    if (segs.empty()) {
+        // A zero-length subpath: a dot with round caps, a square with square caps (aligned
+        // with the stroke space's x axis, i.e. the user space), nothing with butt caps.
+        if (d.cap == CAP_BUTT || count == 0) return;
+        Segment s = sc.segments[first].seg;
+        if (!d.metric_identity) s = transformed(s, d.metric);
+        StrokeSegment ss;
+        ss.seg = s;
+        ss.seg.degree = 1;
+        ss.seg.p[1] = ss.seg.p[0];
+        ss.source = first;
+        ss.end = make_cap(s.p[0], {1, 0}, d.cap);
+        segs.push_back(ss);
+    } else {
+        int n = (int)segs.size();
+        for (int i = 0; i < n; ++i) {
+            bool last = i + 1 == n;
+            if (last && !closed) {
+                Vec2 t = seg_end_tangent(segs[i].seg, true);
+                segs[i].end = make_cap(seg_end(segs[i].seg), t, d.cap);
+                segs[i].butt_end = d.cap == CAP_BUTT;
+            } else {
+                StrokeSegment& next = segs[last ? 0 : i + 1];
+                segs[i].end = make_join(seg_end(segs[i].seg), seg_end_tangent(segs[i].seg, true),
+                                        seg_end_tangent(next.seg, false), d.join, hw, d.miter_limit);
+            }
+        }
+        if (!closed) {
+            Vec2 t = seg_end_tangent(segs[0].seg, false);
+            segs[0].start = make_cap(segs[0].seg.p[0], -t, d.cap);
+            segs[0].butt_start = d.cap == CAP_BUTT;
+        }
+    }
+    for (StrokeSegment& ss : segs) {
+        Box b = grown(seg_bbox(ss.seg), hw);
+        add_end_to_box(b, ss.start, hw);
+        add_end_to_box(b, ss.end, hw);
+        ss.box = d.metric_identity ? b : to_pixel_box(b, d.metric_inv);
+        out.push_back(ss);
+    }
+}
+
+}  // namespace
+
+PreparedScene prepare_scene(const SceneArrays& a) {
+    PreparedScene sc;
+    check(a.n_points >= 0 && a.n_segments >= 0 && a.n_draws >= 0, "negative array size");
+    std::vector<Vec2> pts(a.n_points);
+    for (int i = 0; i < a.n_points; ++i) {
+        pts[i] = {a.points[2 * i], a.points[2 * i + 1]};
+        check(finite(pts[i].x) && finite(pts[i].y), "non-finite point " + std::to_string(i));
+    }
+
+    sc.segments.reserve(a.n_segments);
+    for (int g = 0; g < a.n_segments; ++g) {
+        const int32_t* row = a.segments + SEGMENT_COLS * g;
+        Segment s;
+        s.degree = row[0];
+        check(s.degree >= 1 && s.degree <= 3, "segment degree must be 1, 2 or 3");
+        for (int i = 0; i <= s.degree; ++i) {
+            int32_t k = row[1 + i];
+            check(k >= 0 && k < a.n_points, "segment point index out of range");
+            s.p[i] = pts[k];
+        }
+        sc.segments.push_back(prepare_segment(s, row + 1));
+    }
+
+    sc.stop_offsets.assign(a.stop_offsets, a.stop_offsets + a.n_stops);
+    sc.stop_colors.assign(a.stop_colors, a.stop_colors + 4 * a.n_stops);
+    for (int q = 0; q < a.n_paints; ++q) {
+        const int32_t* row = a.paints + PAINT_COLS * q;
+        const float* f = a.paint_params + PAINT_FCOLS * q;
+        PreparedPaint p;
+        p.kind = row[0];
+        p.first_stop = row[1];
+        p.n_stops = row[2];
+        check(p.kind >= PAINT_SOLID && p.kind <= PAINT_RADIAL, "unknown paint kind");
+        check(p.kind == PAINT_SOLID || (p.first_stop >= 0 && p.n_stops >= 1 &&
+                                        p.first_stop + p.n_stops <= a.n_stops),
+              "gradient stops out of range");
+        p.to_paint = {f[0], f[1], f[2], f[3], f[4], f[5]};
+        for (int i = 0; i < 4; ++i) p.rgba[i] = f[6 + i];
+        for (int i = 0; i < 5; ++i) p.g[i] = f[6 + i];
+        sc.paints.push_back(p);
+    }
+
+    check(a.n_layers >= 1, "at least the root layer is needed");
+    sc.layer_parent.assign(a.layer_parents, a.layer_parents + a.n_layers);
+    sc.layer_opacity.assign(a.layer_opacity, a.layer_opacity + a.n_layers);
+    sc.layer_depth.assign(a.n_layers, 0);
+    check(sc.layer_parent[0] == -1, "layer 0 must be the root");
+    for (int l = 1; l < a.n_layers; ++l) {
+        check(sc.layer_parent[l] >= 0 && sc.layer_parent[l] < l, "a layer's parent must come before it");
+        sc.layer_depth[l] = sc.layer_depth[sc.layer_parent[l]] + 1;
+    }
+
+    for (int di = 0; di < a.n_draws; ++di) {
+        const int32_t* row = a.draws + DRAW_COLS * di;
+        const float* f = a.draw_params + DRAW_FCOLS * di;
+        PreparedDraw d;
+        d.shape = row[0];
+        d.kind = row[1];
+        d.fill_rule = row[2];
+        d.paint = row[3];
+        d.layer = row[4];
+        d.cap = row[5];
+        d.join = row[6];
+        check(d.shape >= 0 && d.shape < a.n_shapes, "draw shape out of range");
+        check(d.paint >= 0 && d.paint < a.n_paints, "draw paint out of range");
+        check(d.layer >= 0 && d.layer < a.n_layers, "draw layer out of range");
+        d.half_width = 0.5 * std::max(0.0f, f[0]);
+        d.miter_limit = std::max(1.0f, f[1]);
+        d.metric = {f[2], f[3], f[4], f[5]};
+        d.metric_identity = f[2] == 1 && f[3] == 0 && f[4] == 0 && f[5] == 1;
+        d.metric_inv = inverse(d.metric);
+        d.metric_scale = std::sqrt(std::fabs(det(d.metric_inv)));
+        check(std::isfinite(d.metric_scale) && det(d.metric) != 0, "singular stroke metric");
+
+        const int32_t* shape = a.shapes + SHAPE_COLS * d.shape;
+        if (shape[0] == SHAPE_ELLIPSE) {
+            check(shape[3] >= 0 && shape[3] < a.n_ellipses, "ellipse index out of range");
+            const float* e = a.ellipses + ELLIPSE_COLS * shape[3];
+            Vec2 c{e[0], e[1]};
+            Mat2 A{e[2], e[3], e[4], e[5]};
+            d.is_ellipse = true;
+            if (d.kind == DRAW_STROKE && !d.metric_identity) {
+                c = d.metric * c;
+                A = {d.metric.a * A.a + d.metric.b * A.c, d.metric.a * A.b + d.metric.b * A.d,
+                     d.metric.c * A.a + d.metric.d * A.c, d.metric.c * A.b + d.metric.d * A.d};
+            }
+            d.ellipse = ellipse_frame(c, A);
+            double m = std::max(d.ellipse.r0, d.ellipse.r1) + (d.kind == DRAW_STROKE ? d.half_width : 0);
+            Box b{c.x - m, c.y - m, c.x + m, c.y + m};
+            d.box = d.kind == DRAW_STROKE && !d.metric_identity ? to_pixel_box(b, d.metric_inv) : b;
+        } else {
+            check(shape[0] == SHAPE_PATH, "unknown shape kind");
+            check(shape[1] >= 0 && shape[2] >= 0 && shape[1] + shape[2] <= a.n_subpaths,
+                  "shape subpaths out of range");
+            d.first_item = d.kind == DRAW_FILL ? (int)sc.fill_items.size() : (int)sc.stroke_items.size();
+            for (int b = shape[1]; b < shape[1] + shape[2]; ++b) {
+                const int32_t* sp = a.subpaths + SUBPATH_COLS * b;
+                int first = sp[0], count = sp[1];
+                bool closed = sp[2] != 0;
+                check(first >= 0 && count >= 0 && first + count <= a.n_segments, "subpath segments out of range");
+                if (count == 0) continue;
+                if (d.kind == DRAW_FILL) {
+                    for (int g = first; g < first + count; ++g) sc.fill_items.push_back(sc.segments[g]);
+                    if (!closed) {  // filling closes an open subpath with a straight line
+                        const PreparedSegment& last = sc.segments[first + count - 1];
+                        const PreparedSegment& head = sc.segments[first];
+                        Segment line;
+                        line.degree = 1;
+                        line.p[0] = seg_end(last.seg);
+                        line.p[1] = head.seg.p[0];
+                        int32_t idx[4] = {last.point_index[last.seg.degree], head.point_index[0], -1, -1};
+                        sc.fill_items.push_back(prepare_segment(line, idx));
+                    }
+                } else {
+                    build_stroke_subpath(sc, first, count, closed, d, sc.stroke_items);
+                }
+            }
+            d.n_items = (d.kind == DRAW_FILL ? (int)sc.fill_items.size() : (int)sc.stroke_items.size()) - d.first_item;
+            for (int i = 0; i < d.n_items; ++i) {
+                const Box& b = d.kind == DRAW_FILL ? sc.fill_items[d.first_item + i].box
+                                                   : sc.stroke_items[d.first_item + i].box;
+                expand(d.box, {b.x0, b.y0});
+                expand(d.box, {b.x1, b.y1});
+            }
+        }
+        if (d.kind == DRAW_STROKE && d.half_width <= 0) d.box = Box{};  // draws nothing
+        sc.draws.push_back(d);
+    }
+    return sc;
+}
+
+}  // namespace vf

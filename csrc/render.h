@@ -1,0 +1,27 @@
+// Forward rendering of a prepared scene into a straight-RGBA float image.
+#pragma once
+
+#include <cstdint>
+
+#include "scene.h"
+
+namespace vf {
+
+enum Mode : int { MODE_MC = 0, MODE_ANALYTIC = 1 };
+
+struct RenderOptions {
+    int width = 0, height = 0;
+    int samples = 2;            // samples x samples per pixel
+    int mode = MODE_MC;
+    int filter = 0;             // FilterKind
+    double filter_radius = 0.5; // support half-width in pixels; also the analytic kernel radius
+    uint64_t seed = 0;
+    int threads = 0;            // 0: all cores
+    bool has_background = false;
+    double background[4] = {0, 0, 0, 0};  // straight RGBA
+};
+
+// out: height x width x 4 floats, straight (not premultiplied) RGBA.
+void render_forward(const PreparedScene& scene, const RenderOptions& options, float* out);
+
+}  // namespace vf

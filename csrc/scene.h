@@ -1,0 +1,118 @@
+// The scene as the core sees it: flat arrays in (structure of arrays, filled by the
+// Python side, all geometry already in pixel space), and the prepared form the samplers
+// read (segments with their control points, bounds, joins, paints).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "geometry.h"
+
+namespace vf {
+
+enum ShapeKind : int32_t { SHAPE_PATH = 0, SHAPE_ELLIPSE = 1 };
+enum DrawKind : int32_t { DRAW_FILL = 0, DRAW_STROKE = 1 };
+enum FillRule : int32_t { NONZERO = 0, EVENODD = 1 };
+enum Cap : int32_t { CAP_BUTT = 0, CAP_ROUND = 1, CAP_SQUARE = 2 };
+enum Join : int32_t { JOIN_MITER = 0, JOIN_ROUND = 1, JOIN_BEVEL = 2 };
+enum PaintKind : int32_t { PAINT_SOLID = 0, PAINT_LINEAR = 1, PAINT_RADIAL = 2 };
+
+// Column layouts of the input tables (row-major, one row per item).
+constexpr int SEGMENT_COLS = 5;   // degree, point index of each control point (-1 unused)
+constexpr int SUBPATH_COLS = 3;   // first segment, segment count, closed (0/1)
+constexpr int SHAPE_COLS = 4;     // kind, first subpath, subpath count, ellipse index
+constexpr int ELLIPSE_COLS = 6;   // cx, cy, a, b, c, d: ellipse {c + (a b; c d)(cos, sin)}
+constexpr int DRAW_COLS = 7;      // shape, kind, fill rule, paint, layer, cap, join
+constexpr int DRAW_FCOLS = 6;     // stroke width, miter limit, metric (a b c d)
+constexpr int PAINT_COLS = 3;     // kind, first stop, stop count
+constexpr int PAINT_FCOLS = 11;   // pixel->paint affine (6), then solid rgba | x1 y1 x2 y2 | cx cy r fx fy
+
+struct SceneArrays {
+    const float* points = nullptr;       int n_points = 0;     // [P, 2]
+    const int32_t* segments = nullptr;   int n_segments = 0;   // [G, SEGMENT_COLS]
+    const int32_t* subpaths = nullptr;   int n_subpaths = 0;   // [B, SUBPATH_COLS]
+    const int32_t* shapes = nullptr;     int n_shapes = 0;     // [S, SHAPE_COLS]
+    const float* ellipses = nullptr;     int n_ellipses = 0;   // [E, ELLIPSE_COLS]
+    const int32_t* draws = nullptr;      int n_draws = 0;      // [D, DRAW_COLS]
+    const float* draw_params = nullptr;                        // [D, DRAW_FCOLS]
+    const int32_t* paints = nullptr;     int n_paints = 0;     // [Q, PAINT_COLS]
+    const float* paint_params = nullptr;                       // [Q, PAINT_FCOLS]
+    const float* stop_offsets = nullptr; int n_stops = 0;      // [T]
+    const float* stop_colors = nullptr;                        // [T, 4] straight RGBA
+    const int32_t* layer_parents = nullptr; int n_layers = 0;  // [L]; layer 0 is the root
+    const float* layer_opacity = nullptr;                      // [L]
+};
+
+// A segment ready for sampling, with where its control points came from (for gradients).
+struct PreparedSegment {
+    Segment seg;
+    int32_t point_index[4] = {-1, -1, -1, -1};
+    Box box;
+    double split[4];        // 0, y-extrema in (0,1) ascending, 1: y-monotone pieces
+    double split_y[4];      // y at each split
+    int n_split = 2;
+};
+
+// Stroke geometry at a segment's end: the join with the next segment, or the cap.
+struct StrokeEnd {
+    enum Kind : int8_t { NONE = 0, DISK, SQUARE, POLYGON } kind = NONE;
+    Vec2 center;            // disk / square centre
+    Vec2 axis{1, 0};        // square: unit direction of one side pair
+    Vec2 poly[4];           // polygon (bevel triangle or miter quadrilateral), convex
+    int n_poly = 0;
+};
+
+// A stroke segment in stroke space (pixel space mapped by the draw's metric), with the
+// end pieces that belong to it: the join or cap after it, and the cap before it when it
+// starts an open subpath.
+struct StrokeSegment {
+    Segment seg;           // in stroke space
+    int32_t source = -1;   // index into PreparedScene::segments
+    bool butt_start = false, butt_end = false;  // free end with a butt cap: an edge of the stroke
+    StrokeEnd start, end;
+    Box box;               // pixel-space bounds of everything above, widened by the half width
+};
+
+struct PreparedDraw {
+    int32_t shape = 0, kind = DRAW_FILL, fill_rule = NONZERO, paint = 0, layer = 0;
+    int32_t cap = CAP_BUTT, join = JOIN_MITER;
+    double half_width = 0, miter_limit = 4;
+    Mat2 metric, metric_inv;    // pixel -> stroke space and back
+    bool metric_identity = true;
+    double metric_scale = 1;    // pixel length per stroke-space length (geometric mean)
+    // Path draws: fill segments (with closing lines for open subpaths) or stroke segments.
+    int first_item = 0, n_items = 0;   // into PreparedScene::fill_items or stroke_items
+    EllipseFrame ellipse;               // ellipse draws
+    bool is_ellipse = false;
+    Box box;                            // pixel-space bounds of what the draw can cover
+};
+
+struct PreparedPaint {
+    int32_t kind = PAINT_SOLID;
+    Affine to_paint;            // pixel -> paint space
+    double rgba[4] = {0, 0, 0, 0};
+    double g[5] = {0, 0, 0, 0, 0};
+    int first_stop = 0, n_stops = 0;
+};
+
+struct PreparedScene {
+    std::vector<PreparedSegment> segments;   // every path segment, pixel space
+    std::vector<PreparedSegment> fill_items; // per fill draw: its segments and closing lines
+    std::vector<StrokeSegment> stroke_items; // per stroke draw
+    std::vector<PreparedDraw> draws;
+    std::vector<PreparedPaint> paints;
+    std::vector<double> stop_offsets;
+    std::vector<double> stop_colors;          // straight RGBA
+    std::vector<int32_t> layer_parent;
+    std::vector<double> layer_opacity;
+    std::vector<int32_t> layer_depth;
+};
+
+// A segment with its bounds and y-monotone pieces; idx: its control points' indices or null.
+PreparedSegment prepare_segment(const Segment& s, const int32_t* idx);
+
+// Validates the arrays (indices in range) and builds the prepared scene. Throws
+// std::invalid_argument with a message on malformed input.
+PreparedScene prepare_scene(const SceneArrays& a);
+
+}  // namespace vf
