@@ -1,0 +1,31 @@
+# Set-up and the two everyday jobs. Everything runs in a local virtual environment.
+PYTHON ?= python3
+VENV ?= .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.vecfit-installed
+# A CPU build of torch: an unpinned torch would pull gigabytes of CUDA packages.
+TORCH := torch==2.13.0
+
+.PHONY: install demo test bench clean
+
+install: $(STAMP)
+
+$(STAMP): pyproject.toml CMakeLists.txt $(wildcard csrc/*)
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q $(TORCH)
+	$(PY) -m pip install -q -e ".[dev]"
+	touch $@
+
+demo: install
+	$(VENV)/bin/vecfit render examples/tiger.svg -o out/tiger.png --samples 4
+	@echo "demo output: out/tiger.png"
+
+test: install
+	$(PY) -m pytest -q
+
+bench: install
+	$(PY) benchmarks/render.py
+
+clean:
+	rm -rf build out tests/failures

@@ -1,0 +1,108 @@
+"""Rendering conformance against the resvg reference corpus in ../shared/conformance.
+
+A case passes when vecfit's render (Monte Carlo, 4x4 samples, box filter, at the case's
+size) matches the reference PNG at PSNR >= 35 dB both composited over white and on the
+alpha channel alone.
+"""
+from __future__ import annotations
+
+import csv
+import math
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+CORPUS = ROOT.parent / "shared" / "conformance"
+FAILURES = ROOT / "tests" / "failures" / "conformance"
+PASS_DB = 35.0
+
+
+@dataclass
+class Case:
+    name: str
+    svg: Path
+    png: Path
+    width: int
+    height: int
+    tags: list[str]
+
+
+@dataclass
+class Result:
+    case: Case
+    psnr_white: float
+    psnr_alpha: float
+    error: str | None = None
+
+    @property
+    def passed(self) -> bool:
+        return self.error is None and self.psnr_white >= PASS_DB and self.psnr_alpha >= PASS_DB
+
+
+def load_manifest() -> list[Case]:
+    cases = []
+    with open(CORPUS / "manifest.tsv", newline="") as f:
+        for row in csv.DictReader(f, delimiter="\t"):
+            cases.append(Case(row["name"], CORPUS / row["svg"], CORPUS / row["png"],
+                              int(row["width"]), int(row["height"]),
+                              [t for t in row["tags"].split(",") if t]))
+    return cases
+
+
+def psnr(a: np.ndarray, b: np.ndarray) -> float:
+    mse = float(np.mean((a.astype(np.float64) - b.astype(np.float64)) ** 2))
+    return math.inf if mse == 0 else 10 * math.log10(1.0 / mse)
+
+
+def over_white(rgba: np.ndarray) -> np.ndarray:
+    a = rgba[..., 3:4]
+    return rgba[..., :3] * a + (1 - a)
+
+
+def run_case(case: Case) -> tuple[Result, np.ndarray | None, np.ndarray]:
+    import vecfit
+    from vecfit.imageio import load_rgba, to_uint8
+
+    expected = load_rgba(case.png)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            scene = vecfit.load_svg(case.svg)
+        image = vecfit.render(scene, case.width, case.height, samples=4, mode="mc", filter="box")
+    except Exception as e:  # recorded as a failure of this case
+        return Result(case, 0.0, 0.0, f"{type(e).__name__}: {e}"), None, expected
+    # Compare what a PNG would hold: 8-bit straight RGBA.
+    actual = to_uint8(image).astype(np.float32) / 255.0
+    return Result(case, psnr(over_white(actual), over_white(expected)),
+                  psnr(actual[..., 3], expected[..., 3])), actual, expected
+
+
+def save_failure(result: Result, actual: np.ndarray | None, expected: np.ndarray) -> Path:
+    """expected | difference | actual, composited over white."""
+    from PIL import Image
+
+    FAILURES.mkdir(parents=True, exist_ok=True)
+    e = over_white(expected)
+    a = over_white(actual) if actual is not None else np.zeros_like(e)
+    d = 1 - np.clip(np.abs(a - e) * 4, 0, 1)  # amplified, dark where they differ
+    strip = np.concatenate([e, d, a], axis=1)
+    path = FAILURES / f"{result.case.name}.png"
+    Image.fromarray((strip * 255 + 0.5).astype(np.uint8)).save(path)
+    return path
+
+
+def tag_table(results: list[Result]) -> str:
+    by_tag: dict[str, list[bool]] = {}
+    for r in results:
+        for tag in r.case.tags or ["(none)"]:
+            by_tag.setdefault(tag, []).append(r.passed)
+    lines = [f"{'tag':28s} {'pass':>5s} {'cases':>6s} {'rate':>7s}"]
+    for tag in sorted(by_tag):
+        v = by_tag[tag]
+        lines.append(f"{tag:28s} {sum(v):5d} {len(v):6d} {100 * sum(v) / len(v):6.1f}%")
+    n = sum(r.passed for r in results)
+    lines.append(f"{'ALL':28s} {n:5d} {len(results):6d} {100 * n / max(1, len(results)):6.1f}%")
+    return "\n".join(lines)

@@ -1,0 +1,18 @@
+import sys
+from pathlib import Path
+
+# Test helpers (reference renderer, conformance harness) live next to the tests.
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+
+import time
+
+_SESSION_START = time.time()
+
+
+def pytest_terminal_summary(terminalreporter):
+    """Show the conformance table when this run wrote it."""
+    table = Path(__file__).resolve().parent / "failures" / "conformance-table.txt"
+    if table.exists() and table.stat().st_mtime >= _SESSION_START:
+        terminalreporter.write_sep("-", "conformance pass rate per tag")
+        terminalreporter.write_line(table.read_text())

@@ -1,0 +1,43 @@
+"""Reading and writing raster images; writes are atomic (temporary file, then rename),
+so an interrupted run never leaves a half-written output."""
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import torch
+from PIL import Image
+
+
+def to_uint8(image: torch.Tensor | np.ndarray) -> np.ndarray:
+    a = image.detach().cpu().numpy() if isinstance(image, torch.Tensor) else np.asarray(image)
+    return (np.clip(a, 0, 1) * 255 + 0.5).astype(np.uint8)
+
+
+def atomic_write(path: str | os.PathLike, write) -> None:
+    """Calls write(tmp_path) for a temporary file next to path, then renames it over path."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def save_png(image, path: str | os.PathLike) -> None:
+    """Save an [H, W, 4] straight-RGBA float image as an 8-bit RGBA PNG."""
+    pixels = to_uint8(image)
+    atomic_write(path, lambda tmp: Image.fromarray(pixels, "RGBA").save(tmp, format="PNG"))
+
+
+def load_rgba(path: str | os.PathLike) -> np.ndarray:
+    """An image file as float RGBA in [0, 1], [H, W, 4]."""
+    with Image.open(path) as im:
+        return np.asarray(im.convert("RGBA"), dtype=np.float32) / 255.0
