@@ -49,7 +49,7 @@ py::array_t<float> render(Array<float> points, Array<int32_t> segments, Array<in
                           Array<float> stop_offsets, Array<float> stop_colors, Array<int32_t> layer_parents,
                           Array<float> layer_opacity, int width, int height, int samples,
                           const std::string& mode, const std::string& filter, double filter_radius,
-                          uint64_t seed, int threads, py::object background) {
+                          uint64_t seed, int threads, py::object background, bool brute_force) {
     if (width <= 0 || height <= 0) throw std::invalid_argument("width and height must be positive");
     if (samples <= 0) throw std::invalid_argument("samples must be positive");
     SceneArrays a;
@@ -81,6 +81,7 @@ py::array_t<float> render(Array<float> points, Array<int32_t> segments, Array<in
     o.filter_radius = filter_radius;
     o.seed = seed;
     o.threads = threads;
+    o.brute_force = brute_force;
     if (!background.is_none()) {
         auto bg = background.cast<std::vector<double>>();
         if (bg.size() != 4) throw std::invalid_argument("background must be 4 numbers (RGBA)");
@@ -110,7 +111,13 @@ Segment segment_from(const Array<double>& pts) {
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "vecfit's compiled core: geometry and rendering on flat arrays";
-    m.def("render", &render, "Render the scene arrays into a [H, W, 4] straight-RGBA image");
+    m.def("render", &render, "Render the scene arrays into a [H, W, 4] straight-RGBA image",
+          py::arg("points"), py::arg("segments"), py::arg("subpaths"), py::arg("shapes"), py::arg("ellipses"),
+          py::arg("draws"), py::arg("draw_params"), py::arg("paints"), py::arg("paint_params"),
+          py::arg("stop_offsets"), py::arg("stop_colors"), py::arg("layer_parents"), py::arg("layer_opacity"),
+          py::arg("width"), py::arg("height"), py::arg("samples"), py::arg("mode"), py::arg("filter"),
+          py::arg("filter_radius"), py::arg("seed"), py::arg("threads"), py::arg("background"),
+          py::arg("brute_force") = false);
     m.def("hardware_threads", &ThreadPool::hardware_threads);
     m.def("has_cuda", [] { return false; });
 

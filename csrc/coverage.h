@@ -24,11 +24,11 @@
 
 namespace vf {
 
-// Signed crossings of the ray from p towards +x with the segment; each y-monotone piece
-// counts on the half-open range [y_low, y_high) so that pieces meeting at a vertex are
-// counted once.
-inline int ray_crossings(const PreparedSegment& s, Vec2 p) {
-    if (p.y < s.box.y0 || p.y > s.box.y1 || p.x > s.box.x1) return 0;
+// Signed crossings of the ray from p towards +x, up to and including x_max, with the
+// segment; each y-monotone piece counts on the half-open range [y_low, y_high) so that
+// pieces meeting at a vertex are counted once. +1 where the curve moves towards +y.
+inline int ray_crossings(const PreparedSegment& s, Vec2 p, double x_max = 1e300) {
+    if (p.y < s.box.y0 || p.y > s.box.y1 || s.box.x1 <= p.x || s.box.x0 > x_max) return 0;
     int w = 0;
     for (int k = 0; k + 1 < s.n_split; ++k) {
         double ya = s.split_y[k], yb = s.split_y[k + 1];
@@ -36,35 +36,20 @@ inline int ray_crossings(const PreparedSegment& s, Vec2 p) {
         if (ya <= p.y && p.y < yb) dir = 1;
         else if (yb <= p.y && p.y < ya) dir = -1;
         else continue;
-        if (p.x < s.box.x0) {
+        if (s.piece_x1[k] <= p.x || s.piece_x0[k] > x_max) continue;
+        if (s.piece_x0[k] > p.x && s.piece_x1[k] <= x_max) {
             w += dir;
             continue;
         }
-        double t = seg_solve_monotone(s.seg, 1, p.y, s.split[k], s.split[k + 1]);
-        if (seg_eval(s.seg, t).x > p.x) w += dir;
+        double t = monotone_root(s.ay, p.y, s.split[k], s.split[k + 1], ya - p.y, yb - p.y);
+        double x = ((s.ax[3] * t + s.ax[2]) * t + s.ax[1]) * t + s.ax[0];
+        if (x > p.x && x <= x_max) w += dir;
     }
     return w;
 }
 
 inline bool winding_inside(int winding, int rule) {
     return rule == EVENODD ? (winding & 1) != 0 : winding != 0;
-}
-
-// Distance from p to the closest of the segments, or `limit` if none is closer.
-inline double segments_distance(const PreparedSegment* segs, int n, Vec2 p, double limit) {
-    double best = limit;
-    for (int i = 0; i < n; ++i) {
-        if (distance2(segs[i].box, p) >= best * best) continue;
-        if (segs[i].seg.degree == 1) {
-            Vec2 a = segs[i].seg.p[0], d = segs[i].seg.p[1] - a;
-            double l2 = dot(d, d);
-            double t = l2 > 0 ? std::clamp(dot(p - a, d) / l2, 0.0, 1.0) : 0.0;
-            best = std::min(best, distance(a + t * d, p));
-        } else {
-            best = std::min(best, seg_closest(segs[i].seg, p).dist);
-        }
-    }
-    return best;
 }
 
 // ----------------------------------------------------------------------- strokes
@@ -130,8 +115,14 @@ inline double sweep_sdf(const Segment& s, Vec2 q, double hw) {
     return best;
 }
 
+// Whether q is within `reach` of the segment's control-point hull's chord-frame box.
+inline bool near_segment(const StrokeSegment& ss, Vec2 q, double reach) {
+    Vec2 r = q - ss.seg.p[0];
+    double s = dot(r, ss.frame_u), n = cross(ss.frame_u, r);
+    return s >= ss.s_min - reach && s <= ss.s_max + reach && n >= ss.n_min - reach && n <= ss.n_max + reach;
+}
+
 inline bool sweep_contains(const Segment& s, Vec2 q, double hw) {
-    if (distance2(seg_bbox(s), q) > hw * hw) return false;
     if (s.degree == 1) {  // the rectangle around the line
         Vec2 d = s.p[1] - s.p[0];
         double l2 = dot(d, d);
@@ -147,13 +138,15 @@ inline bool sweep_contains(const Segment& s, Vec2 q, double hw) {
 }
 
 inline bool stroke_item_contains(const StrokeSegment& s, Vec2 q, double hw) {
-    return end_contains(s.end, q, hw) || end_contains(s.start, q, hw) || sweep_contains(s.seg, q, hw);
+    return end_contains(s.end, q, hw) || end_contains(s.start, q, hw) ||
+           (near_segment(s, q, hw) && sweep_contains(s.seg, q, hw));
 }
 
 // Signed distance (stroke space) to this item's pieces. The butt end lines of free ends
 // bound the sweep; other end normals are interior seams covered by a join or cap.
-inline double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double hw) {
-    double sd = sweep_sdf(s.seg, q, hw);
+inline double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double hw, double limit) {
+    // Farther than hw + limit from the hull: the sweep cannot bring the distance under limit.
+    double sd = near_segment(s, q, hw + limit) ? sweep_sdf(s.seg, q, hw) : 1e300;
     if (s.butt_start || s.butt_end) {
         double dl = 1e300;
         for (int k = 0; k < 2; ++k) {
@@ -170,70 +163,81 @@ inline double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double hw) {
 }
 
 // ----------------------------------------------------------------- whole draws
+// The queries below take the draw's items to look at: all of them (AllItems), or those
+// a tile lists (see tiles.h). Fill winding numbers are computed by the caller.
+
+struct AllItems {
+    int n;
+    int size() const { return n; }
+    int operator[](int i) const { return i; }
+};
 
 inline Vec2 to_stroke_space(const PreparedDraw& d, Vec2 p) {
     return d.metric_identity ? p : d.metric * p;
 }
 
-// Monte Carlo coverage: is p (pixel space) inside the draw?
-inline bool draw_contains(const PreparedScene& sc, const PreparedDraw& d, Vec2 p) {
-    if (p.x < d.box.x0 || p.x > d.box.x1 || p.y < d.box.y0 || p.y > d.box.y1) return false;
-    if (d.kind == DRAW_FILL) {
-        if (d.is_ellipse) return ellipse_contains(d.ellipse, p);
-        int w = 0;
-        const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
-        for (int i = 0; i < d.n_items; ++i) w += ray_crossings(segs[i], p);
-        return winding_inside(w, d.fill_rule);
+inline int draw_winding_all(const PreparedScene& sc, const PreparedDraw& d, Vec2 p) {
+    int w = 0;
+    const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
+    for (int i = 0; i < d.n_items; ++i) w += ray_crossings(segs[i], p);
+    return w;
+}
+
+// Distance from p to the closest fill segment among items, or `limit` if none is closer.
+template <class Items>
+double fill_distance(const PreparedScene& sc, const PreparedDraw& d, const Items& items, Vec2 p, double limit) {
+    const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
+    double best = limit;
+    for (int i = 0; i < items.size(); ++i) {
+        const PreparedSegment& s = segs[items[i]];
+        if (distance2(s.box, p) >= best * best) continue;
+        if (s.seg.degree == 1) best = std::min(best, point_line_segment_distance(p, s.seg.p[0], s.seg.p[1]));
+        else best = std::min(best, seg_closest(s.seg, p).dist);
     }
+    return best;
+}
+
+template <class Items>
+bool stroke_contains(const PreparedScene& sc, const PreparedDraw& d, const Items& items, Vec2 p) {
     Vec2 q = to_stroke_space(d, p);
     double hw = d.half_width;
     if (d.is_ellipse) {
         Vec2 c;
         return ellipse_closest(d.ellipse, q, c) <= hw;
     }
-    const StrokeSegment* items = sc.stroke_items.data() + d.first_item;
-    for (int i = 0; i < d.n_items; ++i) {
-        const Box& b = items[i].box;
-        if (p.x < b.x0 || p.x > b.x1 || p.y < b.y0 || p.y > b.y1) continue;
-        if (stroke_item_contains(items[i], q, hw)) return true;
+    const StrokeSegment* all = sc.stroke_items.data() + d.first_item;
+    for (int i = 0; i < items.size(); ++i) {
+        const StrokeSegment& s = all[items[i]];
+        if (p.x < s.box.x0 || p.x > s.box.x1 || p.y < s.box.y0 || p.y > s.box.y1) continue;
+        if (stroke_item_contains(s, q, hw)) return true;
     }
     return false;
 }
 
-// Signed distance in pixels from p to the draw's boundary (negative inside), clamped to
-// [-limit, limit]: only its value within the prefilter radius matters.
-inline double draw_sdf(const PreparedScene& sc, const PreparedDraw& d, Vec2 p, double limit) {
-    Box near = grown(d.box, limit);
-    if (p.x < near.x0 || p.x > near.x1 || p.y < near.y0 || p.y > near.y1) return limit;
-    if (d.kind == DRAW_FILL) {
-        if (d.is_ellipse) {
-            Vec2 c;
-            double dist = std::min(ellipse_closest(d.ellipse, p, c), limit);
-            return ellipse_contains(d.ellipse, p) ? -dist : dist;
-        }
-        const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
-        double dist = segments_distance(segs, d.n_items, p, limit);
-        int w = 0;
-        for (int i = 0; i < d.n_items; ++i) w += ray_crossings(segs[i], p);
-        return winding_inside(w, d.fill_rule) ? -dist : dist;
-    }
+// Signed distance in pixels to the stroke (negative inside), clamped to [-limit, limit].
+template <class Items>
+double stroke_sdf(const PreparedScene& sc, const PreparedDraw& d, const Items& items, Vec2 p, double limit) {
     Vec2 q = to_stroke_space(d, p);
     double hw = d.half_width;
-    double sd;
+    double sd = 1e300;
     if (d.is_ellipse) {
         Vec2 c;
         sd = ellipse_closest(d.ellipse, q, c) - hw;
     } else {
-        sd = 1e300;
-        const StrokeSegment* items = sc.stroke_items.data() + d.first_item;
-        for (int i = 0; i < d.n_items; ++i) {
-            Box b = grown(items[i].box, limit);
+        const StrokeSegment* all = sc.stroke_items.data() + d.first_item;
+        for (int i = 0; i < items.size(); ++i) {
+            Box b = grown(all[items[i]].box, limit);
             if (p.x < b.x0 || p.x > b.x1 || p.y < b.y0 || p.y > b.y1) continue;
-            sd = std::min(sd, stroke_item_sdf(items[i], q, hw));
+            sd = std::min(sd, stroke_item_sdf(all[items[i]], q, hw, limit / d.metric_scale));
         }
     }
-    sd *= d.metric_scale;
-    return std::clamp(sd, -limit, limit);
+    return std::clamp(sd * d.metric_scale, -limit, limit);
+}
+
+inline double ellipse_fill_sdf(const PreparedDraw& d, Vec2 p, double limit) {
+    Vec2 c;
+    double dist = std::min(ellipse_closest(d.ellipse, p, c), limit);
+    return ellipse_contains(d.ellipse, p) ? -dist : dist;
 }
 
 }  // namespace vf

@@ -78,17 +78,53 @@ struct Compositor {
     }
 };
 
-// Premultiplied colour of the scene at pixel-space point p.
-void eval_point(const PreparedScene& sc, const int* list, int n, Vec2 p, const RenderOptions& o,
+struct LocalItems {
+    const LocalItem* li;
+    int n;
+    int size() const { return n; }
+    int operator[](int i) const { return li[i].item; }
+};
+
+// Coverage of one draw at p in [0, 1]: a step (Monte Carlo) or the prefiltered kernel.
+double entry_coverage(const PreparedScene& sc, const TileBins& bins, const TileEntry& e, const Box& region,
+                      Vec2 p, const RenderOptions& o) {
+    const PreparedDraw& d = sc.draws[e.draw];
+    const bool analytic = o.mode == MODE_ANALYTIC;
+    const double r = o.filter_radius;
+    const bool brute = o.brute_force;
+    LocalItems local{bins.items.data() + e.first, e.count};
+    AllItems all{d.n_items};
+    if (d.kind == DRAW_STROKE) {
+        if (analytic) {
+            double sd = brute ? stroke_sdf(sc, d, all, p, r) : stroke_sdf(sc, d, local, p, r);
+            return kernel_coverage(sd / r);
+        }
+        return (brute ? stroke_contains(sc, d, all, p) : stroke_contains(sc, d, local, p)) ? 1.0 : 0.0;
+    }
+    if (d.is_ellipse) {
+        if (analytic) return kernel_coverage(ellipse_fill_sdf(d, p, r) / r);
+        return ellipse_contains(d.ellipse, p) ? 1.0 : 0.0;
+    }
+    int w = brute ? draw_winding_all(sc, d, p) : tile_winding(sc, bins, e, region, p);
+    bool inside = winding_inside(w, d.fill_rule);
+    if (!analytic) return inside ? 1.0 : 0.0;
+    double dist = brute ? fill_distance(sc, d, all, p, r) : fill_distance(sc, d, local, p, r);
+    return kernel_coverage((inside ? -dist : dist) / r);
+}
+
+// Premultiplied colour of the scene at pixel-space point p, from the tile's entries.
+void eval_point(const PreparedScene& sc, const TileBins& bins, int tile, Vec2 p, const RenderOptions& o,
                 double out[4]) {
     Compositor comp(sc);
-    bool analytic = o.mode == MODE_ANALYTIC;
-    double r = o.filter_radius;
-    for (int k = n - 1; k >= 0; --k) {
-        const PreparedDraw& d = sc.draws[list[k]];
-        double coverage;
-        if (analytic) coverage = kernel_coverage(draw_sdf(sc, d, p, r) / r);
-        else coverage = draw_contains(sc, d, p) ? 1.0 : 0.0;
+    const TileEntry* entries = bins.begin(tile);
+    Box region = bins.region(tile);
+    for (int k = bins.count(tile) - 1; k >= 0; --k) {
+        const TileEntry& e = entries[k];
+        const PreparedDraw& d = sc.draws[e.draw];
+        if (p.x < d.box.x0 - o.filter_radius || p.x > d.box.x1 + o.filter_radius ||
+            p.y < d.box.y0 - o.filter_radius || p.y > d.box.y1 + o.filter_radius)
+            continue;
+        double coverage = entry_coverage(sc, bins, e, region, p, o);
         if (coverage <= 0) continue;
         double c[4];
         paint_color(sc, sc.paints[d.paint], p, c);
@@ -108,7 +144,7 @@ void render_forward(const PreparedScene& sc, const RenderOptions& o, float* out)
     RenderOptions opt = o;
     opt.filter_radius = R;
     double margin = std::max(0.0, R - 0.5) + (o.mode == MODE_ANALYTIC ? R : 0.0);
-    TileBins bins = bin_draws(sc, W, H, margin + 1e-6);
+    TileBins bins = bin_draws(sc, W, H, margin + 1e-6, o.brute_force);
 
     double bg[4] = {0, 0, 0, 0};
     if (o.has_background) {
@@ -119,7 +155,6 @@ void render_forward(const PreparedScene& sc, const RenderOptions& o, float* out)
 
     ThreadPool::instance().parallel_for(bins.nx * bins.ny, o.threads, [&](int tile, int) {
         int tx = tile % bins.nx, ty = tile / bins.nx;
-        const int* list = bins.begin(tile);
         int n = bins.count(tile);
         for (int y = ty * TILE; y < std::min(H, (ty + 1) * TILE); ++y) {
             for (int x = tx * TILE; x < std::min(W, (tx + 1) * TILE); ++x) {
@@ -132,7 +167,7 @@ void render_forward(const PreparedScene& sc, const RenderOptions& o, float* out)
                     double w = filter_weight(o.filter, R, dx, dy);
                     if (w <= 0) continue;
                     double c[4] = {0, 0, 0, 0};
-                    if (n > 0) eval_point(sc, list, n, {x + 0.5 + dx, y + 0.5 + dy}, opt, c);
+                    if (n > 0) eval_point(sc, bins, tile, {x + 0.5 + dx, y + 0.5 + dy}, opt, c);
                     for (int i = 0; i < 4; ++i) acc[i] += w * c[i];
                     wsum += w;
                 }

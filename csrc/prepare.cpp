@@ -29,6 +29,13 @@ PreparedSegment prepare_segment(const Segment& s, const int32_t* idx) {
         if (ext[i] > ps.split[ps.n_split - 1]) ps.split[ps.n_split++] = ext[i];
     ps.split[ps.n_split++] = 1;
     for (int i = 0; i < ps.n_split; ++i) ps.split_y[i] = seg_eval(s, ps.split[i]).y;
+    seg_axis_poly(s, 0, ps.ax);
+    seg_axis_poly(s, 1, ps.ay);
+    for (int k = 0; k + 1 < ps.n_split; ++k) {
+        Box b = seg_bbox(seg_part(s, ps.split[k], ps.split[k + 1]));
+        ps.piece_x0[k] = b.x0;
+        ps.piece_x1[k] = b.x1;
+    }
     return ps;
 }
 
@@ -166,6 +173,19 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
         }
     }
     for (StrokeSegment& ss : segs) {
+        const Segment& s = ss.seg;
+        Vec2 u = normalized(seg_end(s) - s.p[0]);
+        if (u.x == 0 && u.y == 0) u = {1, 0};
+        ss.frame_u = u;
+        ss.s_min = ss.n_min = 1e300;
+        ss.s_max = ss.n_max = -1e300;
+        for (int i = 0; i <= s.degree; ++i) {
+            Vec2 r = s.p[i] - s.p[0];
+            ss.s_min = std::min(ss.s_min, dot(r, u));
+            ss.s_max = std::max(ss.s_max, dot(r, u));
+            ss.n_min = std::min(ss.n_min, cross(u, r));
+            ss.n_max = std::max(ss.n_max, cross(u, r));
+        }
         Box b = grown(seg_bbox(ss.seg), hw);
         add_end_to_box(b, ss.start, hw);
         add_end_to_box(b, ss.end, hw);

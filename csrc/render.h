@@ -17,6 +17,7 @@ struct RenderOptions {
     double filter_radius = 0.5; // support half-width in pixels; also the analytic kernel radius
     uint64_t seed = 0;
     int threads = 0;            // 0: all cores
+    bool brute_force = false;   // test every item of every draw (a check of the tiles)
     bool has_background = false;
     double background[4] = {0, 0, 0, 0};  // straight RGBA
 };

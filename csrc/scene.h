@@ -50,6 +50,8 @@ struct PreparedSegment {
     Box box;
     double split[4];        // 0, y-extrema in (0,1) ascending, 1: y-monotone pieces
     double split_y[4];      // y at each split
+    double piece_x0[3], piece_x1[3];  // x range of each piece (of its control points)
+    double ax[4], ay[4];    // power-basis coefficients of x(t) and y(t)
     int n_split = 2;
 };
 
@@ -71,6 +73,10 @@ struct StrokeSegment {
     bool butt_start = false, butt_end = false;  // free end with a butt cap: an edge of the stroke
     StrokeEnd start, end;
     Box box;               // pixel-space bounds of everything above, widened by the half width
+    // The segment's control points in the frame of its chord (origin p0, unit axis u):
+    // a tighter bound than the box, which spares most samples the quintic.
+    Vec2 frame_u{1, 0};
+    double s_min = 0, s_max = 0, n_min = 0, n_max = 0;
 };
 
 struct PreparedDraw {

@@ -3,41 +3,193 @@
 #include <algorithm>
 #include <cmath>
 
-namespace vf {
+#include "coverage.h"
 
-TileBins bin_draws(const PreparedScene& scene, int width, int height, double margin) {
+namespace vf {
+namespace {
+
+struct TileRange {
+    int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+    bool empty() const { return x1 < x0 || y1 < y0; }
+    int width() const { return x1 - x0 + 1; }
+};
+
+// Tiles whose region (tile grown by margin) overlaps the box, clipped to `clip`.
+TileRange tiles_of(const Box& b, double margin, const TileRange& clip) {
+    TileRange r;
+    if (!valid(b)) return r;
+    double x0 = std::floor((b.x0 - margin) / TILE), x1 = std::floor((b.x1 + margin) / TILE);
+    double y0 = std::floor((b.y0 - margin) / TILE), y1 = std::floor((b.y1 + margin) / TILE);
+    r.x0 = (int)std::max<double>(clip.x0, x0);
+    r.y0 = (int)std::max<double>(clip.y0, y0);
+    r.x1 = (int)std::min<double>(clip.x1, x1);
+    r.y1 = (int)std::min<double>(clip.y1, y1);
+    return r;
+}
+
+// Crossings of the vertical line x = X, for heights in (y_low, y_high]: x-monotone
+// pieces count on [x_low, x_high); direction +1 where the curve moves towards +x.
+int vertical_crossings(const Segment& s, double X, double y_low, double y_high, double* ys, int8_t* dirs) {
+    double ts[4] = {0, 0, 0, 0};
+    double ext[2];
+    int n_ext = seg_extrema(s, 0, ext);
+    int n = 0;
+    ts[n++] = 0;
+    for (int i = 0; i < n_ext; ++i)
+        if (ext[i] > ts[n - 1]) ts[n++] = ext[i];
+    ts[n++] = 1;
+    int count = 0;
+    for (int k = 0; k + 1 < n; ++k) {
+        double xa = seg_eval(s, ts[k]).x, xb = seg_eval(s, ts[k + 1]).x;
+        int dir;
+        if (xa <= X && X < xb) dir = 1;
+        else if (xb <= X && X < xa) dir = -1;
+        else continue;
+        double t = seg_solve_monotone(s, 0, X, ts[k], ts[k + 1]);
+        double y = seg_eval(s, t).y;
+        if (y > y_low && y <= y_high && count < 3) {
+            ys[count] = y;
+            dirs[count] = (int8_t)dir;
+            ++count;
+        }
+    }
+    return count;
+}
+
+struct Pending {
+    int tile;
+    TileEntry entry;
+};
+
+// Bins the items of one path draw into its tiles (counting sort within its tile range)
+// and emits an entry per tile that the draw can affect.
+void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_index, const TileRange& range,
+                   const TileBins& bins, bool every_tile, std::vector<Pending>& pending,
+                   std::vector<LocalItem>& items) {
+    const bool fill = d.kind == DRAW_FILL;
+    const int w = range.width(), h = range.y1 - range.y0 + 1;
+    auto item_box = [&](int k) -> const Box& {
+        return fill ? sc.fill_items[d.first_item + k].box : sc.stroke_items[d.first_item + k].box;
+    };
+    std::vector<int> counts(w * h + 1, 0);
+    std::vector<TileRange> item_tiles(d.n_items);
+    for (int k = 0; k < d.n_items; ++k) {
+        item_tiles[k] = tiles_of(item_box(k), bins.margin, range);
+        const TileRange& r = item_tiles[k];
+        for (int ty = r.y0; ty <= r.y1; ++ty)
+            for (int tx = r.x0; tx <= r.x1; ++tx) ++counts[(ty - range.y0) * w + (tx - range.x0)];
+    }
+    std::vector<int> start(w * h + 1, 0);
+    for (int i = 0; i < w * h; ++i) start[i + 1] = start[i] + counts[i];
+    std::vector<int> local(start[w * h]);
+    std::vector<int> cursor(start.begin(), start.end() - 1);
+    for (int k = 0; k < d.n_items; ++k) {
+        const TileRange& r = item_tiles[k];
+        for (int ty = r.y0; ty <= r.y1; ++ty)
+            for (int tx = r.x0; tx <= r.x1; ++tx) local[cursor[(ty - range.y0) * w + (tx - range.x0)]++] = k;
+    }
+
+    // Fills: crossings of each tile row's top line, to count the corner rays.
+    std::vector<std::vector<std::pair<double, int>>> row_crossings;
+    if (fill) {
+        row_crossings.resize(h);
+        for (int k = 0; k < d.n_items; ++k) {
+            const PreparedSegment& s = sc.fill_items[d.first_item + k];
+            int r0 = std::max(range.y0, (int)std::ceil((s.box.y0 + bins.margin) / TILE));
+            int r1 = std::min(range.y1, (int)std::floor((s.box.y1 + bins.margin) / TILE));
+            for (int ty = r0; ty <= r1; ++ty) {
+                double y = ty * (double)TILE - bins.margin;
+                for (int j = 0; j + 1 < s.n_split; ++j) {
+                    double ya = s.split_y[j], yb = s.split_y[j + 1];
+                    int dir;
+                    if (ya <= y && y < yb) dir = 1;
+                    else if (yb <= y && y < ya) dir = -1;
+                    else continue;
+                    double t = seg_solve_monotone(s.seg, 1, y, s.split[j], s.split[j + 1]);
+                    row_crossings[ty - range.y0].push_back({seg_eval(s.seg, t).x, dir});
+                }
+            }
+        }
+    }
+
+    for (int ty = range.y0; ty <= range.y1; ++ty) {
+        std::vector<std::pair<double, int>>* row = fill ? &row_crossings[ty - range.y0] : nullptr;
+        if (row) std::sort(row->begin(), row->end());
+        // Sweep the row from the right: winding of the corner ray of each tile.
+        int winding = 0;
+        int next = row ? (int)row->size() - 1 : -1;
+        for (int tx = range.x1; tx >= range.x0; --tx) {
+            int tile = ty * bins.nx + tx;
+            Box region = bins.region(tile);
+            if (row) {
+                while (next >= 0 && (*row)[next].first > region.x1) winding += (*row)[next--].second;
+            }
+            int cell = (ty - range.y0) * w + (tx - range.x0);
+            int n_local = start[cell + 1] - start[cell];
+            if (n_local == 0 && !every_tile && !(fill && winding_inside(winding, d.fill_rule))) continue;
+            TileEntry e;
+            e.draw = draw_index;
+            e.winding = fill ? winding : 0;
+            e.first = (int)items.size();
+            e.count = n_local;
+            for (int i = start[cell]; i < start[cell + 1]; ++i) {
+                LocalItem li;
+                li.item = local[i];
+                if (fill) {
+                    const PreparedSegment& s = sc.fill_items[d.first_item + li.item];
+                    if (s.box.x0 <= region.x1 && region.x1 <= s.box.x1)
+                        li.n_cross = vertical_crossings(s.seg, region.x1, region.y0, region.y1, li.cross_y, li.cross_dir);
+                }
+                items.push_back(li);
+            }
+            pending.push_back({tile, e});
+        }
+    }
+}
+
+}  // namespace
+
+TileBins bin_draws(const PreparedScene& sc, int width, int height, double margin, bool every_tile) {
     TileBins bins;
     bins.nx = (width + TILE - 1) / TILE;
     bins.ny = (height + TILE - 1) / TILE;
+    bins.margin = margin;
+    TileRange all{0, 0, bins.nx - 1, bins.ny - 1};
+    std::vector<Pending> pending;
+    for (size_t i = 0; i < sc.draws.size(); ++i) {
+        const PreparedDraw& d = sc.draws[i];
+        TileRange range = tiles_of(d.box, margin, all);
+        if (range.empty()) continue;
+        if (d.is_ellipse) {
+            for (int ty = range.y0; ty <= range.y1; ++ty)
+                for (int tx = range.x0; tx <= range.x1; ++tx) pending.push_back({ty * bins.nx + tx, TileEntry{(int)i, 0, 0, 0}});
+        } else {
+            bin_path_draw(sc, d, (int)i, range, bins, every_tile, pending, bins.items);
+        }
+    }
+    // Stable counting sort by tile keeps each tile's entries in paint order.
     int n_tiles = bins.nx * bins.ny;
-    // Tile range of each draw, or an empty range.
-    std::vector<int> range(4 * scene.draws.size());
-    std::vector<int> counts(n_tiles + 1, 0);
-    for (size_t i = 0; i < scene.draws.size(); ++i) {
-        const Box& b = scene.draws[i].box;
-        int* r = &range[4 * i];
-        r[0] = r[1] = 0;
-        r[2] = r[3] = -1;
-        if (!valid(b)) continue;
-        double x0 = std::floor((b.x0 - margin) / TILE), x1 = std::floor((b.x1 + margin) / TILE);
-        double y0 = std::floor((b.y0 - margin) / TILE), y1 = std::floor((b.y1 + margin) / TILE);
-        r[0] = (int)std::max(0.0, x0);
-        r[1] = (int)std::max(0.0, y0);
-        r[2] = (int)std::min<double>(bins.nx - 1, x1);
-        r[3] = (int)std::min<double>(bins.ny - 1, y1);
-        for (int ty = r[1]; ty <= r[3]; ++ty)
-            for (int tx = r[0]; tx <= r[2]; ++tx) ++counts[ty * bins.nx + tx];
-    }
     bins.start.assign(n_tiles + 1, 0);
-    for (int t = 0; t < n_tiles; ++t) bins.start[t + 1] = bins.start[t] + counts[t];
-    bins.draws.resize(bins.start[n_tiles]);
-    std::vector<int> fill(bins.start.begin(), bins.start.end() - 1);
-    for (size_t i = 0; i < scene.draws.size(); ++i) {
-        const int* r = &range[4 * i];
-        for (int ty = r[1]; ty <= r[3]; ++ty)
-            for (int tx = r[0]; tx <= r[2]; ++tx) bins.draws[fill[ty * bins.nx + tx]++] = (int)i;
-    }
+    for (const Pending& p : pending) ++bins.start[p.tile + 1];
+    for (int t = 0; t < n_tiles; ++t) bins.start[t + 1] += bins.start[t];
+    bins.entries.resize(pending.size());
+    std::vector<int> cursor(bins.start.begin(), bins.start.end() - 1);
+    for (const Pending& p : pending) bins.entries[cursor[p.tile]++] = p.entry;
     return bins;
+}
+
+int tile_winding(const PreparedScene& sc, const TileBins& bins, const TileEntry& e, const Box& region, Vec2 p) {
+    const PreparedDraw& d = sc.draws[e.draw];
+    const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
+    const LocalItem* items = bins.items.data() + e.first;
+    int w = e.winding;
+    for (int i = 0; i < e.count; ++i) {
+        const LocalItem& li = items[i];
+        w += ray_crossings(segs[li.item], p, region.x1);
+        for (int c = 0; c < li.n_cross; ++c)
+            if (li.cross_y[c] <= p.y) w += li.cross_dir[c];  // heights are already > region.y0
+    }
+    return w;
 }
 
 }  // namespace vf

@@ -1,7 +1,21 @@
-// Tile binning: for each 16x16 pixel tile, the draws whose bounds reach it, in paint
-// order, so that a sample only looks at what can cover it.
+// Tile binning: for each 16x16 pixel tile, the draws that can reach it, in paint order,
+// each with the few segments that matter inside the tile.
+//
+// The winding number of a fill at a sample p in tile region R (the tile grown by how far
+// its samples and prefilter reach) is counted along a path from p to infinity that
+// stays in R until R's top-right corner C: p -> (R.x1, p.y) -> C, then the ray from C
+// towards +x. The ray from C is shared by every sample of the tile, so its crossings
+// are counted once per tile (the entry's `winding`); only segments inside R can cross
+// the two short legs. Crossings of the vertical leg do not depend on p either, except
+// through its length, so they are stored per (segment, tile) as heights.
+//
+// Conventions, equivalent to moving the path by an infinitesimal (+e, +e): horizontal
+// lines count pieces on [y_low, y_high); the vertical leg at x = R.x1 counts x-monotone
+// pieces on [x_low, x_high) with crossing height in (R.y0, p.y]; leg 1 counts crossings
+// with p.x < x <= R.x1 and the corner ray those with x > R.x1.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "scene.h"
@@ -10,15 +24,40 @@ namespace vf {
 
 constexpr int TILE = 16;
 
+struct LocalItem {
+    int32_t item = 0;             // index into the draw's fill or stroke items
+    int32_t n_cross = 0;          // crossings of the vertical leg (fills)
+    double cross_y[3] = {0, 0, 0};
+    int8_t cross_dir[3] = {0, 0, 0};
+};
+
+struct TileEntry {
+    int32_t draw = 0;
+    int32_t winding = 0;          // crossings of the corner ray (fills)
+    int32_t first = 0, count = 0; // local items
+};
+
 struct TileBins {
     int nx = 0, ny = 0;
-    std::vector<int> start;  // [nx * ny + 1] offsets into draws
-    std::vector<int> draws;
-    const int* begin(int tile) const { return draws.data() + start[tile]; }
+    double margin = 0;
+    std::vector<int> start;       // [nx * ny + 1] offsets into entries
+    std::vector<TileEntry> entries;
+    std::vector<LocalItem> items;
+    const TileEntry* begin(int tile) const { return entries.data() + start[tile]; }
     int count(int tile) const { return start[tile + 1] - start[tile]; }
+    Box region(int tile) const {  // pixel-space area the tile's samples and prefilter reach
+        int tx = tile % nx, ty = tile / nx;
+        return {tx * (double)TILE - margin, ty * (double)TILE - margin, (tx + 1) * (double)TILE + margin,
+                (ty + 1) * (double)TILE + margin};
+    }
 };
 
 // margin: how far (pixels) outside a tile its samples and their prefilter reach.
-TileBins bin_draws(const PreparedScene& scene, int width, int height, double margin);
+// With every_tile, a draw gets an entry in every tile its bounds reach (no culling of
+// tiles it cannot cover): the brute-force check of the tiles uses that.
+TileBins bin_draws(const PreparedScene& scene, int width, int height, double margin, bool every_tile = false);
+
+// Winding number of a fill draw at p in the tile, from its entry (see above).
+int tile_winding(const PreparedScene& scene, const TileBins& bins, const TileEntry& e, const Box& region, Vec2 p);
 
 }  // namespace vf

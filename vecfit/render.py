@@ -33,7 +33,8 @@ def output_size(scene: Scene, width: int | None, height: int | None) -> tuple[in
 
 def render(scene: Scene, width: int | None = None, height: int | None = None, *,
            samples: int = 2, mode: str = "mc", filter: str = "box", filter_radius: float = 0.5,
-           seed: int = 0, background=None, threads: int | None = None) -> torch.Tensor:
+           seed: int = 0, background=None, threads: int | None = None,
+           _brute_force: bool = False) -> torch.Tensor:
     """Render ``scene`` into an [H, W, 4] float tensor of straight RGBA.
 
     samples: N means N x N stratified samples per pixel (jittered in "mc" mode, at the
@@ -68,5 +69,6 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
         core_args["ellipses"], core_args["draws"], core_args["draw_params"], core_args["paints"],
         core_args["paint_params"], core_args["stop_offsets"], core_args["stop_colors"],
         core_args["layer_parents"], core_args["layer_opacity"], width, height, int(samples),
-        mode, filter, float(filter_radius), int(seed), int(threads or 0), background)
+        mode, filter, float(filter_radius), int(seed), int(threads or 0), background,
+        _brute_force)
     return torch.from_numpy(image)
