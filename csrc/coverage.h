@@ -105,11 +105,30 @@ inline double end_sdf(const StrokeEnd& e, Vec2 q, double hw) {
     }
 }
 
+// Critical points of |B(t) - q| that have a normal: at an end where B' vanishes (a
+// control point on the end point) every q is "critical", which would put a disk there,
+// a round cap or join the style did not ask for. The limit tangent decides there, and
+// its normal line has no area. (An interior cusp keeps its disk, as Skia's stroker does.)
+inline int sweep_critical_points(const Segment& s, Vec2 q, double* ts) {
+    int n = seg_critical_points(s, q, ts);
+    if (n == 0 || (ts[0] > 0 && ts[n - 1] < 1)) return n;
+    double size2 = 0;
+    for (int i = 1; i <= s.degree; ++i) size2 = std::max(size2, dot(s.p[i] - s.p[0], s.p[i] - s.p[0]));
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
+        bool end = ts[i] <= 0 || ts[i] >= 1;
+        Vec2 d = seg_deriv(s, ts[i]);
+        if (end && dot(d, d) <= 1e-18 * size2) continue;
+        ts[m++] = ts[i];
+    }
+    return m;
+}
+
 // Signed distance to the sweep's boundary from its critical points alone (offset curves):
 // min over critical points of (|B(t*) - q| - w/2); +huge when there are none.
 inline double sweep_sdf(const Segment& s, Vec2 q, double hw) {
     double ts[5];
-    int n = seg_critical_points(s, q, ts);
+    int n = sweep_critical_points(s, q, ts);
     double best = 1e300;
     for (int i = 0; i < n; ++i) best = std::min(best, distance(seg_eval(s, ts[i]), q) - hw);
     return best;
@@ -131,7 +150,7 @@ inline bool sweep_contains(const Segment& s, Vec2 q, double hw) {
         return t >= 0 && t <= 1 && std::fabs(cross(d, q - s.p[0])) <= hw * std::sqrt(l2);
     }
     double ts[5];
-    int n = seg_critical_points(s, q, ts);
+    int n = sweep_critical_points(s, q, ts);
     for (int i = 0; i < n; ++i)
         if (dot(seg_eval(s, ts[i]) - q, seg_eval(s, ts[i]) - q) <= hw * hw) return true;
     return false;

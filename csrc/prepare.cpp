@@ -125,6 +125,27 @@ StrokeEnd make_cap(Vec2 at, Vec2 outward, int cap) {
     return e;
 }
 
+// A curve whose control points all lie within sqrt(1e-5) of its length from its chord
+// is stroked as that straight line, as Skia and resvg do: the direction at the end of
+// such a curve is decided by sub-pixel control-point offsets, and stroking it exactly
+// grows visible fins and rounds that those renderers (and users) do not expect.
+Segment straightened(const Segment& s) {
+    if (s.degree == 1) return s;
+    Vec2 a = s.p[0], b = seg_end(s), d = b - a;
+    double l2 = dot(d, d);
+    if (l2 <= 0) return s;
+    for (int i = 1; i < s.degree; ++i) {
+        Vec2 r = s.p[i] - a;
+        double along = dot(r, d) / l2, off = cross(d, r);
+        if (along < 0 || along > 1 || off * off > 1e-5 * l2 * l2) return s;
+    }
+    Segment line;
+    line.degree = 1;
+    line.p[0] = a;
+    line.p[1] = b;
+    return line;
+}
+
 // Stroke pieces of one subpath of a stroke draw, appended to out.
 void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool closed,
                           const PreparedDraw& d, std::vector<StrokeSegment>& out) {
@@ -133,6 +154,7 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
         Segment s = sc.segments[g].seg;
         if (!d.metric_identity) s = transformed(s, d.metric);
         if (is_point(s)) continue;  // zero-length: no sweep, no direction
+        s = straightened(s);
         StrokeSegment ss;
         ss.seg = s;
         ss.source = g;

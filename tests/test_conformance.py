@@ -48,6 +48,5 @@ def test_pass_rate(record_property):
     table = conf.tag_table(results)
     conf.FAILURES.mkdir(parents=True, exist_ok=True)
     (conf.FAILURES.parent / "conformance-table.txt").write_text(table + "\n")
-    print("\n" + table)
     rate = sum(r.passed for r in results) / len(results)
     assert rate >= 0.97, f"pass rate {100 * rate:.1f}% < 97%\n{table}"

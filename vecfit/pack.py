@@ -142,14 +142,6 @@ def _path_segments(path: Path):
         yield ctrl, degrees
 
 
-def _is_similarity(a: torch.Tensor) -> bool:
-    """True for uniform scale (with reflection) without rotation: strokes need no metric."""
-    a = a.detach()
-    s = max(abs(float(a[0, 0])), abs(float(a[1, 1])), 1e-30)
-    return (abs(float(a[0, 1])) <= 1e-9 * s and abs(float(a[1, 0])) <= 1e-9 * s
-            and abs(abs(float(a[0, 0])) - abs(float(a[1, 1]))) <= 1e-6 * s)
-
-
 class Packer:
     def __init__(self, scene: Scene, width: int, height: int):
         self.scene = scene
@@ -196,64 +188,21 @@ class Packer:
             else:
                 self.group_layer.append(parent_layer)
 
-    def _folded_opacity(self, shape: Shape) -> torch.Tensor:
-        """Product of the opacities of groups that are not layers (one draw below them)."""
-        k = torch.tensor(1.0)
+    def _folded_opacities(self, shape: Shape) -> list:
+        """Opacities of the groups above the shape that are not layers (one draw below)."""
+        out = []
         g = shape.group
         while g >= 0:
             group = self.scene.groups[g]
             if float(group.opacity) < 1 and self._group_draw_counts[g] <= 1:
-                k = k * group.opacity
+                out.append(group.opacity)
             g = group.parent
-        return k
+        return out
 
-    # ---------------------------------------------------------------- geometry
-
-    def _add_geometry(self, geometry, m: torch.Tensor) -> int | None:
-        """Adds the shape's geometry in pixel space; returns its shape index."""
+    def _add_gradient(self, paint, alpha: torch.Tensor, m: torch.Tensor, geometry) -> int | None:
+        """Adds a gradient paint; returns its index among the gradients, or None when
+        it paints nothing."""
         out = self.out
-        if isinstance(geometry, (Circle, Ellipse)):
-            r = geometry.radius.reshape(1).expand(2) if isinstance(geometry, Circle) else geometry.radii
-            if float(r.min()) <= 0:
-                return None
-            c = _affine_apply(m, geometry.center.reshape(1, 2).float())[0]
-            axes = m[:2, :2] @ torch.diag(r.float())
-            out.ellipses.append(torch.cat([c, axes.reshape(4)]))
-            out.shapes.append([SHAPE_ELLIPSE, 0, 0, len(out.ellipses) - 1])
-            return len(out.shapes) - 1
-        if isinstance(geometry, Rect):
-            if float(geometry.p_max[0] - geometry.p_min[0]) <= 0 or float(geometry.p_max[1] - geometry.p_min[1]) <= 0:
-                return None
-            pts, degrees = _rect_path(geometry)
-            geometry = Path(points=pts, degrees=np.array(degrees), subpaths=[(0, len(degrees), True)])
-        if not isinstance(geometry, Path):
-            raise VecfitError(f"unknown geometry {type(geometry).__name__}")
-        first_subpath = len(out.subpaths)
-        base = out.n_points
-        out.points.append(_affine_apply(m, geometry.points.float()))
-        out.n_points += len(geometry.points)
-        for (first, count, closed), (p0, n) in zip(geometry.subpaths, geometry.subpath_point_ranges()):
-            seg0 = len(out.segments)
-            k = 0
-            for d in geometry.degrees[first:first + count]:
-                d = int(d)
-                idx = [base + p0 + ((k + i) % n if closed else k + i) for i in range(d + 1)]
-                out.segments.append([d] + idx + [-1] * (4 - len(idx)))
-                k += d
-            out.subpaths.append([seg0, count, int(bool(closed))])
-        out.shapes.append([SHAPE_PATH, first_subpath, len(out.subpaths) - first_subpath, -1])
-        return len(out.shapes) - 1
-
-    # ------------------------------------------------------------------ paints
-
-    def _add_paint(self, paint, alpha: torch.Tensor, m: torch.Tensor, geometry) -> int | None:
-        out = self.out
-        if isinstance(paint, Solid):
-            color = paint.color.float()
-            color = torch.cat([color[:3], color[3:4] * alpha])
-            out.paints.append([PAINT_SOLID, 0, 0])
-            out.paint_params.append(torch.cat([torch.eye(2, 3).reshape(6), color, torch.zeros(1)]))
-            return len(out.paints) - 1
         g = m
         if paint.units == "objectBoundingBox":
             box = _local_bbox(geometry)
@@ -293,50 +242,231 @@ class Packer:
         out.stop_offsets.append(paint.offsets.float())
         out.stop_colors.append(colors)
         out.n_stops += len(paint.offsets)
-        return len(out.paints) - 1
+        self._n_gradients = getattr(self, "_n_gradients", 0) + 1
+        return self._n_gradients - 1
 
     # ------------------------------------------------------------------- draws
+
+    def _shape_matrices(self) -> torch.Tensor:
+        """Each shape's local -> pixel matrix, [S, 3, 3], in one batched product."""
+        shapes = self.scene.shapes
+        if not shapes:
+            return torch.zeros((0, 3, 3))
+        parents = torch.stack([self.canvas] + self.group_matrix)
+        index = torch.tensor([s.group + 1 for s in shapes])
+        own = torch.stack([s.transform.float() for s in shapes])
+        return parents[index] @ own
 
     def pack(self) -> Packed:
         self._prepare_groups()
         out = self.out
-        for shape in self.scene.shapes:
-            parent_m = self.canvas if shape.group < 0 else self.group_matrix[shape.group]
-            layer = 0 if shape.group < 0 else self.group_layer[shape.group]
-            m = parent_m @ shape.transform.float()
+        shapes = self.scene.shapes
+        matrices = self._shape_matrices()
+        # Similarity (no metric needed for strokes) and uniform scale of every shape.
+        lin = matrices[:, :2, :2]
+        scale = torch.sqrt(torch.abs(lin[:, 0, 0] * lin[:, 1, 1] - lin[:, 0, 1] * lin[:, 1, 0]))
+        lin_np = lin.detach().numpy()
+        big = np.maximum(np.maximum(np.abs(lin_np[:, 0, 0]), np.abs(lin_np[:, 1, 1])), 1e-30)
+        similar = ((np.abs(lin_np[:, 0, 1]) <= 1e-9 * big) & (np.abs(lin_np[:, 1, 0]) <= 1e-9 * big)
+                   & (np.abs(np.abs(lin_np[:, 0, 0]) - np.abs(lin_np[:, 1, 1])) <= 1e-6 * big))
+
+        paths = _PathBatch()
+        solid_colors, solid_alphas = [], []   # per solid paint: colour [4], alpha factor
+        gradient_rows = []                    # (paint, alpha, matrix, geometry)
+        stroke_rows = []                      # (draw index, shape index)
+        for i, shape in enumerate(shapes):
             n_draws = self._draws_of(shape)
             if n_draws == 0:
                 continue
-            alpha = self._folded_opacity(shape)
+            layer = 0 if shape.group < 0 else self.group_layer[shape.group]
+            # Alpha factors of this shape's paints (multiplied out in one go later).
+            factors = self._folded_opacities(shape) if shape.group >= 0 else []
             if float(shape.opacity) < 1 and n_draws > 1:
                 layer = self._new_layer(layer, shape.opacity)
             else:
-                alpha = alpha * shape.opacity
-            index = self._add_geometry(shape.geometry, m)
-            if index is None:
-                continue
+                factors.append(shape.opacity)
+            m = matrices[i]
+            geometry = shape.geometry
+            if isinstance(geometry, Rect):
+                geometry = _rect_as_path(geometry)
+                if geometry is None:
+                    continue
+            if isinstance(geometry, Path):
+                if not geometry.subpaths:
+                    continue
+                index = paths.add(geometry, i, len(out.shapes), len(out.subpaths))
+                out.shapes.append([SHAPE_PATH, len(out.subpaths), len(geometry.subpaths), -1])
+                out.subpaths.extend([None] * len(geometry.subpaths))  # filled by the batch
+            else:
+                index = self._add_ellipse(geometry, m)
+                if index is None:
+                    continue
+
+            def paint_index(paint, factors):
+                if isinstance(paint, Solid):
+                    solid_colors.append(paint.color)
+                    solid_alphas.append(factors)
+                    return len(solid_colors) - 1
+                alpha = torch.tensor(1.0)
+                for f in factors:
+                    alpha = alpha * f
+                gradient_rows.append((paint, alpha, m, shape.geometry))
+                return -len(gradient_rows)  # fixed up once the solids are counted
+
             if shape.fill is not None:
-                paint = self._add_paint(shape.fill, alpha * shape.fill_opacity, m, shape.geometry)
-                if paint is not None:
-                    out.draws.append([index, DRAW_FILL, FILL_RULES[shape.fill_rule], paint, layer, 0, 0])
-                    out.draw_params.append(torch.tensor([0, 4, 1, 0, 0, 1], dtype=torch.float32))
-            if shape.stroke is not None and float(shape.stroke_width) > 0:
-                paint = self._add_paint(shape.stroke, alpha * shape.stroke_opacity, m, shape.geometry)
-                if paint is not None:
-                    a = m[:2, :2]
-                    scale = torch.sqrt(torch.abs(torch.linalg.det(a)))
-                    if float(scale) <= 0:
-                        continue
-                    if _is_similarity(a):
-                        metric = torch.eye(2).reshape(4)
-                    else:  # stroke space: the shape's local space, uniformly scaled
-                        metric = (scale * torch.linalg.inv(a)).reshape(4)
-                    width = shape.stroke_width.float().reshape(1) * scale
-                    limit = torch.tensor([float(shape.miter_limit)])
-                    out.draws.append([index, DRAW_STROKE, 0, paint, layer,
-                                      CAPS[shape.linecap], JOINS[shape.linejoin]])
-                    out.draw_params.append(torch.cat([width, limit, metric]))
+                paint = paint_index(shape.fill, factors + [shape.fill_opacity])
+                out.draws.append([index, DRAW_FILL, FILL_RULES[shape.fill_rule], paint, layer, 0, 0])
+            if shape.stroke is not None and float(shape.stroke_width) > 0 and float(scale[i]) > 0:
+                paint = paint_index(shape.stroke, factors + [shape.stroke_opacity])
+                stroke_rows.append((len(out.draws), i))
+                out.draws.append([index, DRAW_STROKE, 0, paint, layer,
+                                  CAPS[shape.linecap], JOINS[shape.linejoin]])
+
+        paths.finish(out, matrices)
+        self._finish_paints(solid_colors, solid_alphas, gradient_rows)
+        self._finish_draw_params(stroke_rows, matrices, scale, similar)
         return out
+
+    def _add_ellipse(self, geometry, m: torch.Tensor) -> int | None:
+        r = geometry.radius.reshape(1).expand(2) if isinstance(geometry, Circle) else geometry.radii
+        if float(r.min()) <= 0:
+            return None
+        c = _affine_apply(m, geometry.center.reshape(1, 2).float())[0]
+        axes = m[:2, :2] @ torch.diag(r.float())
+        self.out.ellipses.append(torch.cat([c, axes.reshape(4)]))
+        self.out.shapes.append([SHAPE_ELLIPSE, 0, 0, len(self.out.ellipses) - 1])
+        return len(self.out.shapes) - 1
+
+    def _finish_paints(self, solid_colors, solid_alphas, gradient_rows) -> None:
+        """Paint table: the solids (stacked in one go), then the gradients; draws that
+        point at a gradient are renumbered."""
+        out = self.out
+        n_solid = len(solid_colors)
+        if n_solid:
+            colors = torch.stack([c.float() for c in solid_colors])
+            # Multiply each paint's alpha factors: pad the lists with ones and stack once.
+            depth = max(len(f) for f in solid_alphas)
+            one = torch.tensor(1.0)
+            columns = [torch.stack([f[k].float().reshape(()) if k < len(f) else one for f in solid_alphas])
+                       for k in range(depth)]
+            alphas = torch.stack(columns).prod(dim=0)
+            colors = torch.cat([colors[:, :3], colors[:, 3:4] * alphas[:, None]], dim=1)
+            ident = torch.eye(2, 3).reshape(1, 6).expand(n_solid, 6)
+            out.paint_params.append(torch.cat([ident, colors, torch.zeros(n_solid, 1)], dim=1))
+            out.paints.extend([[PAINT_SOLID, 0, 0]] * n_solid)
+        gradient_index = []
+        for paint, alpha, m, geometry in gradient_rows:
+            gradient_index.append(self._add_gradient(paint, alpha, m, geometry))
+        keep = []
+        for row in out.draws:
+            if row[3] < 0:
+                g = gradient_index[-row[3] - 1]
+                if g is None:
+                    keep.append(False)  # a gradient that paints nothing (zero-size bbox, ...)
+                    continue
+                row[3] = n_solid + g
+            keep.append(True)
+        self._keep_draws = keep
+
+    def _finish_draw_params(self, stroke_rows, matrices, scale, similar) -> None:
+        out = self.out
+        n = len(out.draws)
+        params = torch.zeros((n, 6))
+        params[:, 1] = 4.0
+        params[:, 2] = 1.0
+        params[:, 5] = 1.0
+        if stroke_rows:
+            rows = torch.tensor([r for r, _ in stroke_rows])
+            idx = [i for _, i in stroke_rows]
+            widths = torch.stack([self.scene.shapes[i].stroke_width.float().reshape(()) for i in idx])
+            s = scale[idx]
+            lin = matrices[idx, :2, :2]
+            det = lin[:, 0, 0] * lin[:, 1, 1] - lin[:, 0, 1] * lin[:, 1, 0]
+            # stroke space: the shape's local space, uniformly scaled (identity for similarities)
+            inv = torch.stack([lin[:, 1, 1], -lin[:, 0, 1], -lin[:, 1, 0], lin[:, 0, 0]], dim=1) / det[:, None]
+            metric = torch.where(torch.as_tensor(similar[idx])[:, None],
+                                 torch.tensor([1.0, 0, 0, 1]).expand(len(idx), 4), s[:, None] * inv)
+            limits = torch.tensor([float(self.scene.shapes[i].miter_limit) for i in idx])
+            stroke_params = torch.cat([(widths * s)[:, None], limits[:, None], metric], dim=1)
+            params = params.index_put((rows,), stroke_params)
+        keep = getattr(self, "_keep_draws", [True] * n)
+        if not all(keep):
+            mask = torch.tensor(keep)
+            params = params[mask]
+            out.draws = [row for row, k in zip(out.draws, keep) if k]
+        out.draw_params = [params]
+
+
+class _PathBatch:
+    """All path geometry of a scene, mapped to pixels and indexed in one go."""
+
+    def __init__(self):
+        self.points: list[torch.Tensor] = []   # local points per path
+        self.owner: list[int] = []              # shape index (for its matrix) per path
+        self.degrees: list[np.ndarray] = []
+        self.subpaths: list[list] = []
+        self.subpath_slot: list[int] = []       # first row in Packed.subpaths per path
+
+    def add(self, path: Path, shape_index: int, core_shape: int, subpath_slot: int) -> int:
+        self.points.append(path.points)
+        self.owner.append(shape_index)
+        self.degrees.append(np.asarray(path.degrees, dtype=np.int64))
+        self.subpaths.append(path.subpaths)
+        self.subpath_slot.append(subpath_slot)
+        return core_shape
+
+    def finish(self, out: Packed, matrices: torch.Tensor) -> None:
+        if not self.points:
+            return
+        counts = [len(p) for p in self.points]
+        local = torch.cat([p.float() for p in self.points])
+        owner = torch.repeat_interleave(torch.tensor(self.owner), torch.tensor(counts))
+        m = matrices[owner]
+        out.points.append(torch.einsum("nij,nj->ni", m[:, :2, :2], local) + m[:, :2, 2])
+        base = out.n_points
+        out.n_points += len(local)
+
+        # Per subpath: first point (global), point count, closed, first segment (global).
+        seg_degrees, sub_first_point, sub_points, sub_closed, sub_seg_first, sub_seg_count = [], [], [], [], [], []
+        point_offset = base
+        seg_offset = len(out.segments)
+        for degrees, subpaths, slot in zip(self.degrees, self.subpaths, self.subpath_slot):
+            p = point_offset
+            for j, (first, count, closed) in enumerate(subpaths):
+                d = degrees[first:first + count]
+                n = int(d.sum()) + (0 if closed else 1)
+                seg_degrees.append(d)
+                sub_first_point.append(p)
+                sub_points.append(n)
+                sub_closed.append(bool(closed))
+                sub_seg_first.append(seg_offset)
+                sub_seg_count.append(count)
+                out.subpaths[slot + j] = [seg_offset, count, int(bool(closed))]
+                seg_offset += count
+                p += n
+            point_offset = p
+        deg = np.concatenate(seg_degrees) if seg_degrees else np.zeros(0, dtype=np.int64)
+        sub_of_seg = np.repeat(np.arange(len(sub_seg_count)), sub_seg_count)
+        # Offset of each segment's first point inside its subpath: the exclusive running
+        # sum of degrees, minus its value at the subpath's first segment.
+        running = np.concatenate([[0], np.cumsum(deg)])
+        first_rel = np.asarray(sub_seg_first, dtype=np.int64) - (sub_seg_first[0] if sub_seg_first else 0)
+        start = running[:-1] - running[first_rel][sub_of_seg]
+        j = np.arange(4)[None, :]
+        local_idx = start[:, None] + j
+        n_sub = np.asarray(sub_points, dtype=np.int64)[sub_of_seg][:, None]
+        closed = np.asarray(sub_closed, dtype=bool)[sub_of_seg][:, None]
+        local_idx = np.where(closed, local_idx % np.maximum(n_sub, 1), local_idx)
+        idx = np.asarray(sub_first_point, dtype=np.int64)[sub_of_seg][:, None] + local_idx
+        idx = np.where(j <= deg[:, None], idx, -1)
+        out.segments.extend(np.concatenate([deg[:, None], idx], axis=1).tolist())
+
+
+def _rect_as_path(rect: Rect) -> Path | None:
+    if float(rect.p_max[0] - rect.p_min[0]) <= 0 or float(rect.p_max[1] - rect.p_min[1]) <= 0:
+        return None
+    pts, degrees = _rect_path(rect)
+    return Path(points=pts, degrees=np.array(degrees), subpaths=[(0, len(degrees), True)])
 
 
 def pack_scene(scene: Scene, width: int, height: int) -> Packed:
