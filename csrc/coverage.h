@@ -10,8 +10,11 @@
 //     end points (bevel), or that quadrilateral reaching to the miter tip (miter, falling
 //     back to bevel past the miter limit);
 //   * per free end, the cap: nothing (butt: the sweep ends at its end normal), a disk
-//     (round) or a square of side w centred on the end point (square; its back half lies
-//     inside the sweep).
+//     (round) or the half square of depth w/2 beyond the end (square).
+// Pieces meet along internal seams (a sweep's end normal, a join polygon's sides from the
+// vertex, a cap's back edge). Signed distances treat seams as open: a point inside a piece
+// is as deep as its distance to the piece's real boundary, so the analytical prefilter
+// sees no lines inside a stroke.
 // Why this form: each piece has a simple inside test and a signed distance, and the
 // union's boundary is a set of curves with known normals (offset curves, disk arcs,
 // polygon edges, butt end lines), which is what boundary sampling needs for gradients.
@@ -71,25 +74,42 @@ inline bool convex_contains(const Vec2* v, int n, Vec2 q) {
     return !(pos && neg);
 }
 
-inline double convex_sdf(const Vec2* v, int n, Vec2 q) {
-    double d = 1e300;
-    for (int i = 0; i < n; ++i) d = std::min(d, point_line_segment_distance(q, v[i], v[(i + 1) % n]));
-    return convex_contains(v, n, q) ? -d : d;
+// A join polygon (vertex first, then its outer points): its two sides from the vertex are
+// seams with the sweeps, so depth inside counts only the outer edges.
+inline double join_polygon_sdf(const Vec2* v, int n, Vec2 q) {
+    double outer = 1e300, all = 1e300;
+    for (int i = 0; i < n; ++i) {
+        double d = point_line_segment_distance(q, v[i], v[(i + 1) % n]);
+        all = std::min(all, d);
+        if (i != 0 && i != n - 1) outer = std::min(outer, d);
+    }
+    return convex_contains(v, n, q) ? -outer : all;
 }
 
-inline double square_sdf(const StrokeEnd& e, Vec2 q, double hw) {
+// Local frame of a square cap: s along the outward tangent from the end point, u across.
+inline void cap_frame(const StrokeEnd& e, Vec2 q, double& s, double& u) {
     Vec2 r = q - e.center;
-    double u = std::fabs(dot(r, e.axis)) - hw, v = std::fabs(cross(e.axis, r)) - hw;
-    double ou = std::max(u, 0.0), ov = std::max(v, 0.0);
-    return std::sqrt(ou * ou + ov * ov) + std::min(std::max(u, v), 0.0);
+    s = dot(r, e.axis);
+    u = cross(e.axis, r);
+}
+
+// Half square s in [0, hw], |u| <= hw; its back edge (s = 0) is a seam with the sweep.
+inline double square_sdf(const StrokeEnd& e, Vec2 q, double hw) {
+    double s, u;
+    cap_frame(e, q, s, u);
+    double au = std::fabs(u);
+    if (s >= 0 && s <= hw && au <= hw) return -std::min(hw - s, hw - au);
+    double ds = s < 0 ? -s : std::max(s - hw, 0.0), du = std::max(au - hw, 0.0);
+    return std::sqrt(ds * ds + du * du);
 }
 
 inline bool end_contains(const StrokeEnd& e, Vec2 q, double hw) {
     switch (e.kind) {
         case StrokeEnd::DISK: return dot(q - e.center, q - e.center) <= hw * hw;
         case StrokeEnd::SQUARE: {
-            Vec2 r = q - e.center;
-            return std::fabs(dot(r, e.axis)) <= hw && std::fabs(cross(e.axis, r)) <= hw;
+            double s, u;
+            cap_frame(e, q, s, u);
+            return s >= 0 && s <= hw && std::fabs(u) <= hw;
         }
         case StrokeEnd::POLYGON: return convex_contains(e.poly, e.n_poly, q);
         default: return false;
@@ -100,7 +120,7 @@ inline double end_sdf(const StrokeEnd& e, Vec2 q, double hw) {
     switch (e.kind) {
         case StrokeEnd::DISK: return distance(q, e.center) - hw;
         case StrokeEnd::SQUARE: return square_sdf(e, q, hw);
-        case StrokeEnd::POLYGON: return convex_sdf(e.poly, e.n_poly, q);
+        case StrokeEnd::POLYGON: return join_polygon_sdf(e.poly, e.n_poly, q);
         default: return 1e300;
     }
 }

@@ -161,9 +161,9 @@ void render_forward(const PreparedScene& sc, const RenderOptions& o, float* out)
                 double acc[4] = {0, 0, 0, 0}, wsum = 0;
                 uint64_t pixel = (uint64_t)y * W + x;
                 for (int s = 0; s < N * N; ++s) {
-                    double u = 0.5, v = 0.5;
-                    if (o.mode == MODE_MC) sample_uniform2(o.seed, pixel, s, u, v);
-                    double dx = R * (2 * ((s % N) + u) / N - 1), dy = R * (2 * ((s / N) + v) / N - 1);
+                    double fx = ((s % N) + 0.5) / N, fy = ((s / N) + 0.5) / N;  // strata centres
+                    if (o.mode == MODE_MC) sample_position(o.seed, pixel, s, N, fx, fy);
+                    double dx = R * (2 * fx - 1), dy = R * (2 * fy - 1);
                     double w = filter_weight(o.filter, R, dx, dy);
                     if (w <= 0) continue;
                     double c[4] = {0, 0, 0, 0};

@@ -487,22 +487,24 @@ VF_HD double ellipse_closest_quadrant(double e0, double e1, double y0, double y1
             double z0 = y0 / e0, z1 = y1 / e1;
             double g = z0 * z0 + z1 * z1 - 1;
             if (g != 0) {
+                // Bisection on t = s + 1 rather than s: near the centre the root has
+                // s close to -1, where s + 1 would lose its relative precision.
                 double r0 = (e0 / e1) * (e0 / e1);
                 double n0 = r0 * z0;
-                double s0 = z1 - 1;
-                double s1 = g < 0 ? 0 : std::hypot(n0, z1) - 1;
-                double s = 0;
+                double t0 = z1;                                    // s0 = z1 - 1
+                double t1 = g < 0 ? 1.0 : std::hypot(n0, z1);      // s1 = 0 or |(n0, z1)| - 1
+                double t = t0;
                 for (int i = 0; i < 200; ++i) {
-                    s = 0.5 * (s0 + s1);
-                    if (s == s0 || s == s1) break;
-                    double q0 = n0 / (s + r0), q1 = z1 / (s + 1);
+                    t = 0.5 * (t0 + t1);
+                    if (t == t0 || t == t1) break;
+                    double q0 = n0 / ((r0 - 1) + t), q1 = z1 / t;
                     double gs = q0 * q0 + q1 * q1 - 1;
-                    if (gs > 0) s0 = s;
-                    else if (gs < 0) s1 = s;
+                    if (gs > 0) t0 = t;
+                    else if (gs < 0) t1 = t;
                     else break;
                 }
-                x0 = r0 * y0 / (s + r0);
-                x1 = y1 / (s + 1);
+                x0 = r0 * y0 / ((r0 - 1) + t);
+                x1 = y1 / t;
                 return std::hypot(x0 - y0, x1 - y1);
             }
             x0 = y0;
@@ -557,6 +559,11 @@ VF_HD double ellipse_closest(const EllipseFrame& f, Vec2 p, Vec2& closest) {
         closest = f.c + Vec2{f.cs * x, f.sn * x};
         return std::hypot(u - x, v);
     }
+    // Rotation leaves ~1e-16 where a point lies on an axis; the quadrant solver needs an
+    // exact zero there (its on-axis branches), so snap coordinates that are pure rounding.
+    double snap = 1e-12 * (e0 + std::fabs(u) + std::fabs(v));
+    if (std::fabs(u) <= snap) u = 0;
+    if (std::fabs(v) <= snap) v = 0;
     double x0, x1, dist;
     dist = ellipse_closest_quadrant(e0, e1, std::fabs(u), std::fabs(v), x0, x1);
     x0 = std::copysign(x0, u);

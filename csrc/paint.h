@@ -29,15 +29,23 @@ inline void stop_color(const PreparedScene& sc, const PreparedPaint& p, double t
     out[3] = a;
 }
 
-// Gradient parameter of a radial gradient with focal point f inside the circle (c, r):
-// the t >= 0 for which q lies on the circle of centre f + t (c - f) and radius t r.
-inline double radial_t(Vec2 q, Vec2 c, double r, Vec2 f) {
+// Gradient parameter of a radial gradient with focal point f and circle (c, r), as SVG 2
+// defines it (a two-point cone from a circle of radius 0 at f to the circle (c, r)): the
+// largest t with t r >= 0 for which q lies on the circle of centre f + t (c - f) and
+// radius t r. Returns false where no such t exists: outside the cone, when the focal
+// point lies outside the circle; that area is not painted.
+inline bool radial_t(Vec2 q, Vec2 c, double r, Vec2 f, double& t) {
     Vec2 d = c - f, e = q - f;
     double a = dot(d, d) - r * r, b = dot(e, d), cc = dot(e, e);
-    if (std::fabs(a) <= 1e-12 * r * r) return b > 0 ? cc / (2 * b) : 1e30;
+    if (std::fabs(a) <= 1e-9 * r * r) {  // focal point on the circle: a linear equation
+        if (b <= 0) return false;
+        t = cc / (2 * b);
+        return true;
+    }
     double disc = b * b - a * cc;
-    if (disc < 0) return 1e30;
-    return (b - std::sqrt(disc)) / a;
+    if (disc < 0) return false;
+    t = a < 0 ? (b - std::sqrt(disc)) / a : (b + std::sqrt(disc)) / a;
+    return t >= 0;
 }
 
 inline void paint_color(const PreparedScene& sc, const PreparedPaint& p, Vec2 pixel, double out[4]) {
@@ -55,7 +63,11 @@ inline void paint_color(const PreparedScene& sc, const PreparedPaint& p, Vec2 pi
         t = l2 > 0 ? dot(q - a, d) / l2 : 1.0;  // degenerate: the last stop's colour
     } else {
         double r = p.g[2];
-        t = r > 0 ? radial_t(q, {p.g[0], p.g[1]}, r, {p.g[3], p.g[4]}) : 1.0;
+        t = 1.0;  // a zero radius paints with the last stop
+        if (r > 0 && !radial_t(q, {p.g[0], p.g[1]}, r, {p.g[3], p.g[4]}, t)) {
+            out[0] = out[1] = out[2] = out[3] = 0;
+            return;
+        }
     }
     stop_color(sc, p, t, out);
 }

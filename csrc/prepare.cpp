@@ -69,7 +69,7 @@ void add_end_to_box(Box& b, const StrokeEnd& e, double hw) {
             expand(b, e.center + Vec2{-hw, -hw});
             expand(b, e.center + Vec2{hw, hw});
             break;
-        case StrokeEnd::SQUARE:
+        case StrokeEnd::SQUARE:  // the half square lies within hw * sqrt(2) of the end point
             expand(b, e.center + Vec2{-hw * 1.5, -hw * 1.5});
             expand(b, e.center + Vec2{hw * 1.5, hw * 1.5});
             break;
@@ -172,6 +172,7 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
         ss.seg.degree = 1;
         ss.seg.p[1] = ss.seg.p[0];
         ss.source = first;
+        ss.start = make_cap(s.p[0], {-1, 0}, d.cap);
         ss.end = make_cap(s.p[0], {1, 0}, d.cap);
         segs.push_back(ss);
     } else {

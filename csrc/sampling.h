@@ -22,6 +22,32 @@ inline void sample_uniform2(uint64_t seed, uint64_t pixel, uint64_t sample, doub
     v = (h >> 11) * (1.0 / 9007199254740992.0);
 }
 
+// Position of sample s (of n x n) inside the unit square for one pixel: correlated
+// multi-jittered sampling (Kensler 2013). Each of the n x n strata holds one sample, and
+// the n^2 samples also fall in distinct columns and rows of the fine n^2 x n^2 grid, which
+// estimates edge coverage with less noise than plain jittered strata. The two
+// permutations are shared by the pixel's rows / columns ("correlated") and drawn per pixel.
+inline uint32_t permute_index(uint32_t i, uint32_t n, uint64_t key) {
+    // i-th element of a random permutation of 0..n-1 (n <= 64): rank by hashed keys.
+    uint64_t ki = mix64(key ^ (i * 0x9e3779b97f4a7c15ull));
+    uint32_t rank = 0;
+    for (uint32_t j = 0; j < n; ++j) {
+        uint64_t kj = mix64(key ^ (j * 0x9e3779b97f4a7c15ull));
+        rank += kj < ki || (kj == ki && j < i);
+    }
+    return rank;
+}
+
+inline void sample_position(uint64_t seed, uint64_t pixel, int s, int n, double& x, double& y) {
+    double u, v;
+    sample_uniform2(seed, pixel, (uint64_t)s, u, v);
+    int sx = s % n, sy = s / n;
+    uint64_t key = mix64(seed ^ mix64(pixel + 0x5851f42d4c957f2dull));
+    uint32_t px = permute_index(sx, n, key), py = permute_index(sy, n, key ^ 0xa511e9b3ull);
+    x = (sx + (py + u) / n) / n;
+    y = (sy + (px + v) / n) / n;
+}
+
 enum FilterKind : int { FILTER_BOX = 0, FILTER_TENT = 1, FILTER_GAUSSIAN = 2 };
 
 // Unnormalised filter weight at offset (dx, dy) from the pixel centre, support radius r.

@@ -223,14 +223,9 @@ class Packer:
             params = torch.cat([to_paint, paint.start.float(), paint.end.float(), torch.zeros(1)])
             kind = PAINT_LINEAR
         elif isinstance(paint, RadialGradient):
+            # SVG 2 semantics, as resvg and browsers draw it: a focal point outside the
+            # circle makes a cone, and the area outside the cone is not painted.
             c, f, r = paint.center.float(), paint.focal.float(), paint.radius.float().reshape(1)
-            # SVG 1.1: a focal point outside the circle is moved onto it; keep it just
-            # inside so that the cone stays well defined.
-            d = f - c
-            dist = torch.linalg.norm(d)
-            limit = r[0] * 0.999
-            if float(dist) > float(limit):
-                f = c + d * (limit / dist)
             params = torch.cat([to_paint, c, r, f])
             kind = PAINT_RADIAL
         else:

@@ -1,0 +1,263 @@
+"""SVG path data (the ``d`` attribute) to subpaths of line, quadratic and cubic segments.
+
+Written here rather than taken from svgelements because the Scene needs choices that
+svgelements does not make for us: arcs as cubics of at most 90 degrees, ``Z`` as an
+explicit closing line, zero-length subpaths kept, and SVG's error rule (draw the path up
+to the first error instead of rejecting it).
+"""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .units import NUMBER
+
+_TOKEN = re.compile(rf"[MmZzLlHhVvCcSsQqTtAa]|{NUMBER}|[^\s,]")
+_COMMANDS = frozenset("MmZzLlHhVvCcSsQqTtAa")
+_ARG_COUNT = {"m": 2, "l": 2, "h": 1, "v": 1, "c": 6, "s": 4, "q": 4, "t": 2, "a": 7}
+
+
+@dataclass
+class Subpath:
+    """Points: the start, then per segment its control points and end (the closing line's
+    end, equal to the start, is not stored)."""
+    points: list = field(default_factory=list)   # [(x, y)]
+    degrees: list = field(default_factory=list)  # [1 | 2 | 3]
+    closed: bool = False
+
+
+class PathDataError(ValueError):
+    """Path data with an error; ``subpaths`` holds what was read before it."""
+
+    def __init__(self, subpaths):
+        super().__init__("invalid path data")
+        self.subpaths = subpaths
+
+
+class _Builder:
+    """Collects segments while tracking the current point and the previous control point
+    (for S and T, which reflect it)."""
+
+    def __init__(self):
+        self.subpaths: list[Subpath] = []
+        self.current: Subpath | None = None
+        self.start = (0.0, 0.0)
+        self.point = (0.0, 0.0)
+        self.last_cubic_ctrl = None  # second control point of the previous C/S
+        self.last_quad_ctrl = None   # control point of the previous Q/T
+
+    def move(self, p):
+        self.current = Subpath(points=[p])
+        self.subpaths.append(self.current)
+        self.start = self.point = p
+        self._forget()
+
+    def _open(self):
+        # A drawing command right after Z starts a new subpath at the closed one's start.
+        if self.current is None or self.current.closed:
+            self.move(self.start)
+
+    def _forget(self):
+        self.last_cubic_ctrl = self.last_quad_ctrl = None
+
+    def segment(self, degree, pts):
+        self._open()
+        self.current.points.extend(pts)
+        self.current.degrees.append(degree)
+        self.point = pts[-1]
+
+    def line(self, p):
+        self.segment(1, [p])
+        self._forget()
+
+    def cubic(self, c1, c2, p):
+        self.segment(3, [c1, c2, p])
+        self._forget()
+        self.last_cubic_ctrl = c2
+
+    def quad(self, c, p):
+        self.segment(2, [c, p])
+        self._forget()
+        self.last_quad_ctrl = c
+
+    def close(self):
+        if self.current is None or self.current.closed:
+            # Z after Z (or before anything) closes an empty subpath at the start point.
+            self.move(self.start)
+        self.current.degrees.append(1)  # explicit line back to the start, not stored twice
+        self.current.closed = True
+        self.point = self.start
+        self._forget()
+
+    def reflected(self, ctrl):
+        if ctrl is None:
+            return self.point
+        return (2 * self.point[0] - ctrl[0], 2 * self.point[1] - ctrl[1])
+
+
+def parse_path_data(d: str) -> list[Subpath]:
+    """Subpaths of ``d`` (empty ones, a moveto alone, are dropped). Raises PathDataError,
+    carrying the subpaths read so far, at the first error."""
+    b = _Builder()
+    tokens = _TOKEN.findall(d or "")
+    i, n = 0, len(tokens)
+    cmd = None
+    try:
+        while i < n:
+            tok = tokens[i]
+            if tok in _COMMANDS:
+                cmd = tok
+                i += 1
+                if cmd in "Zz":
+                    b.close()
+                    continue
+                if cmd not in "Mm" and b.current is None:
+                    raise ValueError("path data must start with a moveto")
+            elif cmd is None or cmd in "Zz":
+                raise ValueError("number without a command")
+            count = _ARG_COUNT[cmd.lower()]
+            if cmd in "Aa":
+                args, i = _arc_args(tokens, i)
+            else:
+                if i + count > n:
+                    raise ValueError("missing arguments")
+                args = [float(t) for t in tokens[i:i + count]]
+                i += count
+            _apply(b, cmd, args)
+            # After a moveto, further coordinate pairs are implicit linetos.
+            if cmd == "M":
+                cmd = "L"
+            elif cmd == "m":
+                cmd = "l"
+    except (ValueError, IndexError):
+        raise PathDataError(_drop_empty(b.subpaths)) from None
+    return _drop_empty(b.subpaths)
+
+
+def _drop_empty(subpaths):
+    return [s for s in subpaths if s.degrees]
+
+
+def _arc_args(tokens, i):
+    """rx ry angle large-arc sweep x y; the flags are single characters that may be written
+    without separators ("0110 20" is 0, 1, 10, 20)."""
+    args = [float(tokens[i]), float(tokens[i + 1]), float(tokens[i + 2])]
+    i += 3
+    for _ in range(2):
+        tok = tokens[i]
+        if not tok or tok[0] not in "01":
+            raise ValueError("arc flag must be 0 or 1")
+        args.append(float(tok[0]))
+        if len(tok) > 1:
+            tokens[i] = tok[1:]  # the rest of the token is the next argument
+        else:
+            i += 1
+    args += [float(tokens[i]), float(tokens[i + 1])]
+    return args, i + 2
+
+
+def _apply(b: _Builder, cmd: str, a: list[float]) -> None:
+    rel = cmd.islower()
+    ox, oy = b.point if rel else (0.0, 0.0)
+    c = cmd.lower()
+    if c == "m":
+        b.move((ox + a[0], oy + a[1]))
+    elif c == "l":
+        b.line((ox + a[0], oy + a[1]))
+    elif c == "h":
+        b.line((ox + a[0] if rel else a[0], b.point[1]))
+    elif c == "v":
+        b.line((b.point[0], oy + a[0] if rel else a[0]))
+    elif c == "c":
+        b.cubic((ox + a[0], oy + a[1]), (ox + a[2], oy + a[3]), (ox + a[4], oy + a[5]))
+    elif c == "s":
+        b.cubic(b.reflected(b.last_cubic_ctrl), (ox + a[0], oy + a[1]), (ox + a[2], oy + a[3]))
+    elif c == "q":
+        b.quad((ox + a[0], oy + a[1]), (ox + a[2], oy + a[3]))
+    elif c == "t":
+        b.quad(b.reflected(b.last_quad_ctrl), (ox + a[0], oy + a[1]))
+    elif c == "a":
+        end = (ox + a[5], oy + a[6])
+        _arc(b, a[0], a[1], a[2], a[3] != 0, a[4] != 0, end)
+
+
+def _arc(b: _Builder, rx, ry, angle, large, sweep, end) -> None:
+    """An elliptical arc as cubics (SVG implementation notes F.6.5 and F.6.6)."""
+    x1, y1 = b.point
+    x2, y2 = end
+    if (x1, y1) == (x2, y2):
+        b._open()  # SVG: an arc to the current point is omitted
+        b._forget()
+        return
+    rx, ry = abs(rx), abs(ry)
+    if rx == 0 or ry == 0:
+        b.line(end)
+        return
+    phi = math.radians(angle % 360)
+    cos_p, sin_p = math.cos(phi), math.sin(phi)
+    # Step 1: the midpoint in the ellipse's axis-aligned frame.
+    dx, dy = (x1 - x2) / 2, (y1 - y2) / 2
+    x1p = cos_p * dx + sin_p * dy
+    y1p = -sin_p * dx + cos_p * dy
+    # Radii too small to reach the end point are scaled up (F.6.6).
+    lam = (x1p / rx) ** 2 + (y1p / ry) ** 2
+    if lam > 1:
+        s = math.sqrt(lam)
+        rx, ry = rx * s, ry * s
+    # Step 2: the centre in that frame.
+    num = rx * rx * ry * ry - rx * rx * y1p * y1p - ry * ry * x1p * x1p
+    den = rx * rx * y1p * y1p + ry * ry * x1p * x1p
+    coef = math.sqrt(max(0.0, num / den)) if den > 0 else 0.0
+    if large == sweep:
+        coef = -coef
+    cxp, cyp = coef * rx * y1p / ry, -coef * ry * x1p / rx
+    # Step 3: the centre in user space and the angle range.
+    cx = cos_p * cxp - sin_p * cyp + (x1 + x2) / 2
+    cy = sin_p * cxp + cos_p * cyp + (y1 + y2) / 2
+    theta1 = math.atan2((y1p - cyp) / ry, (x1p - cxp) / rx)
+    theta2 = math.atan2((-y1p - cyp) / ry, (-x1p - cxp) / rx)
+    delta = theta2 - theta1
+    if sweep and delta < 0:
+        delta += 2 * math.pi
+    elif not sweep and delta > 0:
+        delta -= 2 * math.pi
+    if not math.isfinite(delta):
+        b.line(end)
+        return
+    # Cubics of at most 90 degrees each (error below 3e-4 of the radius).
+    pieces = max(1, math.ceil(abs(delta) / (math.pi / 2) - 1e-9))
+    step = delta / pieces
+    k = 4 / 3 * math.tan(step / 4)
+
+    def at(t):  # point and derivative direction on the ellipse at angle t
+        ct, st = math.cos(t), math.sin(t)
+        px, py = rx * ct, ry * st
+        tx, ty = -rx * st, ry * ct
+        return ((cx + cos_p * px - sin_p * py, cy + sin_p * px + cos_p * py),
+                (cos_p * tx - sin_p * ty, sin_p * tx + cos_p * ty))
+
+    p0, d0 = at(theta1)
+    p0 = (x1, y1)
+    for j in range(1, pieces + 1):
+        p1, d1 = at(theta1 + j * step)
+        if j == pieces:
+            p1 = end  # exactly the arc's end point, not a rounded one
+        c1 = (p0[0] + k * d0[0], p0[1] + k * d0[1])
+        c2 = (p1[0] - k * d1[0], p1[1] - k * d1[1])
+        b.cubic(c1, c2, p1)
+        p0, d0 = p1, d1
+    b._forget()  # a following S or T does not reflect an arc's control point
+
+
+def to_arrays(subpaths: list[Subpath]):
+    """(points [P, 2] float64, degrees [G] int, subpath table) in the Scene's layout."""
+    points, degrees, table = [], [], []
+    for s in subpaths:
+        table.append((len(degrees), len(s.degrees), s.closed))
+        points.extend(s.points)
+        degrees.extend(s.degrees)
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    return pts, np.asarray(degrees, dtype=np.int64), table

@@ -1,0 +1,364 @@
+"""SVG file -> Scene.
+
+The reader walks the XML element tree itself: svgelements (used here for transform lists)
+loses gradients, group opacity and nested viewports, and we need to know which element
+each shape and group came from. Styles cascade and inherit as in ``style.py``; paints and
+gradients are resolved in ``paint.py``; geometry is built in ``shapes.py``.
+
+Structure kept: every <g> (and <a>), every <use> and nested <svg> becomes a Group, in
+document order, with its own transform and opacity; shapes keep their own transform
+and opacity. The root <svg> becomes a Group only when it has an opacity or a transform.
+Shapes and groups are kept even when they draw nothing (no fill and no stroke), so that
+the Scene has one shape per drawable element; ``source`` is the element's id, or its
+position "/i/j/k" in the document when it has no unique id.
+"""
+from __future__ import annotations
+
+import math
+from collections import Counter
+
+import numpy as np
+import torch
+
+from ..errors import SvgError
+from ..scene import Group, Scene, Shape
+from .color import parse_color
+from .dom import href_id, is_svg, local_name, read_root
+from .paint import BLACK, Paints, parse_opacity, parse_paint
+from .shapes import Limiter, ShapeReader
+from .skips import Skips, VecfitWarning
+from .style import Cascade, StyleSheet
+from .units import parse_length, parse_number, parse_transform, parse_viewbox, translate, \
+    view_transform
+
+__all__ = ["load_svg", "VecfitWarning"]
+
+SHAPES = frozenset({"rect", "circle", "ellipse", "line", "polyline", "polygon", "path"})
+CONTAINERS = frozenset({"g", "a"})
+# Elements that are never drawn where they stand (referenced, metadata, or styling).
+NOT_DRAWN = frozenset({
+    "defs", "style", "title", "desc", "metadata", "script", "symbol", "linearGradient",
+    "radialGradient", "stop", "clipPath", "mask", "pattern", "marker", "filter", "view",
+    "cursor", "font", "font-face", "color-profile",
+})
+CAPS = ("butt", "round", "square")
+JOINS = {"miter": "miter", "miter-clip": "miter", "arcs": "miter", "round": "round",
+         "bevel": "bevel"}
+DEFAULT_SIZE = 100.0  # resvg's size for a root with neither width/height nor viewBox
+# Elements drawn inside <use> instances: a guard against reference bombs (uses of groups
+# of uses ...) that would take hours and all memory. The file's own elements are bounded
+# by its size.
+MAX_INSTANCED = 100_000
+
+
+def load_svg(path) -> Scene:
+    """Read the SVG file at ``path`` into a Scene.
+
+    Raises SvgError for a file that cannot be read as SVG. What is not supported is left
+    out (or drawn approximately) with one VecfitWarning per kind, and listed in
+    ``scene.skipped``. An SVG without drawable shapes gives an empty Scene.
+    """
+    root = read_root(path)
+    reader = _Reader(path, root)
+    try:
+        scene = reader.read()
+    except RecursionError:
+        raise SvgError(path, "elements nested too deeply") from None
+    reader.skips.warn(path)
+    return scene
+
+
+def _name(element) -> str:
+    """How messages name an element: its id, else its tag."""
+    return element.get("id") or local_name(element.tag)
+
+
+def _handles(root) -> dict[int, str]:
+    """A handle per element for ``source`` (write-back): its id when that is unique in the
+    document, else its position "/i/j/k" (indices among element children, from the root;
+    "/" is the root itself)."""
+    counts = Counter(e.get("id") for e in root.iter() if e.get("id") is not None)
+    handles, todo = {}, [(root, "")]
+    while todo:
+        element, position = todo.pop()
+        i = element.get("id")
+        handles[id(element)] = i if i is not None and counts[i] == 1 else (position or "/")
+        todo += [(child, f"{position}/{k}") for k, child in enumerate(element)]
+    return handles
+
+
+def _singular(m: np.ndarray | None) -> bool:
+    return m is not None and abs(m[0, 0] * m[1, 1] - m[0, 1] * m[1, 0]) == 0
+
+
+class _Reader:
+    def __init__(self, path, root):
+        self.path = path
+        self.root = root
+        self.skips = Skips()
+        self.ids: dict[str, object] = {}
+        self.parents: dict[int, object] = {}
+        for element in root.iter():
+            i = element.get("id")
+            if i is not None:
+                self.ids.setdefault(i, element)  # the first of duplicated ids wins
+            for child in element:
+                self.parents[id(child)] = element
+        self.handles = _handles(root)
+        self.cascade = Cascade(self._style_sheet())
+        self.width, self.height, self.view, self.viewport = self._root_size()
+        self.paints = Paints(self.ids, self._style_at, self.viewport, self.skips.add)
+        self.shapes: list[Shape] = []
+        self.groups: list[Group] = []
+        self._styles: dict[int, dict] = {}
+        self._instanced = 0
+
+    # --------------------------------------------------------------- document
+
+    def _style_sheet(self) -> StyleSheet:
+        sheet = StyleSheet()
+        for element in self.root.iter():
+            if local_name(element.tag) == "style" and is_svg(element):
+                if (element.get("type") or "text/css").strip().lower() in ("text/css", ""):
+                    sheet.add("".join(element.itertext()))
+        for selector in sheet.unsupported:
+            self.skips.add("css-selector", selector)
+        return sheet
+
+    def _root_size(self):
+        """(width, height) in px, the view matrix, and the viewport size that user-space
+        percentages refer to."""
+        root = self.root
+        vb = parse_viewbox(root.get("viewBox"))
+        if vb is not None and (vb[2] <= 0 or vb[3] <= 0):
+            raise SvgError(self.path, f"invalid viewBox {root.get('viewBox')!r} (zero or negative size)")
+        # Percentages (the default 100%) have no outer viewport to refer to: as not given.
+        w = parse_length(root.get("width"))
+        h = parse_length(root.get("height"))
+        for name, value in (("width", w), ("height", h)):
+            if value is not None and not (0 < value < math.inf):
+                raise SvgError(self.path, f"invalid root {name} {root.get(name)!r}")
+        if w is None and h is None:
+            w, h = (vb[2], vb[3]) if vb else (DEFAULT_SIZE, DEFAULT_SIZE)
+        elif w is None:
+            w = h * vb[2] / vb[3] if vb else DEFAULT_SIZE
+        elif h is None:
+            h = w * vb[3] / vb[2] if vb else DEFAULT_SIZE
+        view = view_transform(vb, w, h, root.get("preserveAspectRatio")) if vb else np.eye(3)
+        viewport = (vb[2], vb[3]) if vb else (w, h)
+        return float(w), float(h), view, viewport
+
+    def read(self) -> Scene:
+        style = self.cascade.computed(self.root, None)
+        group = -1
+        if (style.get("display") or "").strip() != "none":
+            transform = parse_transform(self.root.get("transform"))
+            opacity = parse_opacity(style.get("opacity"))
+            if not _singular(transform):
+                if opacity < 1 or transform is not None:
+                    group = self._group(transform, opacity, -1, self.root)
+                self._children(self.root, style, group, ())
+        lim = Limiter()
+        view = lim.tensor(self.view)
+        if lim.clamped:
+            self.skips.add("out-of-range numbers", _name(self.root))
+        return Scene(width=self.width, height=self.height, shapes=self.shapes, groups=self.groups,
+                     view=view, skipped=self.skips.as_dict())
+
+    # ------------------------------------------------------------------- walk
+
+    def _children(self, element, style, group, stack):
+        for child in element:
+            self._element(child, style, group, stack)
+
+    def _element(self, element, parent_style, group, stack):
+        if not is_svg(element):
+            return  # comments, and other namespaces (editor metadata)
+        tag = local_name(element.tag)
+        if tag in NOT_DRAWN:
+            return
+        if stack:
+            self._instanced += 1
+            if self._instanced > MAX_INSTANCED:
+                raise SvgError(self.path, f"<use> references expand to more than "
+                                          f"{MAX_INSTANCED} elements")
+        if tag not in SHAPES and tag not in CONTAINERS and tag not in ("use", "svg", "switch"):
+            self.skips.add(tag, _name(element))  # text, image, foreignObject, unknown, ...
+            return
+        style = self.cascade.computed(element, parent_style)
+        if (style.get("display") or "").strip() == "none":
+            return
+        transform = parse_transform(element.get("transform"))
+        if _singular(transform):
+            return  # SVG: a non-invertible transform draws nothing
+        self._note_layer_effects(element, style)
+        if tag in CONTAINERS:
+            g = self._group(transform, parse_opacity(style.get("opacity")), group, element)
+            self._children(element, style, g, stack)
+        elif tag == "switch":
+            g = self._group(transform, parse_opacity(style.get("opacity")), group, element)
+            child = _switch_choice(element)
+            if child is not None:
+                self._element(child, style, g, stack)
+        elif tag == "use":
+            self._use(element, style, transform, group, stack)
+        elif tag == "svg":
+            self._nested_svg(element, element, style, transform, group, stack)
+        else:
+            self._shape(tag, element, style, transform, group)
+
+    def _note_layer_effects(self, element, style):
+        for prop in ("clip-path", "mask", "filter"):
+            value = (style.get(prop) or "none").strip()
+            if value != "none":
+                self.skips.add(prop, _name(element))
+
+    def _group(self, transform, opacity, parent, element) -> int:
+        lim = Limiter()
+        m = torch.eye(3) if transform is None else lim.tensor(transform)
+        if lim.clamped:
+            self.skips.add("out-of-range numbers", _name(element))
+        self.groups.append(Group(transform=m, opacity=torch.tensor(float(opacity)),
+                                 parent=parent, source=self.handles[id(element)]))
+        return len(self.groups) - 1
+
+    # ------------------------------------------------------------- references
+
+    def _use(self, element, style, transform, group, stack):
+        name = _name(element)
+        ref = href_id(element)
+        target = self.ids.get(ref) if ref else None
+        if target is None or not is_svg(target):
+            self.skips.add("use", f"{name} (no element #{ref})" if ref else f"{name} (no local href)")
+            return
+        if id(target) in stack or any(e is element for e in target.iter()):
+            self.skips.add("use", f"{name} (recursive)")
+            return
+        x = parse_length(element.get("x"), self.viewport[0]) or 0.0
+        y = parse_length(element.get("y"), self.viewport[1]) or 0.0
+        m = (transform if transform is not None else np.eye(3)) @ translate(x, y)
+        g = self._group(m, parse_opacity(style.get("opacity")), group, element)
+        stack = stack + (id(target),)
+        tag = local_name(target.tag)
+        if tag in ("symbol", "svg"):
+            # The use's width and height, when given, set the viewport of the instance.
+            target_style = self.cascade.computed(target, style)
+            if (target_style.get("display") or "").strip() != "none":
+                self._nested_svg(target, element, target_style, None, g, stack)
+        else:
+            self._element(target, style, g, stack)
+
+    def _nested_svg(self, element, sizer, style, transform, group, stack):
+        """A nested <svg> or an instanced <symbol>: a group mapping its viewBox onto its
+        viewport (width and height from ``sizer``, the element or the <use>)."""
+        vw, vh = self.viewport
+        tag = local_name(element.tag)
+        x = 0.0 if tag == "symbol" else parse_length(element.get("x"), vw) or 0.0
+        y = 0.0 if tag == "symbol" else parse_length(element.get("y"), vh) or 0.0
+        w = parse_length(sizer.get("width") or element.get("width") or "100%", vw)
+        h = parse_length(sizer.get("height") or element.get("height") or "100%", vh)
+        if w is None or h is None or w <= 0 or h <= 0:
+            return
+        m = (transform if transform is not None else np.eye(3)) @ translate(x, y)
+        vb = parse_viewbox(element.get("viewBox"))
+        if vb is not None:
+            if vb[2] <= 0 or vb[3] <= 0:
+                return
+            m = m @ view_transform(vb, w, h, element.get("preserveAspectRatio"))
+        if (style.get("overflow") or "hidden").strip() in ("hidden", "scroll"):
+            self.skips.add("svg viewport clipping", _name(element))
+        g = self._group(m, parse_opacity(style.get("opacity")), group, element)
+        self._children(element, style, g, stack)
+
+    def _style_at(self, element) -> dict:
+        """Computed properties of any element, from its ancestors (for gradient stops)."""
+        key = id(element)
+        if key not in self._styles:
+            parent = self.parents.get(key)
+            self._styles[key] = self.cascade.computed(
+                element, self._style_at(parent) if parent is not None else None)
+        return self._styles[key]
+
+    # ----------------------------------------------------------------- shapes
+
+    def _shape(self, tag, element, style, transform, group):
+        name = _name(element)
+        lim = Limiter()
+        reader = ShapeReader(self.viewport, lim)
+        geometry = reader.build(tag, element)
+        if reader.problem:
+            self.skips.add(reader.problem, name)
+        if geometry is None or (style.get("visibility") or "").strip() in ("hidden", "collapse"):
+            return
+        current = parse_color(style.get("color")) or BLACK
+        fill = self._paint(style, "fill", "black", current, name)
+        stroke = self._paint(style, "stroke", "none", current, name)
+        width = parse_length(style.get("stroke-width"), self._diagonal())
+        width = 1.0 if width is None else width
+        if width <= 0:
+            stroke = None  # SVG: zero or negative width draws no stroke
+        # A shape with neither paint is kept: it draws nothing, but the Scene stays one
+        # shape per drawable element (counts, write-back).
+        self._note_shape_effects(tag, style, name, stroked=stroke is not None)
+        shape = Shape(
+            geometry=geometry, fill=fill, stroke=stroke,
+            stroke_width=lim.tensor(width),
+            fill_rule="evenodd" if (style.get("fill-rule") or "").strip() == "evenodd" else "nonzero",
+            linecap=_choice(style.get("stroke-linecap"), CAPS, "butt"),
+            linejoin=JOINS.get((style.get("stroke-linejoin") or "").strip(), "miter"),
+            miter_limit=_miter_limit(style.get("stroke-miterlimit")),
+            opacity=torch.tensor(parse_opacity(style.get("opacity"))),
+            fill_opacity=torch.tensor(parse_opacity(style.get("fill-opacity"))),
+            stroke_opacity=torch.tensor(parse_opacity(style.get("stroke-opacity"))),
+            transform=torch.eye(3) if transform is None else lim.tensor(transform),
+            group=group, source=self.handles[id(element)])
+        if lim.clamped:
+            self.skips.add("out-of-range numbers", name)
+        self.shapes.append(shape)
+
+    def _paint(self, style, prop, default, current, name):
+        text = style.get(prop)
+        value = parse_paint(text) if text is not None else None
+        if value is None:  # missing or invalid: the property's initial value
+            value = parse_paint(default)
+        return self.paints.resolve(value, current, name)
+
+    def _note_shape_effects(self, tag, style, name, stroked):
+        dashes = (style.get("stroke-dasharray") or "none").strip()
+        if stroked and dashes != "none" and any(
+                parse_number(t) for t in dashes.replace(",", " ").split()):
+            self.skips.add("stroke-dasharray", name)
+        if tag in ("path", "line", "polyline", "polygon") and any(
+                (style.get(f"marker-{k}") or "none").strip() != "none" for k in ("start", "mid", "end")):
+            self.skips.add("marker", name)
+
+    def _diagonal(self) -> float:
+        vw, vh = self.viewport
+        return math.sqrt((vw * vw + vh * vh) / 2)
+
+
+def _choice(text, allowed, default):
+    value = (text or "").strip()
+    return value if value in allowed else default
+
+
+def _miter_limit(text) -> float:
+    value = parse_number(text)
+    return value if value is not None and 1 <= value < math.inf else 4.0
+
+
+def _switch_choice(element):
+    """The child a <switch> draws: the first SVG element whose conditions hold (no
+    required extensions; systemLanguage, if given, includes English). foreignObject,
+    which vecfit cannot draw, is passed over for the SVG fallback that follows it."""
+    for child in element:
+        if not is_svg(child) or local_name(child.tag) == "foreignObject":
+            continue
+        if (child.get("requiredExtensions") or "").strip():
+            continue
+        languages = child.get("systemLanguage")
+        if languages is not None and not any(
+                lang.strip().lower().split("-")[0] == "en" for lang in languages.split(",")):
+            continue
+        return child
+    return None

@@ -1,0 +1,161 @@
+"""Styling: presentation attributes, the ``style`` attribute and ``<style>`` sheets.
+
+The cascade gives each element its *specified* properties (style attribute over CSS rules
+over presentation attributes, ``!important`` CSS over everything); ``computed`` then adds
+inheritance from the parent's computed properties. Values stay raw strings: each property
+is parsed where it is used, with that property's rule for invalid values.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from .dom import local_name
+
+# Properties that inherit (SVG 1.1 property table), limited to those the reader looks at.
+INHERITED = frozenset({
+    "fill", "fill-opacity", "fill-rule", "stroke", "stroke-width", "stroke-opacity",
+    "stroke-linecap", "stroke-linejoin", "stroke-miterlimit", "stroke-dasharray",
+    "stroke-dashoffset", "color", "visibility", "marker-start", "marker-mid", "marker-end",
+})
+NOT_INHERITED = frozenset({
+    "opacity", "display", "stop-color", "stop-opacity", "clip-path", "mask", "filter",
+    "overflow",
+})
+PROPERTIES = INHERITED | NOT_INHERITED
+
+_COMMENT = re.compile(r"/\*.*?\*/", re.DOTALL)
+_SIMPLE_SELECTOR = re.compile(r"(\*|[A-Za-z_][\w-]*)?((?:[.#][A-Za-z_\-][\w-]*)*)$")
+_PART = re.compile(r"[.#][\w-]+")
+
+
+def parse_declarations(text: str) -> list[tuple[str, str, bool]]:
+    """``a: b; c: d !important`` -> [(name, value, important)], names lowercased."""
+    out = []
+    for item in _COMMENT.sub("", text or "").split(";"):
+        name, sep, value = item.partition(":")
+        if not sep:
+            continue
+        value = value.strip()
+        important = value.lower().endswith("!important")
+        if important:
+            value = value[: -len("!important")].strip()
+        name = name.strip().lower()
+        if name == "marker":  # shorthand for the three marker properties
+            out += [(f"marker-{k}", value, important) for k in ("start", "mid", "end")]
+        elif name and value:
+            out.append((name, value, important))
+    return out
+
+
+@dataclass
+class _Rule:
+    tag: str | None
+    ids: tuple[str, ...]
+    classes: tuple[str, ...]
+    specificity: tuple[int, int, int, int]  # (important, ids, classes, tags), then order
+    order: int
+    declarations: list[tuple[str, str]]
+
+    def matches(self, tag: str, element_id: str | None, classes: set[str]) -> bool:
+        return ((self.tag is None or self.tag == tag)
+                and all(i == element_id for i in self.ids)
+                and all(c in classes for c in self.classes))
+
+
+class StyleSheet:
+    """Rules of all ``<style>`` elements, with simple selectors only: ``tag``, ``*``,
+    ``.class``, ``#id``, their compounds (``rect.a.b``) and comma lists. Other selectors
+    are reported through ``unsupported``."""
+
+    def __init__(self):
+        self.rules: list[_Rule] = []
+        self.unsupported: list[str] = []
+
+    def add(self, css: str) -> None:
+        css = _COMMENT.sub("", css)
+        for prelude, body in _blocks(css):
+            if prelude.startswith("@"):
+                self.unsupported.append(prelude.split()[0])  # @media, @font-face, ...
+                continue
+            decls = parse_declarations(body)
+            for selector in prelude.split(","):
+                self._add_selector(selector.strip(), decls)
+        # Sorted so that applying matching rules in order gives later ones precedence.
+        self.rules.sort(key=lambda r: (r.specificity, r.order))
+
+    def _add_selector(self, selector: str, decls) -> None:
+        m = _SIMPLE_SELECTOR.match(selector)
+        if not selector or not m:
+            self.unsupported.append(selector)
+            return
+        tag = None if m.group(1) in (None, "*") else m.group(1)
+        parts = _PART.findall(m.group(2))
+        ids = tuple(p[1:] for p in parts if p[0] == "#")
+        classes = tuple(p[1:] for p in parts if p[0] == ".")
+        for important in (False, True):
+            chosen = [(n, v) for n, v, imp in decls if imp == important]
+            if chosen:
+                self.rules.append(_Rule(tag, ids, classes,
+                                        (int(important), len(ids), len(classes), int(tag is not None)),
+                                        len(self.rules), chosen))
+
+    def declarations_for(self, element, tag: str):
+        """(normal, important) declarations of the rules matching ``element``, lowest
+        precedence first."""
+        if not self.rules:
+            return [], []
+        classes = set((element.get("class") or "").split())
+        element_id = element.get("id")
+        normal, important = [], []
+        for rule in self.rules:
+            if rule.matches(tag, element_id, classes):
+                (important if rule.specificity[0] else normal).extend(rule.declarations)
+        return normal, important
+
+
+def _blocks(css: str):
+    """(prelude, body) of each top-level ``prelude { body }``, nested braces skipped."""
+    i, n = 0, len(css)
+    while i < n:
+        open_ = css.find("{", i)
+        if open_ < 0:
+            return
+        depth, j = 1, open_ + 1
+        while j < n and depth:
+            depth += {"{": 1, "}": -1}.get(css[j], 0)
+            j += 1
+        yield css[i:open_].strip(), css[open_ + 1:j - 1]
+        i = j
+
+
+class Cascade:
+    """Specified and computed properties of elements."""
+
+    def __init__(self, sheet: StyleSheet):
+        self.sheet = sheet
+
+    def specified(self, element) -> dict[str, str]:
+        tag = local_name(element.tag)
+        props = {name: value.strip() for name, value in element.attrib.items()
+                 if name in PROPERTIES}
+        normal, important = self.sheet.declarations_for(element, tag)
+        props.update(normal)
+        props.update((n, v) for n, v, _ in parse_declarations(element.get("style")))
+        props.update(important)
+        return props
+
+    def computed(self, element, parent: dict[str, str] | None) -> dict[str, str]:
+        """Specified properties plus those inherited from ``parent`` (the parent's computed
+        properties). ``inherit`` takes the parent's value of any property."""
+        parent = parent or {}
+        out = {k: v for k, v in parent.items() if k in INHERITED}
+        for name, value in self.specified(element).items():
+            if value == "inherit":
+                if name in parent:
+                    out[name] = parent[name]
+                else:
+                    out.pop(name, None)
+            else:
+                out[name] = value
+        return out
