@@ -31,7 +31,7 @@ KAPPA = 0.5522847498307936  # cubic approximation of a quarter ellipse
 class Packed:
     """The core's input arrays. Float arrays are torch tensors (differentiable)."""
     points: list = field(default_factory=list)        # torch [n, 2] chunks
-    segments: list = field(default_factory=list)      # rows of 5 ints
+    segments: list = field(default_factory=list)      # int arrays [k, 5]
     subpaths: list = field(default_factory=list)      # rows of 3 ints
     shapes: list = field(default_factory=list)        # rows of 4 ints
     ellipses: list = field(default_factory=list)      # torch [6]
@@ -58,7 +58,8 @@ class Packed:
 
         return {
             "points": cat(self.points, 2),
-            "segments": ints(self.segments, 5),
+            "segments": (np.concatenate(self.segments).astype(np.int32) if self.segments
+                         else np.zeros((0, 5), dtype=np.int32)),
             "subpaths": ints(self.subpaths, 3),
             "shapes": ints(self.shapes, 4),
             "ellipses": cat(self.ellipses, 6),
@@ -265,22 +266,36 @@ class Packer:
         similar = ((np.abs(lin_np[:, 0, 1]) <= 1e-9 * big) & (np.abs(lin_np[:, 1, 0]) <= 1e-9 * big)
                    & (np.abs(np.abs(lin_np[:, 0, 0]) - np.abs(lin_np[:, 1, 1])) <= 1e-6 * big))
 
+        scale_np = scale.detach().numpy()
         paths = _PathBatch()
-        solid_colors, solid_alphas = [], []   # per solid paint: colour [4], alpha factor
+        solid_colors, solid_alphas = [], []   # per solid paint: colour [4], alpha factors
         gradient_rows = []                    # (paint, alpha, matrix, geometry)
         stroke_rows = []                      # (draw index, shape index)
+
+        def paint_index(paint, factors, shape_index, geometry):
+            if isinstance(paint, Solid):
+                solid_colors.append(paint.color)
+                solid_alphas.append(factors)
+                return len(solid_colors) - 1
+            alpha = torch.tensor(1.0)
+            for f in factors:
+                alpha = alpha * f
+            gradient_rows.append((paint, alpha, matrices[shape_index], geometry))
+            return -len(gradient_rows)  # fixed up once the solids are counted
+
         for i, shape in enumerate(shapes):
-            n_draws = self._draws_of(shape)
-            if n_draws == 0:
+            has_fill = shape.fill is not None
+            has_stroke = (shape.stroke is not None and float(shape.stroke_width) > 0
+                          and scale_np[i] > 0)
+            if not (has_fill or has_stroke):
                 continue
             layer = 0 if shape.group < 0 else self.group_layer[shape.group]
             # Alpha factors of this shape's paints (multiplied out in one go later).
             factors = self._folded_opacities(shape) if shape.group >= 0 else []
-            if float(shape.opacity) < 1 and n_draws > 1:
+            if has_fill and has_stroke and float(shape.opacity) < 1:
                 layer = self._new_layer(layer, shape.opacity)
             else:
                 factors.append(shape.opacity)
-            m = matrices[i]
             geometry = shape.geometry
             if isinstance(geometry, Rect):
                 geometry = _rect_as_path(geometry)
@@ -293,26 +308,14 @@ class Packer:
                 out.shapes.append([SHAPE_PATH, len(out.subpaths), len(geometry.subpaths), -1])
                 out.subpaths.extend([None] * len(geometry.subpaths))  # filled by the batch
             else:
-                index = self._add_ellipse(geometry, m)
+                index = self._add_ellipse(geometry, matrices[i])
                 if index is None:
                     continue
-
-            def paint_index(paint, factors):
-                if isinstance(paint, Solid):
-                    solid_colors.append(paint.color)
-                    solid_alphas.append(factors)
-                    return len(solid_colors) - 1
-                alpha = torch.tensor(1.0)
-                for f in factors:
-                    alpha = alpha * f
-                gradient_rows.append((paint, alpha, m, shape.geometry))
-                return -len(gradient_rows)  # fixed up once the solids are counted
-
-            if shape.fill is not None:
-                paint = paint_index(shape.fill, factors + [shape.fill_opacity])
+            if has_fill:
+                paint = paint_index(shape.fill, factors + [shape.fill_opacity], i, shape.geometry)
                 out.draws.append([index, DRAW_FILL, FILL_RULES[shape.fill_rule], paint, layer, 0, 0])
-            if shape.stroke is not None and float(shape.stroke_width) > 0 and float(scale[i]) > 0:
-                paint = paint_index(shape.stroke, factors + [shape.stroke_opacity])
+            if has_stroke:
+                paint = paint_index(shape.stroke, factors + [shape.stroke_opacity], i, shape.geometry)
                 stroke_rows.append((len(out.draws), i))
                 out.draws.append([index, DRAW_STROKE, 0, paint, layer,
                                   CAPS[shape.linecap], JOINS[shape.linejoin]])
@@ -338,13 +341,12 @@ class Packer:
         out = self.out
         n_solid = len(solid_colors)
         if n_solid:
-            colors = torch.stack([c.float() for c in solid_colors])
+            colors = _stack(solid_colors)
             # Multiply each paint's alpha factors: pad the lists with ones and stack once.
             depth = max(len(f) for f in solid_alphas)
             one = torch.tensor(1.0)
-            columns = [torch.stack([f[k].float().reshape(()) if k < len(f) else one for f in solid_alphas])
-                       for k in range(depth)]
-            alphas = torch.stack(columns).prod(dim=0)
+            columns = [_stack([f[k] if k < len(f) else one for f in solid_alphas]) for k in range(depth)]
+            alphas = torch.stack(columns).prod(dim=0).reshape(n_solid)
             colors = torch.cat([colors[:, :3], colors[:, 3:4] * alphas[:, None]], dim=1)
             ident = torch.eye(2, 3).reshape(1, 6).expand(n_solid, 6)
             out.paint_params.append(torch.cat([ident, colors, torch.zeros(n_solid, 1)], dim=1))
@@ -414,47 +416,47 @@ class _PathBatch:
         if not self.points:
             return
         counts = [len(p) for p in self.points]
-        local = torch.cat([p.float() for p in self.points])
+        local = torch.cat(self.points).float()
         owner = torch.repeat_interleave(torch.tensor(self.owner), torch.tensor(counts))
         m = matrices[owner]
         out.points.append(torch.einsum("nij,nj->ni", m[:, :2, :2], local) + m[:, :2, 2])
         base = out.n_points
         out.n_points += len(local)
 
-        # Per subpath: first point (global), point count, closed, first segment (global).
-        seg_degrees, sub_first_point, sub_points, sub_closed, sub_seg_first, sub_seg_count = [], [], [], [], [], []
-        point_offset = base
-        seg_offset = len(out.segments)
-        for degrees, subpaths, slot in zip(self.degrees, self.subpaths, self.subpath_slot):
-            p = point_offset
-            for j, (first, count, closed) in enumerate(subpaths):
-                d = degrees[first:first + count]
-                n = int(d.sum()) + (0 if closed else 1)
-                seg_degrees.append(d)
-                sub_first_point.append(p)
-                sub_points.append(n)
-                sub_closed.append(bool(closed))
-                sub_seg_first.append(seg_offset)
-                sub_seg_count.append(count)
-                out.subpaths[slot + j] = [seg_offset, count, int(bool(closed))]
-                seg_offset += count
-                p += n
-            point_offset = p
-        deg = np.concatenate(seg_degrees) if seg_degrees else np.zeros(0, dtype=np.int64)
-        sub_of_seg = np.repeat(np.arange(len(sub_seg_count)), sub_seg_count)
-        # Offset of each segment's first point inside its subpath: the exclusive running
-        # sum of degrees, minus its value at the subpath's first segment.
+        # All subpaths of the batch as arrays: (first segment, count, closed), with segment
+        # numbers counted over the whole batch.
+        seg_base = np.concatenate([[0], np.cumsum([len(d) for d in self.degrees])])
+        rows = [(first + int(b), count, int(bool(closed)))
+                for subpaths, b in zip(self.subpaths, seg_base) for first, count, closed in subpaths]
+        subs = np.asarray(rows, dtype=np.int64).reshape(-1, 3)
+        first, count, closed_sub = subs[:, 0], subs[:, 1], subs[:, 2].astype(bool)
+        slot0 = self.subpath_slot[0]
+        out.subpaths[slot0:slot0 + len(subs)] = subs.tolist()
+        deg = np.concatenate(self.degrees) if self.degrees else np.zeros(0, dtype=np.int64)
         running = np.concatenate([[0], np.cumsum(deg)])
-        first_rel = np.asarray(sub_seg_first, dtype=np.int64) - (sub_seg_first[0] if sub_seg_first else 0)
-        start = running[:-1] - running[first_rel][sub_of_seg]
+        # Points per subpath, and where each starts (subpaths are stored one after another).
+        sub_points = running[first + count] - running[first] + (~closed_sub)
+        sub_first_point = base + np.concatenate([[0], np.cumsum(sub_points)[:-1]])
+        sub_of_seg = np.repeat(np.arange(len(subs)), count)
+        # Offset of each segment's first point inside its subpath.
+        start = running[:-1] - running[first][sub_of_seg]
         j = np.arange(4)[None, :]
         local_idx = start[:, None] + j
-        n_sub = np.asarray(sub_points, dtype=np.int64)[sub_of_seg][:, None]
-        closed = np.asarray(sub_closed, dtype=bool)[sub_of_seg][:, None]
+        n_sub = sub_points[sub_of_seg][:, None]
+        closed = closed_sub[sub_of_seg][:, None]
         local_idx = np.where(closed, local_idx % np.maximum(n_sub, 1), local_idx)
-        idx = np.asarray(sub_first_point, dtype=np.int64)[sub_of_seg][:, None] + local_idx
+        idx = sub_first_point[sub_of_seg][:, None] + local_idx
         idx = np.where(j <= deg[:, None], idx, -1)
-        out.segments.extend(np.concatenate([deg[:, None], idx], axis=1).tolist())
+        out.segments.append(np.concatenate([deg[:, None], idx], axis=1))
+
+
+def _stack(tensors: list) -> torch.Tensor:
+    """torch.stack of float32 tensors of one shape, converting only when it must."""
+    try:
+        return torch.stack(tensors)
+    except (RuntimeError, TypeError):
+        return torch.stack([torch.as_tensor(t, dtype=torch.float32).reshape(tensors[0].shape)
+                            for t in tensors])
 
 
 def _rect_as_path(rect: Rect) -> Path | None:
