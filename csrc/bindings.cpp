@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "backward.h"
 #include "coverage.h"
 #include "render.h"
 #include "scene.h"
@@ -43,35 +44,57 @@ int parse_filter(const std::string& f) {
     throw std::invalid_argument("filter must be 'box', 'tent' or 'gaussian', not '" + f + "'");
 }
 
-py::array_t<float> render(Array<float> points, Array<int32_t> segments, Array<int32_t> subpaths,
-                          Array<int32_t> shapes, Array<float> ellipses, Array<int32_t> draws,
-                          Array<float> draw_params, Array<int32_t> paints, Array<float> paint_params,
-                          Array<float> stop_offsets, Array<float> stop_colors, Array<int32_t> layer_parents,
-                          Array<float> layer_opacity, int width, int height, int samples,
-                          const std::string& mode, const std::string& filter, double filter_radius,
-                          uint64_t seed, int threads, py::object background, bool brute_force) {
+// The scene's arrays, kept alive for the duration of a call.
+struct SceneInput {
+    Array<float> points, ellipses, draw_params, paint_params, stop_offsets, stop_colors, layer_opacity;
+    Array<int32_t> segments, subpaths, shapes, draws, paints, layer_parents;
+
+    SceneArrays arrays() const {
+        SceneArrays a;
+        a.points = rows(points, 2, a.n_points, "points");
+        a.segments = rows(segments, SEGMENT_COLS, a.n_segments, "segments");
+        a.subpaths = rows(subpaths, SUBPATH_COLS, a.n_subpaths, "subpaths");
+        a.shapes = rows(shapes, SHAPE_COLS, a.n_shapes, "shapes");
+        a.ellipses = rows(ellipses, ELLIPSE_COLS, a.n_ellipses, "ellipses");
+        a.draws = rows(draws, DRAW_COLS, a.n_draws, "draws");
+        int n;
+        a.draw_params = rows(draw_params, DRAW_FCOLS, n, "draw_params");
+        if (n != a.n_draws) throw std::invalid_argument("vecfit core: draw_params does not match draws");
+        a.paints = rows(paints, PAINT_COLS, a.n_paints, "paints");
+        a.paint_params = rows(paint_params, PAINT_FCOLS, n, "paint_params");
+        if (n != a.n_paints) throw std::invalid_argument("vecfit core: paint_params does not match paints");
+        a.stop_offsets = rows(stop_offsets, 1, a.n_stops, "stop_offsets");
+        a.stop_colors = rows(stop_colors, 4, n, "stop_colors");
+        if (n != a.n_stops) throw std::invalid_argument("vecfit core: stop_colors does not match stop_offsets");
+        a.layer_parents = rows(layer_parents, 1, a.n_layers, "layer_parents");
+        a.layer_opacity = rows(layer_opacity, 1, n, "layer_opacity");
+        if (n != a.n_layers) throw std::invalid_argument("vecfit core: layer_opacity does not match layer_parents");
+        return a;
+    }
+};
+
+SceneInput scene_input(const py::dict& s) {
+    SceneInput in;
+    in.points = s["points"].cast<Array<float>>();
+    in.segments = s["segments"].cast<Array<int32_t>>();
+    in.subpaths = s["subpaths"].cast<Array<int32_t>>();
+    in.shapes = s["shapes"].cast<Array<int32_t>>();
+    in.ellipses = s["ellipses"].cast<Array<float>>();
+    in.draws = s["draws"].cast<Array<int32_t>>();
+    in.draw_params = s["draw_params"].cast<Array<float>>();
+    in.paints = s["paints"].cast<Array<int32_t>>();
+    in.paint_params = s["paint_params"].cast<Array<float>>();
+    in.stop_offsets = s["stop_offsets"].cast<Array<float>>();
+    in.stop_colors = s["stop_colors"].cast<Array<float>>();
+    in.layer_parents = s["layer_parents"].cast<Array<int32_t>>();
+    in.layer_opacity = s["layer_opacity"].cast<Array<float>>();
+    return in;
+}
+
+RenderOptions render_options(int width, int height, int samples, const std::string& mode, const std::string& filter,
+                             double filter_radius, uint64_t seed, int threads, py::object background) {
     if (width <= 0 || height <= 0) throw std::invalid_argument("width and height must be positive");
     if (samples <= 0) throw std::invalid_argument("samples must be positive");
-    SceneArrays a;
-    a.points = rows(points, 2, a.n_points, "points");
-    a.segments = rows(segments, SEGMENT_COLS, a.n_segments, "segments");
-    a.subpaths = rows(subpaths, SUBPATH_COLS, a.n_subpaths, "subpaths");
-    a.shapes = rows(shapes, SHAPE_COLS, a.n_shapes, "shapes");
-    a.ellipses = rows(ellipses, ELLIPSE_COLS, a.n_ellipses, "ellipses");
-    a.draws = rows(draws, DRAW_COLS, a.n_draws, "draws");
-    int n;
-    a.draw_params = rows(draw_params, DRAW_FCOLS, n, "draw_params");
-    if (n != a.n_draws) throw std::invalid_argument("vecfit core: draw_params does not match draws");
-    a.paints = rows(paints, PAINT_COLS, a.n_paints, "paints");
-    a.paint_params = rows(paint_params, PAINT_FCOLS, n, "paint_params");
-    if (n != a.n_paints) throw std::invalid_argument("vecfit core: paint_params does not match paints");
-    a.stop_offsets = rows(stop_offsets, 1, a.n_stops, "stop_offsets");
-    a.stop_colors = rows(stop_colors, 4, n, "stop_colors");
-    if (n != a.n_stops) throw std::invalid_argument("vecfit core: stop_colors does not match stop_offsets");
-    a.layer_parents = rows(layer_parents, 1, a.n_layers, "layer_parents");
-    a.layer_opacity = rows(layer_opacity, 1, n, "layer_opacity");
-    if (n != a.n_layers) throw std::invalid_argument("vecfit core: layer_opacity does not match layer_parents");
-
     RenderOptions o;
     o.width = width;
     o.height = height;
@@ -81,21 +104,62 @@ py::array_t<float> render(Array<float> points, Array<int32_t> segments, Array<in
     o.filter_radius = filter_radius;
     o.seed = seed;
     o.threads = threads;
-    o.brute_force = brute_force;
     if (!background.is_none()) {
         auto bg = background.cast<std::vector<double>>();
         if (bg.size() != 4) throw std::invalid_argument("background must be 4 numbers (RGBA)");
         o.has_background = true;
         for (int i = 0; i < 4; ++i) o.background[i] = bg[i];
     }
+    return o;
+}
+
+py::array_t<float> render(const py::dict& scene, int width, int height, int samples, const std::string& mode,
+                          const std::string& filter, double filter_radius, uint64_t seed, int threads,
+                          py::object background, bool brute_force) {
+    SceneInput in = scene_input(scene);
+    SceneArrays a = in.arrays();
+    RenderOptions o = render_options(width, height, samples, mode, filter, filter_radius, seed, threads, background);
+    o.brute_force = brute_force;
     py::array_t<float> image({height, width, 4});
     float* out = image.mutable_data();
     {
         py::gil_scoped_release release;
-        PreparedScene scene = prepare_scene(a);
-        render_forward(scene, o, out);
+        PreparedScene prepared = prepare_scene(a);
+        render_forward(prepared, o, out);
     }
     return image;
+}
+
+py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_image, int width, int height,
+                     int samples, const std::string& mode, const std::string& filter, double filter_radius,
+                     uint64_t seed, int threads, py::object background, double boundary_density) {
+    SceneInput in = scene_input(scene);
+    SceneArrays a = in.arrays();
+    RenderOptions o = render_options(width, height, samples, mode, filter, filter_radius, seed, threads, background);
+    if (image.size() != (py::ssize_t)width * height * 4 || d_image.size() != image.size())
+        throw std::invalid_argument("image and its gradient must be height x width x 4");
+    if (o.mode != MODE_MC) throw std::invalid_argument("gradients of the analytical prefilter are not implemented yet");
+    SceneGrads g;
+    {
+        py::gil_scoped_release release;
+        PreparedScene prepared = prepare_scene(a);
+        render_backward(prepared, a, o, image.data(), d_image.data(), boundary_density, g);
+    }
+    auto out = [](const std::vector<double>& v, py::ssize_t cols) {
+        py::array_t<float> arr({(py::ssize_t)(cols > 0 ? v.size() / cols : v.size()), cols});
+        float* p = arr.mutable_data();
+        for (size_t i = 0; i < v.size(); ++i) p[i] = (float)v[i];
+        return arr;
+    };
+    py::dict r;
+    r["points"] = out(g.points, 2);
+    r["ellipses"] = out(g.ellipses, ELLIPSE_COLS);
+    r["draw_params"] = out(g.draw_params, DRAW_FCOLS);
+    r["paint_params"] = out(g.paint_params, PAINT_FCOLS);
+    r["stop_offsets"] = out(g.stop_offsets, 1);
+    r["stop_colors"] = out(g.stop_colors, 4);
+    r["layer_opacity"] = out(g.layer_opacity, 1);
+    return r;
 }
 
 Segment segment_from(const Array<double>& pts) {
@@ -111,13 +175,15 @@ Segment segment_from(const Array<double>& pts) {
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "vecfit's compiled core: geometry and rendering on flat arrays";
-    m.def("render", &render, "Render the scene arrays into a [H, W, 4] straight-RGBA image",
-          py::arg("points"), py::arg("segments"), py::arg("subpaths"), py::arg("shapes"), py::arg("ellipses"),
-          py::arg("draws"), py::arg("draw_params"), py::arg("paints"), py::arg("paint_params"),
-          py::arg("stop_offsets"), py::arg("stop_colors"), py::arg("layer_parents"), py::arg("layer_opacity"),
-          py::arg("width"), py::arg("height"), py::arg("samples"), py::arg("mode"), py::arg("filter"),
-          py::arg("filter_radius"), py::arg("seed"), py::arg("threads"), py::arg("background"),
+    m.def("render", &render, "Render the scene arrays (a dict, see vecfit/pack.py) into [H, W, 4] straight RGBA",
+          py::arg("scene"), py::arg("width"), py::arg("height"), py::arg("samples"), py::arg("mode"),
+          py::arg("filter"), py::arg("filter_radius"), py::arg("seed"), py::arg("threads"), py::arg("background"),
           py::arg("brute_force") = false);
+    m.def("render_grad", &render_grad,
+          "Gradients of the scene arrays given the forward image and dL/d(image) (Monte Carlo mode)",
+          py::arg("scene"), py::arg("image"), py::arg("d_image"), py::arg("width"), py::arg("height"),
+          py::arg("samples"), py::arg("mode"), py::arg("filter"), py::arg("filter_radius"), py::arg("seed"),
+          py::arg("threads"), py::arg("background"), py::arg("boundary_density"));
     m.def("hardware_threads", &ThreadPool::hardware_threads);
     m.def("has_cuda", [] { return false; });
 

@@ -291,6 +291,15 @@ VF_HD Vec2 seg_deriv(const Segment& s, double t) {
     }
 }
 
+VF_HD Vec2 seg_deriv2(const Segment& s, double t) {
+    switch (s.degree) {
+        case 1: return {0, 0};
+        case 2: return 2.0 * (s.p[0] - 2.0 * s.p[1] + s.p[2]);
+        default:
+            return (6 * (1 - t)) * (s.p[0] - 2.0 * s.p[1] + s.p[2]) + (6 * t) * (s.p[1] - 2.0 * s.p[2] + s.p[3]);
+    }
+}
+
 VF_HD Vec2 seg_end(const Segment& s) { return s.p[s.degree]; }
 
 // Power-basis coefficients a[k] of the segment relative to an origin o: B(t) - o = sum a[k] t^k.

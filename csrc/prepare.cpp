@@ -4,6 +4,7 @@
 #include <string>
 
 #include "scene.h"
+#include "stroke.h"
 
 namespace vf {
 namespace {
@@ -80,51 +81,6 @@ void add_end_to_box(Box& b, const StrokeEnd& e, double hw) {
     }
 }
 
-// The join at vertex v between a segment leaving along t_in and one leaving along t_out.
-StrokeEnd make_join(Vec2 v, Vec2 t_in, Vec2 t_out, int join, double hw, double miter_limit) {
-    StrokeEnd e;
-    double c = cross(t_in, t_out), d = dot(t_in, t_out);
-    if (std::fabs(c) < 1e-12 && d > 0) return e;  // no turn: the sweeps already meet
-    if (join == JOIN_ROUND) {
-        e.kind = StrokeEnd::DISK;
-        e.center = v;
-        return e;
-    }
-    // The outer side of the turn is opposite to the direction it turns towards.
-    double s = c >= 0 ? 1.0 : -1.0;
-    Vec2 n_in = -s * perp(t_in), n_out = -s * perp(t_out);
-    e.kind = StrokeEnd::POLYGON;
-    double cos_half = std::sqrt(std::max(0.0, 0.5 * (1 + d)));  // cos of half the turn
-    // Miter length / stroke width = 1 / sin(interior angle / 2) = 1 / cos(turn / 2).
-    if (join == JOIN_MITER && cos_half > 1e-12 && 1.0 / cos_half <= miter_limit) {
-        Vec2 dir = normalized(n_in + n_out);
-        e.poly[0] = v;
-        e.poly[1] = v + hw * n_in;
-        e.poly[2] = v + (hw / cos_half) * dir;
-        e.poly[3] = v + hw * n_out;
-        e.n_poly = 4;
-    } else {
-        e.poly[0] = v;
-        e.poly[1] = v + hw * n_in;
-        e.poly[2] = v + hw * n_out;
-        e.n_poly = 3;
-    }
-    return e;
-}
-
-StrokeEnd make_cap(Vec2 at, Vec2 outward, int cap) {
-    StrokeEnd e;
-    if (cap == CAP_ROUND) {
-        e.kind = StrokeEnd::DISK;
-        e.center = at;
-    } else if (cap == CAP_SQUARE) {
-        e.kind = StrokeEnd::SQUARE;
-        e.center = at;
-        e.axis = outward;
-    }
-    return e;
-}
-
 // A curve whose control points all lie within sqrt(1e-5) of its length from its chord
 // is stroked as that straight line, as Skia and resvg do: the direction at the end of
 // such a curve is decided by sub-pixel control-point offsets, and stroking it exactly
@@ -185,6 +141,7 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
                 segs[i].butt_end = d.cap == CAP_BUTT;
             } else {
                 StrokeSegment& next = segs[last ? 0 : i + 1];
+                segs[i].next = (int)out.size() + (last ? 0 : i + 1);
                 segs[i].end = make_join(seg_end(segs[i].seg), seg_end_tangent(segs[i].seg, true),
                                         seg_end_tangent(next.seg, false), d.join, hw, d.miter_limit);
             }
@@ -300,6 +257,9 @@ PreparedScene prepare_scene(const SceneArrays& a) {
             Vec2 c{e[0], e[1]};
             Mat2 A{e[2], e[3], e[4], e[5]};
             d.is_ellipse = true;
+            d.ellipse_row = shape[3];
+            d.ellipse_center = c;
+            d.ellipse_axes = A;
             if (d.kind == DRAW_STROKE && !d.metric_identity) {
                 c = d.metric * c;
                 A = {d.metric.a * A.a + d.metric.b * A.c, d.metric.a * A.b + d.metric.b * A.d,

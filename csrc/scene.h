@@ -70,6 +70,7 @@ struct StrokeEnd {
 struct StrokeSegment {
     Segment seg;           // in stroke space
     int32_t source = -1;   // index into PreparedScene::segments
+    int32_t next = -1;     // the stroke item after the join at this item's end (index into stroke_items)
     bool butt_start = false, butt_end = false;  // free end with a butt cap: an edge of the stroke
     StrokeEnd start, end;
     Box box;               // pixel-space bounds of everything above, widened by the half width
@@ -88,8 +89,11 @@ struct PreparedDraw {
     double metric_scale = 1;    // pixel length per stroke-space length (geometric mean)
     // Path draws: fill segments (with closing lines for open subpaths) or stroke segments.
     int first_item = 0, n_items = 0;   // into PreparedScene::fill_items or stroke_items
-    EllipseFrame ellipse;               // ellipse draws
+    EllipseFrame ellipse;               // ellipse draws (in stroke space for strokes)
     bool is_ellipse = false;
+    int ellipse_row = -1;               // its input row: pixel-space centre and axes
+    Vec2 ellipse_center;
+    Mat2 ellipse_axes;
     Box box;                            // pixel-space bounds of what the draw can cover
 };
 

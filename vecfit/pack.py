@@ -75,6 +75,11 @@ class Packed:
         }
 
 
+def _value(t) -> float:
+    """A tensor's value as a float, outside the autograd graph (for decisions only)."""
+    return float(t.detach()) if isinstance(t, torch.Tensor) else float(t)
+
+
 def _affine_apply(m: torch.Tensor, p: torch.Tensor) -> torch.Tensor:
     """Apply a 3x3 affine matrix to points [n, 2]."""
     return p @ m[:2, :2].T + m[:2, 2]
@@ -85,7 +90,7 @@ def _rect_path(rect: Rect) -> tuple[torch.Tensor, list[int]]:
     x0, y0 = rect.p_min[0], rect.p_min[1]
     x1, y1 = rect.p_max[0], rect.p_max[1]
     rx, ry = rect.corner_radii[0], rect.corner_radii[1]
-    if float(rx) <= 0 or float(ry) <= 0:
+    if _value(rx) <= 0 or _value(ry) <= 0:
         pts = torch.stack([torch.stack([x0, y0]), torch.stack([x1, y0]),
                            torch.stack([x1, y1]), torch.stack([x0, y1])])
         return pts, [1, 1, 1, 1]
@@ -157,7 +162,7 @@ class Packer:
 
     def _draws_of(self, shape: Shape) -> int:
         n = 1 if shape.fill is not None else 0
-        if shape.stroke is not None and float(shape.stroke_width) > 0:
+        if shape.stroke is not None and _value(shape.stroke_width) > 0:
             n += 1
         return n
 
@@ -184,7 +189,7 @@ class Packer:
             parent_m = self.canvas if group.parent < 0 else self.group_matrix[group.parent]
             parent_layer = 0 if group.parent < 0 else self.group_layer[group.parent]
             self.group_matrix.append(parent_m @ group.transform.float())
-            if float(group.opacity) < 1 and self._group_draw_counts[i] > 1:
+            if _value(group.opacity) < 1 and self._group_draw_counts[i] > 1:
                 self.group_layer.append(self._new_layer(parent_layer, group.opacity))
             else:
                 self.group_layer.append(parent_layer)
@@ -195,7 +200,7 @@ class Packer:
         g = shape.group
         while g >= 0:
             group = self.scene.groups[g]
-            if float(group.opacity) < 1 and self._group_draw_counts[g] <= 1:
+            if _value(group.opacity) < 1 and self._group_draw_counts[g] <= 1:
                 out.append(group.opacity)
             g = group.parent
         return out
@@ -211,13 +216,13 @@ class Packer:
                 return None
             lo, hi = box
             size = hi - lo
-            if float(size.min()) <= 0:
+            if _value(size.min()) <= 0:
                 return None  # SVG: a zero-size bounding box disables the gradient
             bbox = torch.zeros(3, 3)
             bbox[0, 0], bbox[1, 1], bbox[0, 2], bbox[1, 2], bbox[2, 2] = size[0], size[1], lo[0], lo[1], 1
             g = g @ bbox
         g = g @ paint.transform.float()
-        if abs(float(torch.linalg.det(g[:2, :2]))) < 1e-30:
+        if abs(_value(torch.linalg.det(g[:2, :2]))) < 1e-30:
             return None
         to_paint = torch.linalg.inv(g)[:2].reshape(6)
         if isinstance(paint, LinearGradient):
@@ -285,14 +290,14 @@ class Packer:
 
         for i, shape in enumerate(shapes):
             has_fill = shape.fill is not None
-            has_stroke = (shape.stroke is not None and float(shape.stroke_width) > 0
+            has_stroke = (shape.stroke is not None and _value(shape.stroke_width) > 0
                           and scale_np[i] > 0)
             if not (has_fill or has_stroke):
                 continue
             layer = 0 if shape.group < 0 else self.group_layer[shape.group]
             # Alpha factors of this shape's paints (multiplied out in one go later).
             factors = self._folded_opacities(shape) if shape.group >= 0 else []
-            if has_fill and has_stroke and float(shape.opacity) < 1:
+            if has_fill and has_stroke and _value(shape.opacity) < 1:
                 layer = self._new_layer(layer, shape.opacity)
             else:
                 factors.append(shape.opacity)
@@ -327,7 +332,7 @@ class Packer:
 
     def _add_ellipse(self, geometry, m: torch.Tensor) -> int | None:
         r = geometry.radius.reshape(1).expand(2) if isinstance(geometry, Circle) else geometry.radii
-        if float(r.min()) <= 0:
+        if _value(r.min()) <= 0:
             return None
         c = _affine_apply(m, geometry.center.reshape(1, 2).float())[0]
         axes = m[:2, :2] @ torch.diag(r.float())
@@ -460,7 +465,7 @@ def _stack(tensors: list) -> torch.Tensor:
 
 
 def _rect_as_path(rect: Rect) -> Path | None:
-    if float(rect.p_max[0] - rect.p_min[0]) <= 0 or float(rect.p_max[1] - rect.p_min[1]) <= 0:
+    if _value(rect.p_max[0] - rect.p_min[0]) <= 0 or _value(rect.p_max[1] - rect.p_min[1]) <= 0:
         return None
     pts, degrees = _rect_path(rect)
     return Path(points=pts, degrees=np.array(degrees), subpaths=[(0, len(degrees), True)])

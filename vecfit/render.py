@@ -31,9 +31,39 @@ def output_size(scene: Scene, width: int | None, height: int | None) -> tuple[in
     return int(width), int(height)
 
 
+FLOAT_INPUTS = ("points", "ellipses", "draw_params", "paint_params", "stop_offsets", "stop_colors",
+                "layer_opacity")
+
+
+class _Render(torch.autograd.Function):
+    """The core's forward pass; its backward returns the gradients of the float arrays
+    (the autograd graph of vecfit.pack carries them on to the Scene's tensors)."""
+
+    @staticmethod
+    def forward(ctx, settings, boundary_density, structure, *floats):
+        scene = dict(structure)
+        for name, t in zip(FLOAT_INPUTS, floats):
+            scene[name] = t.detach().cpu().numpy()
+        image = _core.render(scene, **settings, brute_force=False)
+        ctx.scene, ctx.settings, ctx.image = scene, settings, image
+        ctx.boundary_density = boundary_density
+        ctx.shapes = [t.shape for t in floats]
+        return torch.from_numpy(image)
+
+    @staticmethod
+    def backward(ctx, grad_image):
+        s = ctx.settings
+        grads = _core.render_grad(ctx.scene, ctx.image, grad_image.detach().cpu().contiguous().numpy(),
+                                  s["width"], s["height"], s["samples"], s["mode"], s["filter"],
+                                  s["filter_radius"], s["seed"], s["threads"], s["background"],
+                                  ctx.boundary_density)
+        out = [torch.from_numpy(grads[name]).reshape(shape) for name, shape in zip(FLOAT_INPUTS, ctx.shapes)]
+        return (None, None, None, *out)
+
+
 def render(scene: Scene, width: int | None = None, height: int | None = None, *,
            samples: int = 2, mode: str = "mc", filter: str = "box", filter_radius: float = 0.5,
-           seed: int = 0, background=None, threads: int | None = None,
+           seed: int = 0, background=None, threads: int | None = None, boundary_samples: float = 4.0,
            _brute_force: bool = False) -> torch.Tensor:
     """Render ``scene`` into an [H, W, 4] float tensor of straight RGBA.
 
@@ -41,6 +71,10 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     strata centres in "analytic" mode). filter: the pixel filter, with its radius in
     pixels (box always covers exactly the pixel). background: None (transparent) or an
     RGBA / RGB sequence in [0, 1]. threads: None or 0 for all cores.
+
+    The result is differentiable with respect to every tensor of the scene (Monte Carlo
+    mode): the backward pass samples the boundaries at ``boundary_samples`` points per
+    pixel of boundary length, with the same seed.
     """
     if mode not in MODES:
         raise VecfitError(f"mode must be one of {', '.join(MODES)}, not {mode!r}")
@@ -59,16 +93,25 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
             raise VecfitError("background must have 3 or 4 components")
         background = bg
     arrays = pack_scene(scene, width, height).arrays()
-    core_args = {k: (v.detach().cpu().numpy() if isinstance(v, torch.Tensor) else v)
-                 for k, v in arrays.items()}
-    for name, value in core_args.items():
-        if value.dtype.kind == "f" and not np.isfinite(value).all():
+    floats = [arrays[name].to(torch.float32) for name in FLOAT_INPUTS]
+    for name, value in zip(FLOAT_INPUTS, floats):
+        if not torch.isfinite(value.detach()).all():
             raise VecfitError(f"the scene has non-finite values ({name})")
-    image = _core.render(
-        core_args["points"], core_args["segments"], core_args["subpaths"], core_args["shapes"],
-        core_args["ellipses"], core_args["draws"], core_args["draw_params"], core_args["paints"],
-        core_args["paint_params"], core_args["stop_offsets"], core_args["stop_colors"],
-        core_args["layer_parents"], core_args["layer_opacity"], width, height, int(samples),
-        mode, filter, float(filter_radius), int(seed), int(threads or 0), background,
-        _brute_force)
-    return torch.from_numpy(image)
+    structure = {k: v for k, v in arrays.items() if k not in FLOAT_INPUTS}
+    settings = dict(width=width, height=height, samples=int(samples), mode=mode, filter=filter,
+                    filter_radius=float(filter_radius), seed=int(seed), threads=int(threads or 0),
+                    background=background)
+    if _brute_force:
+        scene_np = dict(structure)
+        scene_np.update({n: t.detach().numpy() for n, t in zip(FLOAT_INPUTS, floats)})
+        return torch.from_numpy(_core.render(scene_np, **settings, brute_force=True))
+    if torch.is_grad_enabled() and any(t.requires_grad for t in floats):
+        if mode != "mc":
+            raise VecfitError("gradients are available in Monte Carlo mode (mode='mc') so far")
+        return _Render.apply(settings, float(boundary_samples), structure, *floats)
+    with torch.no_grad():
+        return _Render.forward(_Ctx(), settings, float(boundary_samples), structure, *floats)
+
+
+class _Ctx:
+    """Stands in for autograd's context when no gradient is needed."""

@@ -1,0 +1,719 @@
+// Backward pass (Monte Carlo mode), after Li et al. 2020, section 5:
+//   * interior term: per pixel sample, reverse-mode through front-to-back compositing
+//     (with layers) into paint parameters, stop offsets / colours and layer opacities;
+//   * boundary term (Reynolds transport): stratified samples on every boundary of every
+//     draw (fill segments, ellipses, stroke offset curves, caps, joins, butt ends), each
+//     weighted by its length element; at p+ = p + eps n (just outside) the scene is
+//     composited once with the draw forced to cover p+ and once as it is. The difference
+//     times the normal velocity of p goes to the parameters. A shared edge is counted
+//     once, an occluded one gives zero, and a boundary piece that lies inside another
+//     piece of the same stroke changes nothing.
+// Gradients accumulate in one buffer per lane (a fixed slice of the work), summed in
+// lane order: the result is deterministic for a given seed and thread count.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "backward.h"
+#include "coverage.h"
+#include "paint.h"
+#include "sampling.h"
+#include "stroke.h"
+#include "thread_pool.h"
+#include "tiles.h"
+
+namespace vf {
+namespace {
+
+constexpr double EPS_NORMAL = 1e-4;  // pixels: how far p+ and p- lie from the boundary
+constexpr int MAX_DEPTH = 64;
+
+struct Hit {
+    int draw;
+    double c[4];  // premultiplied colour of the draw at the point
+};
+
+int tile_of(const TileBins& bins, Vec2 p) {
+    int tx = std::clamp((int)std::floor(p.x / TILE), 0, bins.nx - 1);
+    int ty = std::clamp((int)std::floor(p.y / TILE), 0, bins.ny - 1);
+    return ty * bins.nx + tx;
+}
+
+bool covers(const PreparedScene& sc, const TileBins& bins, const TileEntry& e, const Box& region, Vec2 p) {
+    const PreparedDraw& d = sc.draws[e.draw];
+    if (p.x < d.box.x0 || p.x > d.box.x1 || p.y < d.box.y0 || p.y > d.box.y1) return false;
+    if (d.kind == DRAW_STROKE) {
+        struct Local {
+            const LocalItem* li;
+            int n;
+            int size() const { return n; }
+            int operator[](int i) const { return li[i].item; }
+        } local{bins.items.data() + e.first, e.count};
+        return stroke_contains(sc, d, local, p);
+    }
+    if (d.is_ellipse) return ellipse_contains(d.ellipse, p);
+    return winding_inside(tile_winding(sc, bins, e, region, p), d.fill_rule);
+}
+
+// Does draw `draw` cover p? (p inside the tile grid's reach.)
+bool draw_covers_at(const PreparedScene& sc, const TileBins& bins, int draw, Vec2 p) {
+    int tile = tile_of(bins, p);
+    Box region = bins.region(tile);
+    if (p.x < region.x0 || p.x > region.x1 || p.y < region.y0 || p.y > region.y1) return false;
+    const TileEntry* es = bins.begin(tile);
+    int n = bins.count(tile);
+    int lo = 0, hi = n;  // entries are sorted by draw index (paint order)
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (es[mid].draw < draw) lo = mid + 1; else hi = mid;
+    }
+    if (lo >= n || es[lo].draw != draw) return false;
+    return covers(sc, bins, es[lo], region, p);
+}
+
+// Draws covering p, front to back, with their premultiplied colours; `forced` (if >= 0)
+// counts as covering. Returns the count.
+int collect_hits(const PreparedScene& sc, const TileBins& bins, Vec2 p, int forced, std::vector<Hit>& hits) {
+    hits.clear();
+    int tile = tile_of(bins, p);
+    Box region = bins.region(tile);
+    bool in_region = p.x >= region.x0 && p.x <= region.x1 && p.y >= region.y0 && p.y <= region.y1;
+    const TileEntry* es = bins.begin(tile);
+    int n = in_region ? bins.count(tile) : 0;
+    bool forced_done = forced < 0;
+    auto add = [&](int draw) {
+        Hit h;
+        h.draw = draw;
+        paint_color(sc, sc.paints[sc.draws[draw].paint], p, h.c);
+        hits.push_back(h);
+    };
+    for (int k = n - 1; k >= 0; --k) {
+        int draw = es[k].draw;
+        if (!forced_done && forced > draw) {
+            add(forced);
+            forced_done = true;
+        }
+        if (draw == forced) {
+            add(forced);
+            forced_done = true;
+            continue;
+        }
+        if (covers(sc, bins, es[k], region, p)) add(draw);
+    }
+    if (!forced_done) add(forced);
+    return (int)hits.size();
+}
+
+// Compositing of hits (given front to back) evaluated back to front, with the tape needed
+// to run it in reverse.
+struct Tape {
+    enum Kind { OVER, PUSH, POP };
+    struct Op {
+        Kind kind;
+        int ref;           // hit index (OVER) or layer (PUSH/POP)
+        double prev[4];    // the frame's colour before the op (OVER) / the parent's (POP)
+        double layer[4];   // the closed layer's colour (POP)
+    };
+    std::vector<Op> ops;
+};
+
+void composite(const PreparedScene& sc, const std::vector<Hit>& hits, Tape* tape, double out[4]) {
+    struct Frame {
+        int layer;
+        double c[4];
+    } stack[MAX_DEPTH];
+    int top = 0;
+    stack[0].layer = 0;
+    for (double& v : stack[0].c) v = 0;
+    if (tape) tape->ops.clear();
+    auto is_ancestor_or_self = [&](int a, int l) {
+        while (sc.layer_depth[l] > sc.layer_depth[a]) l = sc.layer_parent[l];
+        return l == a;
+    };
+    auto pop = [&] {
+        Frame& child = stack[top];
+        Frame& parent = stack[top - 1];
+        double op = sc.layer_opacity[child.layer];
+        if (tape) {
+            Tape::Op o{Tape::POP, child.layer, {}, {}};
+            for (int i = 0; i < 4; ++i) { o.prev[i] = parent.c[i]; o.layer[i] = child.c[i]; }
+            tape->ops.push_back(o);
+        }
+        double k = 1 - op * child.c[3];
+        for (int i = 0; i < 4; ++i) parent.c[i] = op * child.c[i] + k * parent.c[i];
+        --top;
+    };
+    for (int h = (int)hits.size() - 1; h >= 0; --h) {
+        int layer = sc.draws[hits[h].draw].layer;
+        while (!is_ancestor_or_self(stack[top].layer, layer)) pop();
+        int chain[MAX_DEPTH], n = 0;
+        for (int l = layer; l != stack[top].layer && n < MAX_DEPTH; l = sc.layer_parent[l]) chain[n++] = l;
+        while (n > 0 && top + 1 < MAX_DEPTH) {
+            Frame& f = stack[++top];
+            f.layer = chain[--n];
+            for (double& v : f.c) v = 0;
+            if (tape) tape->ops.push_back({Tape::PUSH, f.layer, {}, {}});
+        }
+        Frame& f = stack[top];
+        if (tape) {
+            Tape::Op o{Tape::OVER, h, {}, {}};
+            for (int i = 0; i < 4; ++i) o.prev[i] = f.c[i];
+            tape->ops.push_back(o);
+        }
+        const double* c = hits[h].c;
+        for (int i = 0; i < 4; ++i) f.c[i] = c[i] + (1 - c[3]) * f.c[i];
+    }
+    while (top > 0) pop();
+    for (int i = 0; i < 4; ++i) out[i] = stack[0].c[i];
+}
+
+// Reverse of composite: g is dL/d(result); adds dL/d(hit colour) into g_hits and
+// dL/d(layer opacity) into grads.
+void composite_backward(const PreparedScene& sc, const std::vector<Hit>& hits, const Tape& tape, const double g[4],
+                        std::vector<std::array<double, 4>>& g_hits, SceneGrads& grads) {
+    g_hits.assign(hits.size(), {0, 0, 0, 0});
+    double adj[MAX_DEPTH][4];
+    int top = 0;
+    for (int i = 0; i < 4; ++i) adj[0][i] = g[i];
+    for (int k = (int)tape.ops.size() - 1; k >= 0; --k) {
+        const Tape::Op& o = tape.ops[k];
+        double* a = adj[top];
+        if (o.kind == Tape::OVER) {
+            const double* c = hits[o.ref].c;
+            double dp = a[0] * o.prev[0] + a[1] * o.prev[1] + a[2] * o.prev[2] + a[3] * o.prev[3];
+            for (int i = 0; i < 4; ++i) g_hits[o.ref][i] += a[i];
+            g_hits[o.ref][3] -= dp;
+            for (int i = 0; i < 4; ++i) a[i] *= 1 - c[3];
+        } else if (o.kind == Tape::POP) {
+            double op = sc.layer_opacity[o.ref];
+            double dp = a[0] * o.prev[0] + a[1] * o.prev[1] + a[2] * o.prev[2] + a[3] * o.prev[3];
+            double dl = a[0] * o.layer[0] + a[1] * o.layer[1] + a[2] * o.layer[2] + a[3] * o.layer[3];
+            grads.layer_opacity[o.ref] += dl - o.layer[3] * dp;
+            double* child = adj[top + 1];
+            for (int i = 0; i < 4; ++i) child[i] = op * a[i];
+            child[3] -= op * dp;
+            double k2 = 1 - op * o.layer[3];
+            for (int i = 0; i < 4; ++i) a[i] *= k2;
+            ++top;
+        } else {  // PUSH: the layer's frame began empty; back to the parent's adjoint
+            --top;
+        }
+    }
+}
+
+// dL/d(premultiplied scene colour, background under it excluded) of each pixel, from
+// dL/d(straight output) and the output itself.
+void pixel_adjoints(const RenderOptions& o, const float* image, const float* d_image, std::vector<double>& g) {
+    int n = o.width * o.height;
+    g.assign(4 * (size_t)n, 0);
+    double bg[4] = {0, 0, 0, 0};
+    if (o.has_background) {
+        double a = std::clamp(o.background[3], 0.0, 1.0);
+        for (int i = 0; i < 3; ++i) bg[i] = std::clamp(o.background[i], 0.0, 1.0) * a;
+        bg[3] = a;
+    }
+    for (int p = 0; p < n; ++p) {
+        const float* s = image + 4 * p;
+        const float* ds = d_image + 4 * p;
+        double a = s[3];
+        if (a <= 0) continue;  // straight colour undefined: no gradient
+        double gc[4];
+        double sum = 0;
+        for (int i = 0; i < 3; ++i) {
+            gc[i] = ds[i] / a;  // straight = premultiplied / alpha
+            sum += ds[i] * s[i];
+        }
+        gc[3] = ds[3] - sum / a;
+        // total = scene + (1 - scene.a) * background
+        double gb = gc[0] * bg[0] + gc[1] * bg[1] + gc[2] * bg[2] + gc[3] * bg[3];
+        for (int i = 0; i < 4; ++i) g[4 * (size_t)p + i] = gc[i];
+        g[4 * (size_t)p + 3] -= gb;
+    }
+}
+
+// ------------------------------------------------------------------- boundaries
+
+// One boundary sample: a point, its outward normal (pixel space), its length weight, and
+// how the point moves along the normal per unit change of each parameter it depends on.
+struct Velocity {
+    std::vector<double>* target;
+    size_t index;
+    double value;
+};
+
+struct BoundarySample {
+    Vec2 p, n;
+    double weight = 0;  // length element / samples
+    int draw = -1;
+    Velocity v[24];
+    int nv = 0;
+    void add(std::vector<double>* t, size_t i, double value) {
+        if (nv < 24 && value != 0) v[nv++] = {t, i, value};
+    }
+};
+
+// A boundary piece: what to sample and how many samples.
+struct Piece {
+    enum Kind { FILL_SEGMENT, ELLIPSE, OFFSET, END } kind;
+    int draw, item, side, count;
+};
+
+double polygon_length(const Segment& s) {
+    double l = 0;
+    for (int i = 0; i < s.degree; ++i) l += distance(s.p[i], s.p[i + 1]);
+    return l;
+}
+
+double bernstein(int n, int i, double t) {
+    static const double binom[4][4] = {{1, 0, 0, 0}, {1, 1, 0, 0}, {1, 2, 1, 0}, {1, 3, 3, 1}};
+    return binom[n][i] * std::pow(t, i) * std::pow(1 - t, n - i);
+}
+
+// Pixel-space control-point indices of a stroke item (its straightened form uses the ends).
+void stroke_item_indices(const PreparedScene& sc, const StrokeSegment& s, int32_t idx[4]) {
+    const PreparedSegment& src = sc.segments[s.source];
+    for (int i = 0; i < 4; ++i) idx[i] = -1;
+    if (s.seg.degree == src.seg.degree) {
+        for (int i = 0; i <= s.seg.degree; ++i) idx[i] = src.point_index[i];
+    } else {
+        idx[0] = src.point_index[0];
+        idx[s.seg.degree] = src.point_index[src.seg.degree];
+    }
+}
+
+// The frame of a stroke item's end: unit tangent (direction of travel) and the two
+// control points it comes from (head - tail), with their distance, in stroke space.
+struct EndFrame {
+    Vec2 t;
+    int head = 0, tail = 0;  // control point numbers within the segment
+    double length = 0;
+};
+
+EndFrame end_frame(const Segment& s, bool end) {
+    EndFrame f;
+    int n = s.degree;
+    if (end) {
+        f.head = n;
+        for (int i = n - 1; i >= 0; --i)
+            if (dot(s.p[n] - s.p[i], s.p[n] - s.p[i]) > 1e-24) { f.tail = i; break; }
+    } else {
+        f.tail = 0;
+        for (int i = 1; i <= n; ++i)
+            if (dot(s.p[i] - s.p[0], s.p[i] - s.p[0]) > 1e-24) { f.head = i; break; }
+    }
+    Vec2 d = s.p[f.head] - s.p[f.tail];
+    f.length = length(d);
+    f.t = f.length > 0 ? (1 / f.length) * d : Vec2{1, 0};
+    return f;
+}
+
+class BoundaryPass {
+public:
+    BoundaryPass(const PreparedScene& sc, const RenderOptions& o, double density)
+        : sc_(sc), o_(o), density_(density) {}
+
+    std::vector<Piece> pieces() const {
+        std::vector<Piece> out;
+        auto count = [&](double len) { return std::max(1, (int)std::ceil(density_ * len)); };
+        for (int di = 0; di < (int)sc_.draws.size(); ++di) {
+            const PreparedDraw& d = sc_.draws[di];
+            if (!valid(d.box)) continue;
+            if (d.is_ellipse) {
+                double r = std::max(d.ellipse.r0, d.ellipse.r1) + (d.kind == DRAW_STROKE ? d.half_width : 0);
+                double len = 2 * M_PI * r * (d.kind == DRAW_STROKE ? d.metric_scale : 1.0);
+                if (d.kind == DRAW_FILL) out.push_back({Piece::ELLIPSE, di, 0, 0, count(len)});
+                else for (int s = -1; s <= 1; s += 2) out.push_back({Piece::ELLIPSE, di, 0, s, count(len)});
+                continue;
+            }
+            for (int k = 0; k < d.n_items; ++k) {
+                if (d.kind == DRAW_FILL) {
+                    out.push_back({Piece::FILL_SEGMENT, di, k, 0, count(polygon_length(sc_.fill_items[d.first_item + k].seg))});
+                } else {
+                    const StrokeSegment& s = sc_.stroke_items[d.first_item + k];
+                    double len = (polygon_length(s.seg) + 2 * M_PI * d.half_width) * d.metric_scale;
+                    for (int side = -1; side <= 1; side += 2) out.push_back({Piece::OFFSET, di, k, side, count(len)});
+                    double end_len = 2 * M_PI * d.half_width * d.metric_scale + 4 * d.half_width * d.miter_limit;
+                    out.push_back({Piece::END, di, k, 0, count(end_len)});   // start piece
+                    out.push_back({Piece::END, di, k, 1, count(end_len)});   // end piece
+                }
+            }
+        }
+        return out;
+    }
+
+    // Fills bs for sample j of the piece; false if the sample does not exist.
+    bool sample(const Piece& pc, int j, uint64_t key, SceneGrads& g, BoundarySample& bs) const {
+        double u, v;
+        sample_uniform2(o_.seed ^ 0xb0b0b0b0ull, key, (uint64_t)j, u, v);
+        double t = (j + u) / pc.count;
+        bs.nv = 0;
+        bs.draw = pc.draw;
+        const PreparedDraw& d = sc_.draws[pc.draw];
+        switch (pc.kind) {
+            case Piece::FILL_SEGMENT: return fill_sample(d, sc_.fill_items[d.first_item + pc.item], t, pc.count, g, bs);
+            case Piece::ELLIPSE: return ellipse_sample(pc, d, t, g, bs);
+            case Piece::OFFSET: return offset_sample(pc, d, t, g, bs);
+            default: return end_sample(pc, d, t, v, g, bs);
+        }
+    }
+
+private:
+    const PreparedScene& sc_;
+    const RenderOptions& o_;
+    double density_;
+
+    // Stroke space -> pixel space for a point, a normal (as a covector) and a normal velocity.
+    Vec2 to_pixel(const PreparedDraw& d, Vec2 q) const { return d.metric_identity ? q : d.metric_inv * q; }
+    // Pixel normal for stroke-space normal n_q, and the factor that turns a stroke-space
+    // normal velocity into a pixel-space one.
+    Vec2 pixel_normal(const PreparedDraw& d, Vec2 n_q, double& factor) const {
+        if (d.metric_identity) {
+            factor = 1;
+            return n_q;
+        }
+        Vec2 m{d.metric.a * n_q.x + d.metric.c * n_q.y, d.metric.b * n_q.x + d.metric.d * n_q.y};  // M^T n
+        double l = length(m);
+        factor = l > 0 ? 1 / l : 0;
+        return factor * m;
+    }
+    // Pixel-space velocity coefficients of a stroke-space point displacement along n_q,
+    // for the pixel point with index idx: (M^T n_q) / |M^T n_q| scaled by w.
+    void add_point(SceneGrads& g, BoundarySample& bs, int32_t idx, Vec2 n_pixel, double w) const {
+        if (idx < 0) return;
+        bs.add(&g.points, 2 * (size_t)idx, w * n_pixel.x);
+        bs.add(&g.points, 2 * (size_t)idx + 1, w * n_pixel.y);
+    }
+    // Same for a stroke-space direction vector e (not the normal): w * (M^T e).n_q / |M^T n_q|
+    void add_point_dir(const PreparedDraw& d, SceneGrads& g, BoundarySample& bs, int32_t idx, Vec2 e,
+                       double factor, double w) const {
+        if (idx < 0) return;
+        Vec2 m = d.metric_identity ? e : Vec2{d.metric.a * e.x + d.metric.c * e.y, d.metric.b * e.x + d.metric.d * e.y};
+        bs.add(&g.points, 2 * (size_t)idx, w * factor * m.x);
+        bs.add(&g.points, 2 * (size_t)idx + 1, w * factor * m.y);
+    }
+
+    bool fill_sample(const PreparedDraw& d, const PreparedSegment& s, double t, int count, SceneGrads& g,
+                     BoundarySample& bs) const {
+        Vec2 dp = seg_deriv(s.seg, t);
+        double speed = length(dp);
+        if (speed <= 0) return false;
+        bs.p = seg_eval(s.seg, t);
+        bs.n = (1 / speed) * Vec2{dp.y, -dp.x};  // one side; the caller picks the outward one
+        bs.weight = speed / count;
+        for (int i = 0; i <= s.seg.degree; ++i) add_point(g, bs, s.point_index[i], bs.n, bernstein(s.seg.degree, i, t));
+        (void)d;
+        return true;
+    }
+
+    // Ellipse q = c + A (cos, sin) from its pixel-space row; a stroke offsets it by
+    // side * hw along the normal in stroke space (q_s = M q).
+    bool ellipse_sample(const Piece& pc, const PreparedDraw& d, double t, SceneGrads& g, BoundarySample& bs) const {
+        double phi = 2 * M_PI * t;
+        Vec2 u{std::cos(phi), std::sin(phi)}, du{-std::sin(phi), std::cos(phi)};
+        Mat2 M = d.kind == DRAW_STROKE ? d.metric : Mat2{};
+        Mat2 A = d.ellipse_axes;
+        Vec2 c = d.ellipse_center;
+        Vec2 q = M * (c + A * u), dq = M * (A * du), ddq = M * (A * (-1.0 * u));
+        double sp = length(dq);
+        if (sp <= 0) return false;
+        Vec2 n = (1 / sp) * Vec2{dq.y, -dq.x};
+        if (dot(n, q - M * c) < 0) n = -n;  // outward
+        double side = d.kind == DRAW_STROKE ? pc.side : 0, hw = d.half_width;
+        Vec2 n_side = side < 0 ? -n : n;
+        double kappa = std::fabs(cross(dq, ddq)) / (sp * sp * sp);
+        double stretch = side == 0 ? 1 : std::fabs(1 + side * hw * kappa);
+        double factor;
+        bs.n = pixel_normal(d, n_side, factor);
+        Vec2 point = q + (side * hw) * n;
+        bs.p = d.kind == DRAW_STROKE ? to_pixel(d, point) : point;
+        Vec2 step = (sp * stretch / sp) * dq;
+        bs.weight = length(d.kind == DRAW_STROKE ? to_pixel(d, step) : step) * 2 * M_PI / pc.count;
+        // d q_s / d c = M, d q_s / d A[r][k] = M e_r u_k; normal changes are tangential.
+        size_t row = ELLIPSE_COLS * (size_t)d.ellipse_row;
+        Vec2 mt{M.a * n_side.x + M.c * n_side.y, M.b * n_side.x + M.d * n_side.y};  // M^T n
+        bs.add(&g.ellipses, row + 0, factor * mt.x);
+        bs.add(&g.ellipses, row + 1, factor * mt.y);
+        bs.add(&g.ellipses, row + 2, factor * mt.x * u.x);
+        bs.add(&g.ellipses, row + 3, factor * mt.x * u.y);
+        bs.add(&g.ellipses, row + 4, factor * mt.y * u.x);
+        bs.add(&g.ellipses, row + 5, factor * mt.y * u.y);
+        if (d.kind == DRAW_STROKE) bs.add(&g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * factor);
+        return true;
+    }
+
+    bool offset_sample(const Piece& pc, const PreparedDraw& d, double t, SceneGrads& g, BoundarySample& bs) const {
+        const StrokeSegment& s = sc_.stroke_items[d.first_item + pc.item];
+        Vec2 b1 = seg_deriv(s.seg, t);
+        double sp = length(b1);
+        if (sp <= 0) return false;
+        Vec2 T = (1 / sp) * b1, N = perp(T);
+        double hw = d.half_width, side = pc.side;
+        Vec2 q = seg_eval(s.seg, t) + (side * hw) * N;
+        // q' = B' + side hw N', N' = perp(T'), T' = (B'' - (B''.T) T) / |B'|
+        Vec2 b2 = seg_deriv2(s.seg, t);
+        Vec2 tprime = (1 / sp) * (b2 - dot(b2, T) * T);
+        Vec2 dq = b1 + (side * hw) * perp(tprime);
+        Vec2 n_q = side * N;
+        double factor;
+        bs.n = pixel_normal(d, n_q, factor);
+        bs.p = to_pixel(d, q);
+        bs.weight = length(d.metric_identity ? dq : d.metric_inv * dq) / pc.count;
+        int32_t idx[4];
+        stroke_item_indices(sc_, s, idx);
+        for (int i = 0; i <= s.seg.degree; ++i)
+            add_point_dir(d, g, bs, idx[i], n_q, factor, bernstein(s.seg.degree, i, t));
+        bs.add(&g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * factor);
+        return true;
+    }
+
+    // The end pieces of a stroke item: the cap before it (side 0), or the join or cap
+    // after it (side 1), sampled along the outline that can be the stroke's boundary (not
+    // the seams with the sweeps). Translation exactly; tangent rotations and the width by
+    // central differences of the construction.
+    struct EndGeometry {
+        bool valid = false, butt = false, join = false;
+        Vec2 at;               // the vertex
+        EndFrame in, out;      // frames: in = of this item's end (or start); out = the next item's start
+        Vec2 out_axis;         // caps: the outward direction
+    };
+
+    EndGeometry end_geometry(const PreparedDraw& d, const StrokeSegment& s, int side) const {
+        EndGeometry eg;
+        const StrokeEnd& e = side == 0 ? s.start : s.end;
+        eg.butt = side == 0 ? s.butt_start : s.butt_end;
+        if (e.kind == StrokeEnd::NONE && !eg.butt) return eg;
+        eg.valid = true;
+        if (side == 0) {
+            eg.at = s.seg.p[0];
+            eg.in = end_frame(s.seg, false);
+            eg.out_axis = -eg.in.t;
+        } else {
+            eg.at = seg_end(s.seg);
+            eg.in = end_frame(s.seg, true);
+            eg.out_axis = eg.in.t;
+            if (s.next >= 0 && e.kind != StrokeEnd::NONE && !eg.butt) {
+                eg.join = true;
+                eg.out = end_frame(sc_.stroke_items[s.next].seg, false);
+            }
+        }
+        if (e.kind == StrokeEnd::SQUARE || e.kind == StrokeEnd::DISK) eg.out_axis = e.kind == StrokeEnd::SQUARE ? e.axis : eg.out_axis;
+        (void)d;
+        return eg;
+    }
+
+    // Point and outward normal at fraction lam of the outline of the piece built from the
+    // given tangents and half width; returns the outline's length.
+    double outline(const PreparedDraw& d, const EndGeometry& eg, int side, const StrokeSegment& s, Vec2 t_in,
+                   Vec2 t_out, double hw, double lam, Vec2& q, Vec2& n) const {
+        const StrokeEnd& stored = side == 0 ? s.start : s.end;
+        if (eg.butt) {  // the end normal line, facing along the outward tangent
+            Vec2 axis = side == 0 ? -t_in : t_in, nn = perp(axis);
+            q = eg.at + ((2 * lam - 1) * hw) * nn;
+            n = axis;
+            return 2 * hw;
+        }
+        StrokeEnd e;
+        if (eg.join) e = make_join(eg.at, t_in, t_out, d.join, hw, d.miter_limit);
+        else if (stored.kind == StrokeEnd::SQUARE && s.seg.degree == 1 && s.seg.p[0].x == s.seg.p[1].x &&
+                 s.seg.p[0].y == s.seg.p[1].y)
+            e = stored;  // the dot of a zero-length subpath: axis fixed
+        else e = make_cap(eg.at, side == 0 ? -t_in : t_in, d.cap);
+        if (e.kind == StrokeEnd::DISK) {
+            double phi = 2 * M_PI * lam;
+            n = {std::cos(phi), std::sin(phi)};
+            q = e.center + hw * n;
+            return 2 * M_PI * hw;
+        }
+        if (e.kind == StrokeEnd::SQUARE) {  // three outer edges of the half square
+            Vec2 A = e.axis, B = perp(A);
+            double x = 4 * hw * lam;
+            if (x < hw) { q = e.center + x * A + hw * B; n = B; }
+            else if (x < 3 * hw) { q = e.center + hw * A + (2 * hw - x) * B; n = A; }
+            else { q = e.center + (4 * hw - x) * A - hw * B; n = -B; }
+            return 4 * hw;
+        }
+        if (e.kind == StrokeEnd::POLYGON) {  // outer edges: poly[1] .. poly[n-1]
+            int edges = e.n_poly - 2;
+            double lens[2], total = 0;
+            for (int k = 0; k < edges; ++k) total += (lens[k] = distance(e.poly[k + 1], e.poly[k + 2]));
+            if (total <= 0) return 0;
+            double x = lam * total;
+            int k = 0;
+            while (k + 1 < edges && x > lens[k]) x -= lens[k++];
+            Vec2 a = e.poly[k + 1], b = e.poly[k + 2];
+            q = a + (lens[k] > 0 ? x / lens[k] : 0.0) * (b - a);
+            n = normalized(perp(b - a));
+            if (dot(n, q - e.poly[0]) < 0) n = -n;
+            return total;
+        }
+        return 0;
+    }
+
+    bool end_sample(const Piece& pc, const PreparedDraw& d, double t, double, SceneGrads& g,
+                    BoundarySample& bs) const {
+        const StrokeSegment& s = sc_.stroke_items[d.first_item + pc.item];
+        EndGeometry eg = end_geometry(d, s, pc.side);
+        if (!eg.valid) return false;
+        double hw = d.half_width;
+        Vec2 q, n;
+        Vec2 t_out = eg.join ? eg.out.t : eg.in.t;
+        double len = outline(d, eg, pc.side, s, eg.in.t, t_out, hw, t, q, n);
+        if (len <= 0) return false;
+        double factor;
+        bs.n = pixel_normal(d, n, factor);
+        bs.p = to_pixel(d, q);
+        // length in pixels: the outline's stroke-space length, scaled along its direction
+        Vec2 dir = perp(n);
+        bs.weight = len * length(d.metric_identity ? dir : d.metric_inv * dir) / pc.count;
+        int32_t idx[4];
+        stroke_item_indices(sc_, s, idx);
+        int vertex = pc.side == 0 ? idx[0] : idx[s.seg.degree];
+        add_point_dir(d, g, bs, vertex, n, factor, 1.0);
+        // rotation of a frame by a small angle h, and the width
+        const double h = 1e-6, dw = 1e-6 * std::max(hw, 1.0);
+        auto rotate = [](Vec2 v, double a) {
+            return Vec2{v.x * std::cos(a) - v.y * std::sin(a), v.x * std::sin(a) + v.y * std::cos(a)};
+        };
+        auto normal_rate = [&](Vec2 ti_p, Vec2 to_p, Vec2 ti_m, Vec2 to_m, double hw_p, double hw_m, double step) {
+            Vec2 qp, qm, nn;
+            outline(d, eg, pc.side, s, ti_p, to_p, hw_p, t, qp, nn);
+            outline(d, eg, pc.side, s, ti_m, to_m, hw_m, t, qm, nn);
+            return dot(qp - qm, n) / (2 * step);
+        };
+        double rate_in = normal_rate(rotate(eg.in.t, h), t_out, rotate(eg.in.t, -h), t_out, hw, hw, h);
+        // dtheta = N . (d head - d tail) / L for the frame's control points (stroke space)
+        auto add_frame = [&](const EndFrame& f, const int32_t* fidx, double rate) {
+            if (f.length <= 0 || rate == 0) return;
+            Vec2 N = perp(f.t);
+            add_point_dir(d, g, bs, fidx[f.head], N, factor, rate / f.length);
+            add_point_dir(d, g, bs, fidx[f.tail], N, factor, -rate / f.length);
+        };
+        add_frame(eg.in, idx, rate_in);
+        if (eg.join) {
+            double rate_out = normal_rate(eg.in.t, rotate(t_out, h), eg.in.t, rotate(t_out, -h), hw, hw, h);
+            int32_t nidx[4];
+            stroke_item_indices(sc_, sc_.stroke_items[s.next], nidx);
+            add_frame(eg.out, nidx, rate_out);
+        }
+        double rate_w = normal_rate(eg.in.t, t_out, eg.in.t, t_out, hw + dw, hw - dw, dw);
+        bs.add(&g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * rate_w * factor);
+        return true;
+    }
+};
+
+
+}  // namespace
+
+void render_backward(const PreparedScene& sc, const SceneArrays& a, const RenderOptions& o, const float* image,
+                     const float* d_image, double boundary_density, SceneGrads& out) {
+    const int W = o.width, H = o.height, N = std::max(1, o.samples);
+    const double R = o.filter == FILTER_BOX ? 0.5 : std::max(0.5, o.filter_radius);
+    // Boundary samples reach pixels within R of them, so tiles must see that far out.
+    TileBins bins = bin_draws(sc, W, H, R + 4 * EPS_NORMAL, false);
+    std::vector<double> gpix;
+    pixel_adjoints(o, image, d_image, gpix);
+    int lanes = std::max(1, o.threads > 0 ? o.threads : ThreadPool::hardware_threads());
+    std::vector<SceneGrads> grads(lanes);
+    for (SceneGrads& g : grads) g.resize_like(a);
+    int n_tiles = bins.nx * bins.ny;
+
+    // Interior term.
+    ThreadPool::instance().parallel_for(lanes, lanes, [&](int lane, int) {
+        SceneGrads& g = grads[lane];
+        std::vector<Hit> hits;
+        Tape tape;
+        std::vector<std::array<double, 4>> g_hits;
+        for (int tile = lane; tile < n_tiles; tile += lanes) {
+            int tx = tile % bins.nx, ty = tile / bins.nx;
+            for (int y = ty * TILE; y < std::min(H, (ty + 1) * TILE); ++y) {
+                for (int x = tx * TILE; x < std::min(W, (tx + 1) * TILE); ++x) {
+                    uint64_t pixel = (uint64_t)y * W + x;
+                    const double* gp = gpix.data() + 4 * pixel;
+                    if (gp[0] == 0 && gp[1] == 0 && gp[2] == 0 && gp[3] == 0) continue;
+                    double wsum = 0;
+                    for (int s = 0; s < N * N; ++s) {
+                        double fx = ((s % N) + 0.5) / N, fy = ((s / N) + 0.5) / N;
+                        if (o.mode == MODE_MC) sample_position(o.seed, pixel, s, N, fx, fy);
+                        wsum += filter_weight(o.filter, R, R * (2 * fx - 1), R * (2 * fy - 1));
+                    }
+                    if (wsum <= 0) continue;
+                    for (int s = 0; s < N * N; ++s) {
+                        double fx = ((s % N) + 0.5) / N, fy = ((s / N) + 0.5) / N;
+                        if (o.mode == MODE_MC) sample_position(o.seed, pixel, s, N, fx, fy);
+                        double dx = R * (2 * fx - 1), dy = R * (2 * fy - 1);
+                        double w = filter_weight(o.filter, R, dx, dy) / wsum;
+                        if (w <= 0) continue;
+                        Vec2 p{x + 0.5 + dx, y + 0.5 + dy};
+                        if (collect_hits(sc, bins, p, -1, hits) == 0) continue;
+                        double c[4], gs[4];
+                        composite(sc, hits, &tape, c);
+                        for (int i = 0; i < 4; ++i) gs[i] = w * gp[i];
+                        composite_backward(sc, hits, tape, gs, g_hits, g);
+                        for (size_t k = 0; k < hits.size(); ++k)
+                            paint_color_backward(sc, sc.draws[hits[k].draw].paint, p, g_hits[k].data(), g);
+                    }
+                }
+            }
+        }
+    });
+
+    // Boundary term.
+    BoundaryPass pass(sc, o, boundary_density);
+    std::vector<Piece> pieces = pass.pieces();
+    double filter_integral = 1.0;  // of the unnormalised filter over its support
+    if (o.filter == FILTER_TENT) filter_integral = R * R;
+    else if (o.filter == FILTER_GAUSSIAN) {
+        double sigma = R / 2, one = sigma * std::sqrt(2 * M_PI) * std::erf(R / (sigma * std::sqrt(2.0)));
+        filter_integral = one * one;
+    } else filter_integral = 4 * R * R;
+    ThreadPool::instance().parallel_for(lanes, lanes, [&](int lane, int) {
+        SceneGrads& g = grads[lane];
+        std::vector<Hit> hits;
+        BoundarySample bs;
+        for (size_t k = lane; k < pieces.size(); k += lanes) {
+            const Piece& pc = pieces[k];
+            for (int j = 0; j < pc.count; ++j) {
+                if (!pass.sample(pc, j, (uint64_t)k, g, bs)) continue;
+                Vec2 p = bs.p;
+                if (!(p.x >= -R && p.x <= W + R && p.y >= -R && p.y <= H + R)) continue;
+                bool in_minus = draw_covers_at(sc, bins, bs.draw, p - EPS_NORMAL * bs.n);
+                bool in_plus = draw_covers_at(sc, bins, bs.draw, p + EPS_NORMAL * bs.n);
+                if (pc.kind == Piece::FILL_SEGMENT && !in_minus && in_plus) {
+                    bs.n = -bs.n;  // the segment runs the other way round
+                    for (int i = 0; i < bs.nv; ++i) bs.v[i].value = -bs.v[i].value;
+                    std::swap(in_minus, in_plus);
+                }
+                if (!in_minus || in_plus) continue;  // no change of coverage across p
+                Vec2 outside = p + EPS_NORMAL * bs.n;
+                double c_in[4], c_out[4];
+                collect_hits(sc, bins, outside, bs.draw, hits);
+                composite(sc, hits, nullptr, c_in);
+                collect_hits(sc, bins, outside, -1, hits);
+                composite(sc, hits, nullptr, c_out);
+                double delta[4];
+                for (int i = 0; i < 4; ++i) delta[i] = c_in[i] - c_out[i];
+                if (delta[0] == 0 && delta[1] == 0 && delta[2] == 0 && delta[3] == 0) continue;
+                int x0 = std::max(0, (int)std::floor(p.x - R)), x1 = std::min(W - 1, (int)std::floor(p.x + R));
+                int y0 = std::max(0, (int)std::floor(p.y - R)), y1 = std::min(H - 1, (int)std::floor(p.y + R));
+                double total = 0;
+                for (int py = y0; py <= y1; ++py)
+                    for (int px = x0; px <= x1; ++px) {
+                        double dx = p.x - (px + 0.5), dy = p.y - (py + 0.5);
+                        if (std::fabs(dx) > R || std::fabs(dy) > R) continue;
+                        double w = filter_weight(o.filter, R, dx, dy) / filter_integral;
+                        const double* gp = gpix.data() + 4 * ((size_t)py * W + px);
+                        total += w * (gp[0] * delta[0] + gp[1] * delta[1] + gp[2] * delta[2] + gp[3] * delta[3]);
+                    }
+                total *= bs.weight;
+                if (total == 0) continue;
+                for (int i = 0; i < bs.nv; ++i) (*bs.v[i].target)[bs.v[i].index] += total * bs.v[i].value;
+            }
+        }
+    });
+
+    out = grads[0];
+    for (int l = 1; l < lanes; ++l) out.add(grads[l]);
+}
+
+}  // namespace vf

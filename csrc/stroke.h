@@ -1,0 +1,56 @@
+// Construction of the stroke's join and cap pieces from a vertex, the tangents that meet
+// there and the half width; shared by scene preparation and the backward pass (which
+// rebuilds them under small changes of the tangents and the width).
+#pragma once
+
+#include "geometry.h"
+#include "scene.h"
+
+namespace vf {
+
+// The join at vertex v between a segment leaving along t_in and one leaving along t_out.
+inline StrokeEnd make_join(Vec2 v, Vec2 t_in, Vec2 t_out, int join, double hw, double miter_limit) {
+    StrokeEnd e;
+    double c = cross(t_in, t_out), d = dot(t_in, t_out);
+    if (std::fabs(c) < 1e-12 && d > 0) return e;  // no turn: the sweeps already meet
+    if (join == JOIN_ROUND) {
+        e.kind = StrokeEnd::DISK;
+        e.center = v;
+        return e;
+    }
+    // The outer side of the turn is opposite to the direction it turns towards.
+    double s = c >= 0 ? 1.0 : -1.0;
+    Vec2 n_in = -s * perp(t_in), n_out = -s * perp(t_out);
+    e.kind = StrokeEnd::POLYGON;
+    double cos_half = std::sqrt(std::max(0.0, 0.5 * (1 + d)));  // cos of half the turn
+    // Miter length / stroke width = 1 / sin(interior angle / 2) = 1 / cos(turn / 2).
+    if (join == JOIN_MITER && cos_half > 1e-12 && 1.0 / cos_half <= miter_limit) {
+        Vec2 dir = normalized(n_in + n_out);
+        e.poly[0] = v;
+        e.poly[1] = v + hw * n_in;
+        e.poly[2] = v + (hw / cos_half) * dir;
+        e.poly[3] = v + hw * n_out;
+        e.n_poly = 4;
+    } else {
+        e.poly[0] = v;
+        e.poly[1] = v + hw * n_in;
+        e.poly[2] = v + hw * n_out;
+        e.n_poly = 3;
+    }
+    return e;
+}
+
+inline StrokeEnd make_cap(Vec2 at, Vec2 outward, int cap) {
+    StrokeEnd e;
+    if (cap == CAP_ROUND) {
+        e.kind = StrokeEnd::DISK;
+        e.center = at;
+    } else if (cap == CAP_SQUARE) {
+        e.kind = StrokeEnd::SQUARE;
+        e.center = at;
+        e.axis = outward;
+    }
+    return e;
+}
+
+}  // namespace vf
