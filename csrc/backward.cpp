@@ -699,8 +699,10 @@ void render_backward(const PreparedScene& sc, const SceneArrays& a, const Render
                 double total = 0;
                 for (int py = y0; py <= y1; ++py)
                     for (int px = x0; px <= x1; ++px) {
+                        // Half-open support, as a pixel's samples are: a point on the line
+                        // between two pixels belongs to one of them, not both.
                         double dx = p.x - (px + 0.5), dy = p.y - (py + 0.5);
-                        if (std::fabs(dx) > R || std::fabs(dy) > R) continue;
+                        if (dx < -R || dx >= R || dy < -R || dy >= R) continue;
                         double w = filter_weight(o.filter, R, dx, dy) / filter_integral;
                         const double* gp = gpix.data() + 4 * ((size_t)py * W + px);
                         total += w * (gp[0] * delta[0] + gp[1] * delta[1] + gp[2] * delta[2] + gp[3] * delta[3]);
