@@ -1,4 +1,4 @@
-// Backward pass (Monte Carlo mode), after Li et al. 2020, section 5:
+// Backward pass, after Li et al. 2020, section 5. Monte Carlo mode:
 //   * interior term: per pixel sample, reverse-mode through front-to-back compositing
 //     (with layers) into paint parameters, stop offsets / colours and layer opacities;
 //   * boundary term (Reynolds transport): stratified samples on every boundary of every
@@ -8,6 +8,8 @@
 //     times the normal velocity of p goes to the parameters. A shared edge is counted
 //     once, an occluded one gives zero, and a boundary piece that lies inside another
 //     piece of the same stroke changes nothing.
+// Analytical prefilter: the chain rule through the kernel K(sd / r) and the signed
+// distance, whose derivative needs no derivative of the root solver (sdf_backward).
 // Gradients accumulate in one buffer per lane (a fixed slice of the work), summed in
 // lane order: the result is deterministic for a given seed and thread count.
 #include <algorithm>
@@ -31,7 +33,18 @@ constexpr int MAX_DEPTH = 64;
 
 struct Hit {
     int draw;
-    double c[4];  // premultiplied colour of the draw at the point
+    double c[4];  // premultiplied colour of the draw at the point (times its coverage)
+    // analytical prefilter only: coverage K(sd / r), the signed distance, the paint colour
+    // (premultiplied) and the piece the distance came from
+    double cov = 1, sd = 0, paint[4] = {0, 0, 0, 0};
+    SdfArg arg;
+};
+
+struct LocalList {
+    const LocalItem* li;
+    int n;
+    int size() const { return n; }
+    int operator[](int i) const { return li[i].item; }
 };
 
 int tile_of(const TileBins& bins, Vec2 p) {
@@ -103,6 +116,45 @@ int collect_hits(const PreparedScene& sc, const TileBins& bins, Vec2 p, int forc
     }
     if (!forced_done) add(forced);
     return (int)hits.size();
+}
+
+inline double kernel(double d) {
+    if (d <= -1) return 1;
+    if (d >= 1) return 0;
+    return 0.5 + (d * d * d - 3 * d) * 0.25;
+}
+
+inline double kernel_slope(double d) { return std::fabs(d) < 1 ? 0.75 * (d * d - 1) : 0.0; }
+
+// Analytical prefilter: the draws reaching p, front to back, with fractional coverage.
+void collect_hits_analytic(const PreparedScene& sc, const TileBins& bins, Vec2 p, double r, std::vector<Hit>& hits) {
+    hits.clear();
+    int tile = tile_of(bins, p);
+    Box region = bins.region(tile);
+    const TileEntry* es = bins.begin(tile);
+    for (int k = bins.count(tile) - 1; k >= 0; --k) {
+        const TileEntry& e = es[k];
+        const PreparedDraw& d = sc.draws[e.draw];
+        Box near = grown(d.box, r);
+        if (p.x < near.x0 || p.x > near.x1 || p.y < near.y0 || p.y > near.y1) continue;
+        LocalList local{bins.items.data() + e.first, e.count};
+        Hit h;
+        h.draw = e.draw;
+        if (d.kind == DRAW_STROKE) {
+            h.sd = stroke_sdf(sc, d, local, p, r, &h.arg);
+        } else if (d.is_ellipse) {
+            h.sd = ellipse_fill_sdf(d, p, r, &h.arg);
+        } else {
+            double dist = fill_distance(sc, d, local, p, r, &h.arg);
+            bool inside = winding_inside(tile_winding(sc, bins, e, region, p), d.fill_rule);
+            h.sd = inside ? -dist : dist;
+        }
+        h.cov = kernel(h.sd / r);
+        if (h.cov <= 0) continue;
+        paint_color(sc, sc.paints[d.paint], p, h.paint);
+        for (int i = 0; i < 4; ++i) h.c[i] = h.cov * h.paint[i];
+        hits.push_back(h);
+    }
 }
 
 // Compositing of hits (given front to back) evaluated back to front, with the tape needed
@@ -603,6 +655,117 @@ private:
 };
 
 
+// ------------------------------------------------------- analytical prefilter
+
+// Adds g_sd * d(sd)/d(parameters) for a hit of the analytical prefilter. At a closest
+// point the first-order condition holds, so the solver's t* drops out (implicit
+// function theorem): d|B(t*) - p| / dP_i = basis_i(t*) (B(t*) - p) / |B(t*) - p|.
+// Joins, caps and butt ends: central differences of their construction in the vertex,
+// the tangents' angles and the width.
+void sdf_backward(const PreparedScene& sc, const Hit& h, Vec2 p, double g_sd, SceneGrads& g) {
+    const PreparedDraw& d = sc.draws[h.draw];
+    const SdfArg& arg = h.arg;
+    auto add_pixel_point = [&](int32_t idx, Vec2 v) {  // v: d sd / d(pixel point)
+        if (idx < 0) return;
+        g.points[2 * (size_t)idx] += v.x;
+        g.points[2 * (size_t)idx + 1] += v.y;
+    };
+    auto mt = [&](Vec2 v) {  // M^T v: a stroke-space gradient seen in pixel space
+        return d.metric_identity ? v : Vec2{d.metric.a * v.x + d.metric.c * v.y, d.metric.b * v.x + d.metric.d * v.y};
+    };
+    if (d.kind == DRAW_FILL) {
+        double sign = h.sd < 0 ? -1 : 1;
+        double dist = distance(arg.closest, p);
+        if (dist <= 0) return;
+        Vec2 dir = (1 / dist) * (arg.closest - p);  // d dist / d(closest point)
+        if (arg.kind == SdfArg::SEGMENT) {
+            const PreparedSegment& seg = sc.fill_items[arg.item];
+            for (int i = 0; i <= seg.seg.degree; ++i)
+                add_pixel_point(seg.point_index[i], (g_sd * sign * bernstein(seg.seg.degree, i, arg.t)) * dir);
+        } else if (arg.kind == SdfArg::ELLIPSE) {
+            Vec2 u = inverse(d.ellipse_axes) * (arg.closest - d.ellipse_center);
+            double* ge = g.ellipses.data() + ELLIPSE_COLS * (size_t)d.ellipse_row;
+            double k = g_sd * sign;
+            ge[0] += k * dir.x; ge[1] += k * dir.y;
+            ge[2] += k * dir.x * u.x; ge[3] += k * dir.x * u.y;
+            ge[4] += k * dir.y * u.x; ge[5] += k * dir.y * u.y;
+        }
+        return;
+    }
+    // Strokes: sd (pixels) = metric_scale * sd (stroke space).
+    double gs = g_sd * d.metric_scale;
+    Vec2 q = d.metric_identity ? p : d.metric * p;
+    double hw = d.half_width;
+    double* gw = g.draw_params.data() + DRAW_FCOLS * (size_t)h.draw;  // width = 2 hw
+    if (arg.kind == SdfArg::ELLIPSE || arg.kind == SdfArg::SWEEP) {
+        double dist = distance(arg.closest, q);
+        gw[0] += -0.5 * gs;
+        if (dist <= 0) return;
+        Vec2 dir = (1 / dist) * (arg.closest - q);
+        if (arg.kind == SdfArg::ELLIPSE) {
+            Vec2 local = d.metric_identity ? arg.closest : d.metric_inv * arg.closest;
+            Vec2 u = inverse(d.ellipse_axes) * (local - d.ellipse_center);
+            Vec2 m = mt(dir);
+            double* ge = g.ellipses.data() + ELLIPSE_COLS * (size_t)d.ellipse_row;
+            ge[0] += gs * m.x; ge[1] += gs * m.y;
+            ge[2] += gs * m.x * u.x; ge[3] += gs * m.x * u.y;
+            ge[4] += gs * m.y * u.x; ge[5] += gs * m.y * u.y;
+            return;
+        }
+        const StrokeSegment& s = sc.stroke_items[arg.item];
+        int32_t idx[4];
+        stroke_item_indices(sc, s, idx);
+        for (int i = 0; i <= s.seg.degree; ++i)
+            add_pixel_point(idx[i], (gs * bernstein(s.seg.degree, i, arg.t)) * mt(dir));
+        return;
+    }
+    // BUTT / END: rebuild the piece from (vertex, tangent angles, half width).
+    const StrokeSegment& s = sc.stroke_items[arg.item];
+    int side = arg.side;
+    bool point = s.seg.degree == 1 && s.seg.p[0].x == s.seg.p[1].x && s.seg.p[0].y == s.seg.p[1].y;
+    EndFrame in = end_frame(s.seg, side == 1), out;
+    bool join = side == 1 && arg.kind == SdfArg::END && s.next >= 0 && s.end.kind != StrokeEnd::NONE;
+    if (join) out = end_frame(sc.stroke_items[s.next].seg, false);
+    Vec2 V = side == 0 ? s.seg.p[0] : seg_end(s.seg);
+    double sign = h.sd < 0 ? -1 : 1;
+    auto value = [&](Vec2 qq, Vec2 t_in, Vec2 t_out, double w) {
+        if (arg.kind == SdfArg::BUTT) {
+            Vec2 n = perp(t_in);
+            return sign * point_line_segment_distance(qq, V - w * n, V + w * n);
+        }
+        StrokeEnd e;
+        if (join) e = make_join(V, t_in, t_out, d.join, w, d.miter_limit);
+        else if (point) e = side == 0 ? s.start : s.end;
+        else e = make_cap(V, side == 0 ? -t_in : t_in, d.cap);
+        return end_sdf(e, qq, w);
+    };
+    auto rotate = [](Vec2 v, double a) {
+        return Vec2{v.x * std::cos(a) - v.y * std::sin(a), v.x * std::sin(a) + v.y * std::cos(a)};
+    };
+    const double hq = 1e-6 * std::max(1.0, hw), ha = 1e-6;
+    Vec2 to = join ? out.t : in.t;
+    // translation of the vertex moves the piece: d/dV = -d/dq
+    double dqx = (value(q + Vec2{hq, 0}, in.t, to, hw) - value(q - Vec2{hq, 0}, in.t, to, hw)) / (2 * hq);
+    double dqy = (value(q + Vec2{0, hq}, in.t, to, hw) - value(q - Vec2{0, hq}, in.t, to, hw)) / (2 * hq);
+    int32_t idx[4];
+    stroke_item_indices(sc, s, idx);
+    add_pixel_point(side == 0 ? idx[0] : idx[s.seg.degree], (-gs) * mt(Vec2{dqx, dqy}));
+    double dw = (value(q, in.t, to, hw + hq) - value(q, in.t, to, hw - hq)) / (2 * hq);
+    gw[0] += 0.5 * gs * dw;
+    auto add_frame = [&](const EndFrame& f, const int32_t* fidx, double rate) {
+        if (f.length <= 0 || rate == 0 || point) return;
+        Vec2 N = mt(perp(f.t));
+        add_pixel_point(fidx[f.head], (gs * rate / f.length) * N);
+        add_pixel_point(fidx[f.tail], (-gs * rate / f.length) * N);
+    };
+    add_frame(in, idx, (value(q, rotate(in.t, ha), to, hw) - value(q, rotate(in.t, -ha), to, hw)) / (2 * ha));
+    if (join) {
+        int32_t nidx[4];
+        stroke_item_indices(sc, sc.stroke_items[s.next], nidx);
+        add_frame(out, nidx, (value(q, in.t, rotate(to, ha), hw) - value(q, in.t, rotate(to, -ha), hw)) / (2 * ha));
+    }
+}
+
 }  // namespace
 
 void render_backward(const PreparedScene& sc, const SceneArrays& a, const RenderOptions& o, const float* image,
@@ -610,7 +773,7 @@ void render_backward(const PreparedScene& sc, const SceneArrays& a, const Render
     const int W = o.width, H = o.height, N = std::max(1, o.samples);
     const double R = o.filter == FILTER_BOX ? 0.5 : std::max(0.5, o.filter_radius);
     // Boundary samples reach pixels within R of them, so tiles must see that far out.
-    TileBins bins = bin_draws(sc, W, H, R + 4 * EPS_NORMAL, false);
+    TileBins bins = bin_draws(sc, W, H, (o.mode == MODE_ANALYTIC ? 2 * R : R) + 4 * EPS_NORMAL, false);
     std::vector<double> gpix;
     pixel_adjoints(o, image, d_image, gpix);
     int lanes = std::max(1, o.threads > 0 ? o.threads : ThreadPool::hardware_threads());
@@ -618,7 +781,9 @@ void render_backward(const PreparedScene& sc, const SceneArrays& a, const Render
     for (SceneGrads& g : grads) g.resize_like(a);
     int n_tiles = bins.nx * bins.ny;
 
-    // Interior term.
+    // Interior term (and, for the analytical prefilter, all of it: coverage is a smooth
+    // function of the geometry there, so there is no boundary term).
+    const bool analytic = o.mode == MODE_ANALYTIC;
     ThreadPool::instance().parallel_for(lanes, lanes, [&](int lane, int) {
         SceneGrads& g = grads[lane];
         std::vector<Hit> hits;
@@ -645,18 +810,35 @@ void render_backward(const PreparedScene& sc, const SceneArrays& a, const Render
                         double w = filter_weight(o.filter, R, dx, dy) / wsum;
                         if (w <= 0) continue;
                         Vec2 p{x + 0.5 + dx, y + 0.5 + dy};
-                        if (collect_hits(sc, bins, p, -1, hits) == 0) continue;
+                        if (analytic) collect_hits_analytic(sc, bins, p, R, hits);
+                        else collect_hits(sc, bins, p, -1, hits);
+                        if (hits.empty()) continue;
                         double c[4], gs[4];
                         composite(sc, hits, &tape, c);
                         for (int i = 0; i < 4; ++i) gs[i] = w * gp[i];
                         composite_backward(sc, hits, tape, gs, g_hits, g);
-                        for (size_t k = 0; k < hits.size(); ++k)
-                            paint_color_backward(sc, sc.draws[hits[k].draw].paint, p, g_hits[k].data(), g);
+                        for (size_t k = 0; k < hits.size(); ++k) {
+                            const Hit& h = hits[k];
+                            double gpaint[4];
+                            for (int i = 0; i < 4; ++i) gpaint[i] = h.cov * g_hits[k][i];
+                            paint_color_backward(sc, sc.draws[h.draw].paint, p, gpaint, g);
+                            if (!analytic) continue;
+                            double g_cov = 0;
+                            for (int i = 0; i < 4; ++i) g_cov += g_hits[k][i] * h.paint[i];
+                            double g_sd = g_cov * kernel_slope(h.sd / R) / R;
+                            if (g_sd != 0) sdf_backward(sc, h, p, g_sd, g);
+                        }
                     }
                 }
             }
         }
     });
+
+    if (analytic) {
+        out = grads[0];
+        for (int l = 1; l < lanes; ++l) out.add(grads[l]);
+        return;
+    }
 
     // Boundary term.
     BoundaryPass pass(sc, o, boundary_density);

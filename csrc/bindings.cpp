@@ -138,7 +138,6 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
     RenderOptions o = render_options(width, height, samples, mode, filter, filter_radius, seed, threads, background);
     if (image.size() != (py::ssize_t)width * height * 4 || d_image.size() != image.size())
         throw std::invalid_argument("image and its gradient must be height x width x 4");
-    if (o.mode != MODE_MC) throw std::invalid_argument("gradients of the analytical prefilter are not implemented yet");
     SceneGrads g;
     {
         py::gil_scoped_release release;
@@ -180,7 +179,7 @@ PYBIND11_MODULE(_core, m) {
           py::arg("filter"), py::arg("filter_radius"), py::arg("seed"), py::arg("threads"), py::arg("background"),
           py::arg("brute_force") = false);
     m.def("render_grad", &render_grad,
-          "Gradients of the scene arrays given the forward image and dL/d(image) (Monte Carlo mode)",
+          "Gradients of the scene arrays given the forward image and dL/d(image)",
           py::arg("scene"), py::arg("image"), py::arg("d_image"), py::arg("width"), py::arg("height"),
           py::arg("samples"), py::arg("mode"), py::arg("filter"), py::arg("filter_radius"), py::arg("seed"),
           py::arg("threads"), py::arg("background"), py::arg("boundary_density"));

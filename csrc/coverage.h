@@ -27,6 +27,15 @@
 
 namespace vf {
 
+// Which piece a signed distance came from, for its gradient (analytical prefilter).
+struct SdfArg {
+    enum Kind { NONE, SEGMENT, ELLIPSE, SWEEP, BUTT, END } kind = NONE;
+    int item = -1;     // fill or stroke item (global index)
+    int side = 0;      // BUTT / END: 0 at the item's start, 1 at its end
+    double t = 0;      // SEGMENT / SWEEP: parameter of the closest point
+    Vec2 closest;      // SEGMENT / SWEEP / ELLIPSE: the closest point
+};
+
 // Signed crossings of the ray from p towards +x, up to and including x_max, with the
 // segment; each y-monotone piece counts on the half-open range [y_low, y_high) so that
 // pieces meeting at a vertex are counted once. +1 where the curve moves towards +y.
@@ -146,11 +155,17 @@ inline int sweep_critical_points(const Segment& s, Vec2 q, double* ts) {
 
 // Signed distance to the sweep's boundary from its critical points alone (offset curves):
 // min over critical points of (|B(t*) - q| - w/2); +huge when there are none.
-inline double sweep_sdf(const Segment& s, Vec2 q, double hw) {
+inline double sweep_sdf(const Segment& s, Vec2 q, double hw, double* t_best = nullptr) {
     double ts[5];
     int n = sweep_critical_points(s, q, ts);
     double best = 1e300;
-    for (int i = 0; i < n; ++i) best = std::min(best, distance(seg_eval(s, ts[i]), q) - hw);
+    for (int i = 0; i < n; ++i) {
+        double v = distance(seg_eval(s, ts[i]), q) - hw;
+        if (v < best) {
+            best = v;
+            if (t_best) *t_best = ts[i];
+        }
+    }
     return best;
 }
 
@@ -183,21 +198,35 @@ inline bool stroke_item_contains(const StrokeSegment& s, Vec2 q, double hw) {
 
 // Signed distance (stroke space) to this item's pieces. The butt end lines of free ends
 // bound the sweep; other end normals are interior seams covered by a join or cap.
-inline double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double hw, double limit) {
+inline double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double hw, double limit, SdfArg* arg = nullptr) {
     // Farther than hw + limit from the hull: the sweep cannot bring the distance under limit.
-    double sd = near_segment(s, q, hw + limit) ? sweep_sdf(s.seg, q, hw) : 1e300;
+    double t = 0;
+    double sd = near_segment(s, q, hw + limit) ? sweep_sdf(s.seg, q, hw, &t) : 1e300;
+    SdfArg::Kind kind = SdfArg::SWEEP;
+    int side = 0;
     if (s.butt_start || s.butt_end) {
         double dl = 1e300;
+        int dl_side = 0;
         for (int k = 0; k < 2; ++k) {
             if (!(k == 0 ? s.butt_start : s.butt_end)) continue;
             Vec2 at = k == 0 ? s.seg.p[0] : seg_end(s.seg);
             Vec2 n = perp(seg_end_tangent(s.seg, k == 1));
-            dl = std::min(dl, point_line_segment_distance(q, at - hw * n, at + hw * n));
+            double v = point_line_segment_distance(q, at - hw * n, at + hw * n);
+            if (v < dl) { dl = v; dl_side = k; }
         }
-        sd = sd <= 0 ? std::max(sd, -dl) : std::min(sd, dl);
+        double combined = sd <= 0 ? std::max(sd, -dl) : std::min(sd, dl);
+        if (combined != sd) { kind = SdfArg::BUTT; side = dl_side; }
+        sd = combined;
     }
-    sd = std::min(sd, end_sdf(s.start, q, hw));
-    sd = std::min(sd, end_sdf(s.end, q, hw));
+    double e0 = end_sdf(s.start, q, hw), e1 = end_sdf(s.end, q, hw);
+    if (e0 < sd) { sd = e0; kind = SdfArg::END; side = 0; }
+    if (e1 < sd) { sd = e1; kind = SdfArg::END; side = 1; }
+    if (arg) {
+        arg->kind = kind;
+        arg->side = side;
+        arg->t = t;
+        if (kind == SdfArg::SWEEP) arg->closest = seg_eval(s.seg, t);
+    }
     return sd;
 }
 
@@ -224,14 +253,31 @@ inline int draw_winding_all(const PreparedScene& sc, const PreparedDraw& d, Vec2
 
 // Distance from p to the closest fill segment among items, or `limit` if none is closer.
 template <class Items>
-double fill_distance(const PreparedScene& sc, const PreparedDraw& d, const Items& items, Vec2 p, double limit) {
+double fill_distance(const PreparedScene& sc, const PreparedDraw& d, const Items& items, Vec2 p, double limit,
+                     SdfArg* arg = nullptr) {
     const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
     double best = limit;
     for (int i = 0; i < items.size(); ++i) {
         const PreparedSegment& s = segs[items[i]];
         if (distance2(s.box, p) >= best * best) continue;
-        if (s.seg.degree == 1) best = std::min(best, point_line_segment_distance(p, s.seg.p[0], s.seg.p[1]));
-        else best = std::min(best, seg_closest(s.seg, p).dist);
+        Closest c;
+        if (s.seg.degree == 1) {
+            Vec2 a = s.seg.p[0], e = s.seg.p[1] - a;
+            double l2 = dot(e, e);
+            c.t = l2 > 0 ? std::clamp(dot(p - a, e) / l2, 0.0, 1.0) : 0.0;
+            c.dist = distance(a + c.t * e, p);
+        } else {
+            c = seg_closest(s.seg, p);
+        }
+        if (c.dist < best) {
+            best = c.dist;
+            if (arg) {
+                arg->kind = SdfArg::SEGMENT;
+                arg->item = d.first_item + items[i];
+                arg->t = c.t;
+                arg->closest = seg_eval(s.seg, c.t);
+            }
+        }
     }
     return best;
 }
@@ -255,27 +301,44 @@ bool stroke_contains(const PreparedScene& sc, const PreparedDraw& d, const Items
 
 // Signed distance in pixels to the stroke (negative inside), clamped to [-limit, limit].
 template <class Items>
-double stroke_sdf(const PreparedScene& sc, const PreparedDraw& d, const Items& items, Vec2 p, double limit) {
+double stroke_sdf(const PreparedScene& sc, const PreparedDraw& d, const Items& items, Vec2 p, double limit,
+                  SdfArg* arg = nullptr) {
     Vec2 q = to_stroke_space(d, p);
     double hw = d.half_width;
     double sd = 1e300;
     if (d.is_ellipse) {
         Vec2 c;
         sd = ellipse_closest(d.ellipse, q, c) - hw;
+        if (arg) {
+            arg->kind = SdfArg::ELLIPSE;
+            arg->closest = c;
+        }
     } else {
         const StrokeSegment* all = sc.stroke_items.data() + d.first_item;
+        SdfArg local;
         for (int i = 0; i < items.size(); ++i) {
             Box b = grown(all[items[i]].box, limit);
             if (p.x < b.x0 || p.x > b.x1 || p.y < b.y0 || p.y > b.y1) continue;
-            sd = std::min(sd, stroke_item_sdf(all[items[i]], q, hw, limit / d.metric_scale));
+            double v = stroke_item_sdf(all[items[i]], q, hw, limit / d.metric_scale, arg ? &local : nullptr);
+            if (v < sd) {
+                sd = v;
+                if (arg) {
+                    *arg = local;
+                    arg->item = d.first_item + items[i];
+                }
+            }
         }
     }
     return std::clamp(sd * d.metric_scale, -limit, limit);
 }
 
-inline double ellipse_fill_sdf(const PreparedDraw& d, Vec2 p, double limit) {
+inline double ellipse_fill_sdf(const PreparedDraw& d, Vec2 p, double limit, SdfArg* arg = nullptr) {
     Vec2 c;
     double dist = std::min(ellipse_closest(d.ellipse, p, c), limit);
+    if (arg) {
+        arg->kind = SdfArg::ELLIPSE;
+        arg->closest = c;
+    }
     return ellipse_contains(d.ellipse, p) ? -dist : dist;
 }
 

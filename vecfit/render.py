@@ -72,9 +72,9 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     pixels (box always covers exactly the pixel). background: None (transparent) or an
     RGBA / RGB sequence in [0, 1]. threads: None or 0 for all cores.
 
-    The result is differentiable with respect to every tensor of the scene (Monte Carlo
-    mode): the backward pass samples the boundaries at ``boundary_samples`` points per
-    pixel of boundary length, with the same seed.
+    The result is differentiable with respect to every tensor of the scene. In "mc" mode
+    the backward pass samples the boundaries (``boundary_samples`` points per pixel of
+    boundary length, same seed); in "analytic" mode it differentiates the prefilter.
     """
     if mode not in MODES:
         raise VecfitError(f"mode must be one of {', '.join(MODES)}, not {mode!r}")
@@ -106,8 +106,6 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
         scene_np.update({n: t.detach().numpy() for n, t in zip(FLOAT_INPUTS, floats)})
         return torch.from_numpy(_core.render(scene_np, **settings, brute_force=True))
     if torch.is_grad_enabled() and any(t.requires_grad for t in floats):
-        if mode != "mc":
-            raise VecfitError("gradients are available in Monte Carlo mode (mode='mc') so far")
         return _Render.apply(settings, float(boundary_samples), structure, *floats)
     with torch.no_grad():
         return _Render.forward(_Ctx(), settings, float(boundary_samples), structure, *floats)

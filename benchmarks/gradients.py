@@ -1,0 +1,109 @@
+"""Backward speed: forward and backward times on the benchmark scenes, and a painterly
+workload (random open cubic strokes) as one Adam iteration would run it.
+
+    python benchmarks/gradients.py [--threads 2] [--repeats 5]
+
+Loss = sum of the squared image (as in diffvg's timings). Times are medians after a
+warm-up; "iteration" is forward + backward + an Adam step.
+"""
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+import warnings
+
+import numpy as np
+import torch
+
+from common import SCENES
+
+import vecfit
+from vecfit.scene import Path, Scene, Shape, Solid
+
+
+def timed(fn, repeats):
+    fn()
+    out = []
+    for _ in range(repeats):
+        out.append(fn())
+    return [statistics.median(x) for x in zip(*out)]
+
+
+def scene_workload(name, mode, samples, threads, repeats):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        scene = vecfit.load_svg(SCENES / f"{name}.svg")
+    params = [s.geometry.points for s in scene.shapes if hasattr(s.geometry, "points")]
+    for p in params:
+        p.requires_grad_(True)
+
+    def run():
+        t0 = time.perf_counter()
+        img = vecfit.render(scene, samples=samples, mode=mode, threads=threads)
+        t1 = time.perf_counter()
+        (img ** 2).sum().backward()
+        t2 = time.perf_counter()
+        for p in params:
+            p.grad = None
+        return t1 - t0, t2 - t1
+    return timed(run, repeats)
+
+
+def strokes_scene(n, size, seed=0):
+    """n open strokes of 1-3 cubic segments, widths 1-5 px, random colours with alpha."""
+    rng = np.random.default_rng(seed)
+    shapes = []
+    for _ in range(n):
+        segs = int(rng.integers(1, 4))
+        start = rng.uniform(0, size, 2)
+        pts = [start]
+        for _ in range(segs):
+            for _ in range(3):
+                pts.append(pts[-1] + rng.normal(0, size / 12, 2))
+        path = Path(points=torch.tensor(np.array(pts), dtype=torch.float32, requires_grad=True),
+                    degrees=np.full(segs, 3), subpaths=[(0, segs, False)])
+        shapes.append(Shape(geometry=path, stroke=Solid(torch.tensor(rng.uniform(0, 1, 4), dtype=torch.float32,
+                                                                     requires_grad=True)),
+                            stroke_width=torch.tensor(float(rng.uniform(1, 5)), requires_grad=True),
+                            linecap="round", linejoin="round"))
+    return Scene(width=size, height=size, shapes=shapes)
+
+
+def strokes_workload(size, threads, repeats):
+    scene = strokes_scene(256, size)
+    params = scene.parameters()
+    tensors = params["points"] + params["colors"] + params["stroke_widths"]
+    opt = torch.optim.Adam(tensors, lr=0.01)
+    target = torch.rand(size, size, 4, generator=torch.Generator().manual_seed(1))
+
+    def run():
+        t0 = time.perf_counter()
+        opt.zero_grad()
+        img = vecfit.render(scene, samples=2, threads=threads)
+        t1 = time.perf_counter()
+        ((img - target) ** 2).sum().backward()
+        t2 = time.perf_counter()
+        opt.step()
+        t3 = time.perf_counter()
+        return t1 - t0, t2 - t1, t3 - t0
+    return timed(run, repeats)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--repeats", type=int, default=5)
+    args = ap.parse_args()
+    print(f"threads={args.threads}, median of {args.repeats}; seconds")
+    print(f"{'workload':34s} {'forward':>9s} {'backward':>9s} {'iteration':>10s}")
+    for name in ["tiger", "mcseem2", "boston"]:
+        f, b = scene_workload(name, "mc", 2, args.threads, args.repeats)
+        print(f"{name + ', MC 2x2':34s} {f:9.3f} {b:9.3f} {'':>10s}")
+    for size in (256, 512):
+        f, b, it = strokes_workload(size, args.threads, args.repeats)
+        print(f"{f'256 strokes at {size}x{size}, MC 2x2':34s} {f:9.3f} {b:9.3f} {it:10.3f}")
+
+
+if __name__ == "__main__":
+    main()
