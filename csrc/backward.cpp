@@ -157,6 +157,39 @@ void collect_hits_analytic(const PreparedScene& sc, const TileBins& bins, Vec2 p
     }
 }
 
+// The jump at p when draw `forced` comes to cover it, for scenes without layers:
+// composite = F + T (c_d + (1 - a_d) B) with the draw, F + T B without it, where T is
+// the transmittance of what lies in front of the draw and B the composite behind it, so
+// delta = T (c_d - a_d B). One front-to-back pass that stops as soon as T is 0 (the
+// draw is hidden) or B is opaque.
+void jump_without_layers(const PreparedScene& sc, const TileBins& bins, Vec2 p, int forced, double delta[4]) {
+    for (int i = 0; i < 4; ++i) delta[i] = 0;
+    int tile = tile_of(bins, p);
+    Box region = bins.region(tile);
+    if (p.x < region.x0 || p.x > region.x1 || p.y < region.y0 || p.y > region.y1) return;
+    const TileEntry* es = bins.begin(tile);
+    double T = 1, B[4] = {0, 0, 0, 0}, c[4];
+    for (int k = bins.count(tile) - 1; k >= 0; --k) {
+        int draw = es[k].draw;
+        if (draw == forced) continue;
+        if (draw > forced) {  // in front
+            if (!covers(sc, bins, es[k], region, p)) continue;
+            paint_color(sc, sc.paints[sc.draws[draw].paint], p, c);
+            T *= 1 - c[3];
+            if (T <= 0) return;
+        } else {  // behind
+            if (!covers(sc, bins, es[k], region, p)) continue;
+            paint_color(sc, sc.paints[sc.draws[draw].paint], p, c);
+            double k2 = 1 - B[3];
+            for (int i = 0; i < 4; ++i) B[i] += k2 * c[i];
+            if (B[3] >= 1) break;
+        }
+    }
+    double cd[4];
+    paint_color(sc, sc.paints[sc.draws[forced].paint], p, cd);
+    for (int i = 0; i < 4; ++i) delta[i] = T * (cd[i] - cd[3] * B[i]);
+}
+
 // Compositing of hits (given front to back) evaluated back to front, with the tape needed
 // to run it in reverse.
 struct Tape {
@@ -333,6 +366,16 @@ void stroke_item_indices(const PreparedScene& sc, const StrokeSegment& s, int32_
         idx[s.seg.degree] = src.point_index[src.seg.degree];
     }
 }
+
+// The whole stroke-space segment a stroke item is a piece of (as preparation made it).
+Segment whole_segment(const PreparedScene& sc, const PreparedDraw& d, const StrokeSegment& s) {
+    Segment w = sc.segments[s.source].seg;
+    if (!d.metric_identity) w = transformed(w, d.metric);
+    return straightened(w);
+}
+
+// A piece's parameter t as a parameter of the whole segment.
+inline double whole_t(const StrokeSegment& s, double t) { return s.t0 + t * (s.t1 - s.t0); }
 
 // The frame of a stroke item's end: unit tangent (direction of travel) and the two
 // control points it comes from (head - tail), with their distance, in stroke space.
@@ -514,7 +557,7 @@ private:
         int32_t idx[4];
         stroke_item_indices(sc_, s, idx);
         for (int i = 0; i <= s.seg.degree; ++i)
-            add_point_dir(d, g, bs, idx[i], n_q, factor, bernstein(s.seg.degree, i, t));
+            add_point_dir(d, g, bs, idx[i], n_q, factor, bernstein(s.seg.degree, i, whole_t(s, t)));
         bs.add(&g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * factor);
         return true;
     }
@@ -536,21 +579,22 @@ private:
         eg.butt = side == 0 ? s.butt_start : s.butt_end;
         if (e.kind == StrokeEnd::NONE && !eg.butt) return eg;
         eg.valid = true;
+        // Frames of the whole segments (a piece's end frame is the whole segment's, and
+        // its control points are the ones the gradients belong to).
         if (side == 0) {
             eg.at = s.seg.p[0];
-            eg.in = end_frame(s.seg, false);
+            eg.in = end_frame(whole_segment(sc_, d, s), false);
             eg.out_axis = -eg.in.t;
         } else {
             eg.at = seg_end(s.seg);
-            eg.in = end_frame(s.seg, true);
+            eg.in = end_frame(whole_segment(sc_, d, s), true);
             eg.out_axis = eg.in.t;
             if (s.next >= 0 && e.kind != StrokeEnd::NONE && !eg.butt) {
                 eg.join = true;
-                eg.out = end_frame(sc_.stroke_items[s.next].seg, false);
+                eg.out = end_frame(whole_segment(sc_, d, sc_.stroke_items[s.next]), false);
             }
         }
         if (e.kind == StrokeEnd::SQUARE || e.kind == StrokeEnd::DISK) eg.out_axis = e.kind == StrokeEnd::SQUARE ? e.axis : eg.out_axis;
-        (void)d;
         return eg;
     }
 
@@ -716,16 +760,16 @@ void sdf_backward(const PreparedScene& sc, const Hit& h, Vec2 p, double g_sd, Sc
         int32_t idx[4];
         stroke_item_indices(sc, s, idx);
         for (int i = 0; i <= s.seg.degree; ++i)
-            add_pixel_point(idx[i], (gs * bernstein(s.seg.degree, i, arg.t)) * mt(dir));
+            add_pixel_point(idx[i], (gs * bernstein(s.seg.degree, i, whole_t(s, arg.t))) * mt(dir));
         return;
     }
     // BUTT / END: rebuild the piece from (vertex, tangent angles, half width).
     const StrokeSegment& s = sc.stroke_items[arg.item];
     int side = arg.side;
     bool point = s.seg.degree == 1 && s.seg.p[0].x == s.seg.p[1].x && s.seg.p[0].y == s.seg.p[1].y;
-    EndFrame in = end_frame(s.seg, side == 1), out;
+    EndFrame in = end_frame(whole_segment(sc, d, s), side == 1), out;
     bool join = side == 1 && arg.kind == SdfArg::END && s.next >= 0 && s.end.kind != StrokeEnd::NONE;
-    if (join) out = end_frame(sc.stroke_items[s.next].seg, false);
+    if (join) out = end_frame(whole_segment(sc, d, sc.stroke_items[s.next]), false);
     Vec2 V = side == 0 ? s.seg.p[0] : seg_end(s.seg);
     double sign = h.sd < 0 ? -1 : 1;
     auto value = [&](Vec2 qq, Vec2 t_in, Vec2 t_out, double w) {
@@ -841,6 +885,7 @@ void render_backward(const PreparedScene& sc, const SceneArrays& a, const Render
     }
 
     // Boundary term.
+    const bool no_layers = sc.layer_parent.size() <= 1;
     BoundaryPass pass(sc, o, boundary_density);
     std::vector<Piece> pieces = pass.pieces();
     double filter_integral = 1.0;  // of the unnormalised filter over its support
@@ -868,13 +913,17 @@ void render_backward(const PreparedScene& sc, const SceneArrays& a, const Render
                 }
                 if (!in_minus || in_plus) continue;  // no change of coverage across p
                 Vec2 outside = p + EPS_NORMAL * bs.n;
-                double c_in[4], c_out[4];
-                collect_hits(sc, bins, outside, bs.draw, hits);
-                composite(sc, hits, nullptr, c_in);
-                collect_hits(sc, bins, outside, -1, hits);
-                composite(sc, hits, nullptr, c_out);
                 double delta[4];
-                for (int i = 0; i < 4; ++i) delta[i] = c_in[i] - c_out[i];
+                if (no_layers) {
+                    jump_without_layers(sc, bins, outside, bs.draw, delta);
+                } else {
+                    double c_in[4], c_out[4];
+                    collect_hits(sc, bins, outside, bs.draw, hits);
+                    composite(sc, hits, nullptr, c_in);
+                    collect_hits(sc, bins, outside, -1, hits);
+                    composite(sc, hits, nullptr, c_out);
+                    for (int i = 0; i < 4; ++i) delta[i] = c_in[i] - c_out[i];
+                }
                 if (delta[0] == 0 && delta[1] == 0 && delta[2] == 0 && delta[3] == 0) continue;
                 int x0 = std::max(0, (int)std::floor(p.x - R)), x1 = std::min(W - 1, (int)std::floor(p.x + R));
                 int y0 = std::max(0, (int)std::floor(p.y - R)), y1 = std::min(H - 1, (int)std::floor(p.y + R));

@@ -53,4 +53,31 @@ inline StrokeEnd make_cap(Vec2 at, Vec2 outward, int cap) {
     return e;
 }
 
+inline Segment transformed(const Segment& s, const Mat2& m) {
+    Segment out = s;
+    for (int i = 0; i <= s.degree; ++i) out.p[i] = m * s.p[i];
+    return out;
+}
+
+// A curve whose control points all lie within sqrt(1e-5) of its length from its chord
+// is stroked as that straight line, as Skia and resvg do: the direction at the end of
+// such a curve is decided by sub-pixel control-point offsets, and stroking it exactly
+// grows visible fins and rounds that those renderers (and users) do not expect.
+inline Segment straightened(const Segment& s) {
+    if (s.degree == 1) return s;
+    Vec2 a = s.p[0], b = seg_end(s), d = b - a;
+    double l2 = dot(d, d);
+    if (l2 <= 0) return s;
+    for (int i = 1; i < s.degree; ++i) {
+        Vec2 r = s.p[i] - a;
+        double along = dot(r, d) / l2, off = cross(d, r);
+        if (along < 0 || along > 1 || off * off > 1e-5 * l2 * l2) return s;
+    }
+    Segment line;
+    line.degree = 1;
+    line.p[0] = a;
+    line.p[1] = b;
+    return line;
+}
+
 }  // namespace vf

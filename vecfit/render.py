@@ -63,7 +63,7 @@ class _Render(torch.autograd.Function):
 
 def render(scene: Scene, width: int | None = None, height: int | None = None, *,
            samples: int = 2, mode: str = "mc", filter: str = "box", filter_radius: float = 0.5,
-           seed: int = 0, background=None, threads: int | None = None, boundary_samples: float = 4.0,
+           seed: int = 0, background=None, threads: int | None = None, boundary_samples: float = 2.0,
            _brute_force: bool = False) -> torch.Tensor:
     """Render ``scene`` into an [H, W, 4] float tensor of straight RGBA.
 
