@@ -90,6 +90,32 @@ def strokes_workload(size, threads, repeats):
     return timed(run, repeats)
 
 
+def growth(size, threads, iterations=100):
+    """Time per Adam iteration at the start and at the end of a run on the painterly
+    workload (diffvg's grows by half as the strokes spread)."""
+    scene = strokes_scene(256, size, seed=3)
+    params = scene.parameters()
+    opt = torch.optim.Adam([{"params": params["points"], "lr": 1.0},
+                            {"params": params["colors"], "lr": 0.01},
+                            {"params": params["stroke_widths"], "lr": 0.1}])
+    yy, xx = torch.meshgrid(torch.linspace(0, 1, size), torch.linspace(0, 1, size), indexing="ij")
+    target = torch.stack([xx, yy, 1 - xx, torch.ones_like(xx)], dim=-1)
+    times = []
+    for _ in range(iterations):
+        t0 = time.perf_counter()
+        opt.zero_grad()
+        img = vecfit.render(scene, samples=2, threads=threads)
+        ((img - target) ** 2).sum().backward()
+        opt.step()
+        with torch.no_grad():
+            for w in params["stroke_widths"]:
+                w.clamp_(0.5, 20)
+            for c in params["colors"]:
+                c.clamp_(0, 1)
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times[1:11]), statistics.median(times[-10:])
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--threads", type=int, default=2)
@@ -100,9 +126,16 @@ def main():
     for name in ["tiger", "mcseem2", "boston"]:
         f, b = scene_workload(name, "mc", 2, args.threads, args.repeats)
         print(f"{name + ', MC 2x2':34s} {f:9.3f} {b:9.3f} {'':>10s}")
+    for name in ["tiger", "mcseem2", "boston"]:
+        f, b = scene_workload(name, "analytic", 1, args.threads, args.repeats)
+        print(f"{name + ', analytic 1x1':34s} {f:9.3f} {b:9.3f} {'':>10s}")
     for size in (256, 512):
         f, b, it = strokes_workload(size, args.threads, args.repeats)
         print(f"{f'256 strokes at {size}x{size}, MC 2x2':34s} {f:9.3f} {b:9.3f} {it:10.3f}")
+    for size in (256, 512):
+        first, last = growth(size, args.threads)
+        print(f"painterly run at {size}x{size}: iterations 2-11 {first:.3f} s, last 10 of 100 {last:.3f} s "
+              f"({last / first:.2f}x)")
 
 
 if __name__ == "__main__":

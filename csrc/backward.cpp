@@ -95,13 +95,19 @@ int collect_hits(const PreparedScene& sc, const TileBins& bins, Vec2 p, int forc
     const TileEntry* es = bins.begin(tile);
     int n = in_region ? bins.count(tile) : 0;
     bool forced_done = forced < 0;
+    // Without layers, what lies behind a second opaque draw cannot matter: the first
+    // opaque one hides it, and that one's alpha derivative needs only the composite behind
+    // it, which the second one ends.
+    bool may_stop = forced < 0 && sc.layer_parent.size() <= 1;
+    int opaque = 0;
     auto add = [&](int draw) {
         Hit h;
         h.draw = draw;
         paint_color(sc, sc.paints[sc.draws[draw].paint], p, h.c);
         hits.push_back(h);
+        if (h.c[3] >= 1) ++opaque;
     };
-    for (int k = n - 1; k >= 0; --k) {
+    for (int k = n - 1; k >= 0 && !(may_stop && opaque >= 2); --k) {
         int draw = es[k].draw;
         if (!forced_done && forced > draw) {
             add(forced);
@@ -352,7 +358,10 @@ double polygon_length(const Segment& s) {
 
 double bernstein(int n, int i, double t) {
     static const double binom[4][4] = {{1, 0, 0, 0}, {1, 1, 0, 0}, {1, 2, 1, 0}, {1, 3, 3, 1}};
-    return binom[n][i] * std::pow(t, i) * std::pow(1 - t, n - i);
+    double u = 1 - t, v = binom[n][i];
+    for (int k = 0; k < i; ++k) v *= t;
+    for (int k = i; k < n; ++k) v *= u;
+    return v;
 }
 
 // Pixel-space control-point indices of a stroke item (its straightened form uses the ends).
@@ -904,7 +913,10 @@ void render_backward(const PreparedScene& sc, const SceneArrays& a, const Render
                 if (!pass.sample(pc, j, (uint64_t)k, g, bs)) continue;
                 Vec2 p = bs.p;
                 if (!(p.x >= -R && p.x <= W + R && p.y >= -R && p.y <= H + R)) continue;
-                bool in_minus = draw_covers_at(sc, bins, bs.draw, p - EPS_NORMAL * bs.n);
+                // Just inside a stroke piece is inside the stroke by construction (within
+                // w/2 of the curve along its normal); fills need both sides for orientation.
+                bool fill_piece = pc.kind == Piece::FILL_SEGMENT || (pc.kind == Piece::ELLIPSE && pc.side == 0);
+                bool in_minus = !fill_piece || draw_covers_at(sc, bins, bs.draw, p - EPS_NORMAL * bs.n);
                 bool in_plus = draw_covers_at(sc, bins, bs.draw, p + EPS_NORMAL * bs.n);
                 if (pc.kind == Piece::FILL_SEGMENT && !in_minus && in_plus) {
                     bs.n = -bs.n;  // the segment runs the other way round

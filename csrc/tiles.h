@@ -1,4 +1,5 @@
-// Tile binning: for each 16x16 pixel tile, the draws that can reach it, in paint order,
+// Tile binning: for each 8x8 pixel tile (measured against 16x16: the backward pass of
+// tiger and boston twice as fast, the forward pass the same), the draws that can reach it, in paint order,
 // each with the few segments that matter inside the tile.
 //
 // The winding number of a fill at a sample p in tile region R (the tile grown by how far
@@ -22,7 +23,7 @@
 
 namespace vf {
 
-constexpr int TILE = 16;
+constexpr int TILE = 8;
 
 struct LocalItem {
     int32_t item = 0;             // index into the draw's fill or stroke items
