@@ -434,12 +434,16 @@ public:
                 if (d.kind == DRAW_FILL) {
                     out.push_back({Piece::FILL_SEGMENT, di, k, 0, count(polygon_length(sc_.fill_items[d.first_item + k].seg))});
                 } else {
+                    // Offset curves are about as long as the curve plus hw times its turning.
                     const StrokeSegment& s = sc_.stroke_items[d.first_item + k];
-                    double len = (polygon_length(s.seg) + 2 * M_PI * d.half_width) * d.metric_scale;
+                    Vec2 ta = seg_end_tangent(s.seg, false), tb = seg_end_tangent(s.seg, true);
+                    double turn = std::acos(std::clamp(dot(ta, tb), -1.0, 1.0));
+                    double len = (polygon_length(s.seg) + d.half_width * turn) * d.metric_scale;
                     for (int side = -1; side <= 1; side += 2) out.push_back({Piece::OFFSET, di, k, side, count(len)});
-                    double end_len = 2 * M_PI * d.half_width * d.metric_scale + 4 * d.half_width * d.miter_limit;
-                    out.push_back({Piece::END, di, k, 0, count(end_len)});   // start piece
-                    out.push_back({Piece::END, di, k, 1, count(end_len)});   // end piece
+                    // Caps and joins only where there are some (pieces of one curve meet smoothly).
+                    double end_len = (2 * M_PI * d.half_width + 4 * d.half_width * d.miter_limit) * d.metric_scale;
+                    if (s.start.kind != StrokeEnd::NONE || s.butt_start) out.push_back({Piece::END, di, k, 0, count(end_len)});
+                    if (s.end.kind != StrokeEnd::NONE || s.butt_end) out.push_back({Piece::END, di, k, 1, count(end_len)});
                 }
             }
         }

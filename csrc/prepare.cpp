@@ -75,6 +75,25 @@ void add_end_to_box(Box& b, const StrokeEnd& e, double hw) {
     }
 }
 
+// Whether the squared distance from any point within `reach` of the segment is strictly
+// convex along it, so that it has at most one critical point there. True when the
+// radius of curvature everywhere exceeds the segment's length plus the reach: the speed
+// is at least the smallest projection of the hodograph's control points on the chord
+// direction u, and |B''| at most the largest second difference, so R >= speed^2 / |B''|.
+bool is_simple(const Segment& s, Vec2 u, double reach) {
+    if (s.degree == 1) return true;
+    double min_proj = 1e300, max_second = 0, len = 0;
+    for (int i = 0; i < s.degree; ++i) {
+        min_proj = std::min(min_proj, s.degree * dot(s.p[i + 1] - s.p[i], u));
+        len += distance(s.p[i], s.p[i + 1]);
+    }
+    for (int i = 0; i + 2 <= s.degree; ++i)
+        max_second = std::max(max_second, s.degree * (s.degree - 1) * length(s.p[i] - 2.0 * s.p[i + 1] + s.p[i + 2]));
+    if (min_proj <= 0) return false;
+    if (max_second <= 0) return true;
+    return min_proj * min_proj / max_second > len + reach;
+}
+
 // Stroke pieces of one subpath of a stroke draw, appended to out.
 void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool closed,
                           const PreparedDraw& d, std::vector<StrokeSegment>& out) {
@@ -149,6 +168,7 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
             ss.n_min = std::min(ss.n_min, cross(u, r));
             ss.n_max = std::max(ss.n_max, cross(u, r));
         }
+        ss.simple = is_simple(s, u, hw + 4.0);  // reach: the half width plus any prefilter radius used
         Box b = grown(seg_bbox(ss.seg), hw);
         add_end_to_box(b, ss.start, hw);
         add_end_to_box(b, ss.end, hw);

@@ -80,6 +80,9 @@ struct StrokeSegment {
     // a tighter bound than the box, which spares most samples the quintic.
     Vec2 frame_u{1, 0};
     double s_min = 0, s_max = 0, n_min = 0, n_max = 0;
+    // Gently curved (radius of curvature above the piece's length plus its reach): the
+    // distance to any point in reach has at most one critical point on the piece.
+    bool simple = false;
 };
 
 struct PreparedDraw {
