@@ -459,7 +459,7 @@ public:
         bs.draw = pc.draw;
         const PreparedDraw& d = sc_.draws[pc.draw];
         switch (pc.kind) {
-            case Piece::FILL_SEGMENT: return fill_sample(d, sc_.fill_items[d.first_item + pc.item], t, pc.count, g, bs);
+            case Piece::FILL_SEGMENT: return fill_sample(sc_.fill_items[d.first_item + pc.item], t, pc.count, g, bs);
             case Piece::ELLIPSE: return ellipse_sample(pc, d, t, g, bs);
             case Piece::OFFSET: return offset_sample(pc, d, t, g, bs);
             default: return end_sample(pc, d, t, v, g, bs);
@@ -501,8 +501,7 @@ private:
         bs.add(&g.points, 2 * (size_t)idx + 1, w * factor * m.y);
     }
 
-    bool fill_sample(const PreparedDraw& d, const PreparedSegment& s, double t, int count, SceneGrads& g,
-                     BoundarySample& bs) const {
+    bool fill_sample(const PreparedSegment& s, double t, int count, SceneGrads& g, BoundarySample& bs) const {
         Vec2 dp = seg_deriv(s.seg, t);
         double speed = length(dp);
         if (speed <= 0) return false;
@@ -510,7 +509,6 @@ private:
         bs.n = (1 / speed) * Vec2{dp.y, -dp.x};  // one side; the caller picks the outward one
         bs.weight = speed / count;
         for (int i = 0; i <= s.seg.degree; ++i) add_point(g, bs, s.point_index[i], bs.n, bernstein(s.seg.degree, i, t));
-        (void)d;
         return true;
     }
 
@@ -583,7 +581,6 @@ private:
         bool valid = false, butt = false, join = false;
         Vec2 at;               // the vertex
         EndFrame in, out;      // frames: in = of this item's end (or start); out = the next item's start
-        Vec2 out_axis;         // caps: the outward direction
     };
 
     EndGeometry end_geometry(const PreparedDraw& d, const StrokeSegment& s, int side) const {
@@ -597,17 +594,14 @@ private:
         if (side == 0) {
             eg.at = s.seg.p[0];
             eg.in = end_frame(whole_segment(sc_, d, s), false);
-            eg.out_axis = -eg.in.t;
         } else {
             eg.at = seg_end(s.seg);
             eg.in = end_frame(whole_segment(sc_, d, s), true);
-            eg.out_axis = eg.in.t;
             if (s.next >= 0 && e.kind != StrokeEnd::NONE && !eg.butt) {
                 eg.join = true;
                 eg.out = end_frame(whole_segment(sc_, d, sc_.stroke_items[s.next]), false);
             }
         }
-        if (e.kind == StrokeEnd::SQUARE || e.kind == StrokeEnd::DISK) eg.out_axis = e.kind == StrokeEnd::SQUARE ? e.axis : eg.out_axis;
         return eg;
     }
 

@@ -31,6 +31,9 @@ def test_render_writes_rgba_png(svg, tmp_path):
     assert r.exit_code == 0, r.output
     im = Image.open(out)
     assert im.mode == "RGBA" and im.size == (40, 20)
+    umask = os.umask(0)
+    os.umask(umask)
+    assert out.stat().st_mode & 0o777 == 0o666 & ~umask  # as a plain open would make it
     a = np.asarray(im)
     assert tuple(a[10, 20]) == (255, 0, 0, 255) and a[0, 0, 3] == 0
 
