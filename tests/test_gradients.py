@@ -272,3 +272,22 @@ def test_analytic_circle_and_ellipse():
                   "e_center": torch.tensor([20.0, 24.0]), "radii": torch.tensor([9.0, 5.0])},
           {"center": 0.01, "radius": 0.01, "e_center": 0.01, "radii": 0.01}, rtol=0.02, atol=0.01,
           mode="analytic")
+
+
+@pytest.mark.parametrize("mode", ["mc", "analytic"])
+def test_no_nan_with_points_on_boundaries(mode):
+    """Edges through pixel centres and sample rows, vertices on pixel corners, a stroke
+    whose end lies on a fill's edge, and coincident control points: gradients finite."""
+    pts = torch.tensor([[10.5, 10.5], [30.5, 10.5], [30.5, 30.5], [10.5, 30.5]], requires_grad=True)
+    line = torch.tensor([[20.0, 10.5], [20.0, 20.0], [20.0, 20.0], [30.5, 20.0]], requires_grad=True)
+    width = torch.tensor(2.0, requires_grad=True)
+    shapes = [background(),
+              Shape(geometry=Path(points=pts, degrees=np.array([1, 1, 1, 1]), subpaths=[(0, 4, True)]),
+                    fill=solid(0.8, 0.2, 0.2, 0.9)),
+              Shape(geometry=Path(points=line, degrees=np.array([3]), subpaths=[(0, 1, False)]),
+                    stroke=solid(0.1, 0.1, 0.8, 1), stroke_width=width, linecap="square"),
+              Shape(geometry=Circle(torch.tensor([20.5, 20.5]), torch.tensor(0.5)), fill=solid(0, 1, 0, 1))]
+    img = vecfit.render(Scene(width=40, height=40, shapes=shapes), samples=4 if mode == "mc" else 1, mode=mode)
+    (img * W).sum().backward()
+    for t in (pts, line, width):
+        assert t.grad is not None and torch.isfinite(t.grad).all()
