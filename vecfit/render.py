@@ -35,20 +35,24 @@ FLOAT_INPUTS = ("points", "ellipses", "draw_params", "paint_params", "stop_offse
                 "layer_opacity")
 
 
+def _core_render(settings: dict, structure: dict, floats, brute_force: bool = False):
+    """The core's forward pass on the packed arrays: (the arrays it saw, image)."""
+    scene = dict(structure)
+    for name, t in zip(FLOAT_INPUTS, floats):
+        scene[name] = t.detach().cpu().numpy()
+    return scene, _core.render(scene, **settings, brute_force=brute_force)
+
+
 class _Render(torch.autograd.Function):
     """The core's forward pass; its backward returns the gradients of the float arrays
     (the autograd graph of vecfit.pack carries them on to the Scene's tensors)."""
 
     @staticmethod
     def forward(ctx, settings, boundary_density, structure, *floats):
-        scene = dict(structure)
-        for name, t in zip(FLOAT_INPUTS, floats):
-            scene[name] = t.detach().cpu().numpy()
-        image = _core.render(scene, **settings, brute_force=False)
-        ctx.scene, ctx.settings, ctx.image = scene, settings, image
-        ctx.boundary_density = boundary_density
+        ctx.scene, ctx.image = _core_render(settings, structure, floats)
+        ctx.settings, ctx.boundary_density = settings, boundary_density
         ctx.shapes = [t.shape for t in floats]
-        return torch.from_numpy(image)
+        return torch.from_numpy(ctx.image)
 
     @staticmethod
     def backward(ctx, grad_image):
@@ -101,15 +105,6 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     settings = dict(width=width, height=height, samples=int(samples), mode=mode, filter=filter,
                     filter_radius=float(filter_radius), seed=int(seed), threads=int(threads or 0),
                     background=background)
-    if _brute_force:
-        scene_np = dict(structure)
-        scene_np.update({n: t.detach().numpy() for n, t in zip(FLOAT_INPUTS, floats)})
-        return torch.from_numpy(_core.render(scene_np, **settings, brute_force=True))
-    if torch.is_grad_enabled() and any(t.requires_grad for t in floats):
+    if torch.is_grad_enabled() and any(t.requires_grad for t in floats) and not _brute_force:
         return _Render.apply(settings, float(boundary_samples), structure, *floats)
-    with torch.no_grad():
-        return _Render.forward(_Ctx(), settings, float(boundary_samples), structure, *floats)
-
-
-class _Ctx:
-    """Stands in for autograd's context when no gradient is needed."""
+    return torch.from_numpy(_core_render(settings, structure, floats, brute_force=_brute_force)[1])
