@@ -1,0 +1,533 @@
+"""Scene -> SVG: write a Scene's current values back into a copy of its source SVG.
+
+The source file is parsed again (comments and processing instructions kept), each
+Shape's and Group's element is found by its ``source`` handle (see ``read._handles``),
+and what the Scene models is written into that element; everything else (ids, classes,
+unknown attributes, unsupported content) stays as it was.
+
+By default only values that differ from what the source file itself gives are written,
+so an unchanged Scene reproduces the file's content (re-serialised by ElementTree);
+``full=True`` writes every modelled value (useful to check the writer).
+
+Style precedence: a property that the element's ``style`` attribute or a matching CSS
+rule sets is written into the ``style`` attribute (merged with what is there), anything
+else as a presentation attribute.
+"""
+from __future__ import annotations
+
+import gzip
+import io
+import math
+import re
+import warnings
+import xml.etree.ElementTree as ET
+from collections import Counter
+from pathlib import Path as FsPath
+
+import numpy as np
+import torch
+
+from ..errors import VecfitError
+from ..imageio import atomic_write
+from ..scene import Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect, Scene, Solid
+from .dom import is_svg, local_name, read_root
+from .paint import GRADIENTS
+from .style import INHERITED
+from .units import parse_length, translate
+
+__all__ = ["write_svg"]
+
+# Initial values of the properties written here (used to decide whether a property can be
+# dropped instead of written).
+INITIAL = {"opacity": "1", "fill-opacity": "1", "stroke-opacity": "1", "stop-opacity": "1",
+           "fill": "black", "stroke": "none", "stroke-width": "1"}
+
+
+# ------------------------------------------------------------------------ numbers
+
+def fmt(value, decimals: int = 4) -> str:
+    """A finite number, compact: at most ``decimals`` decimals, no trailing zeros."""
+    v = float(value)
+    if not math.isfinite(v):
+        raise VecfitError(f"cannot write a non-finite value ({v}) to SVG")
+    s = f"{v:.{decimals}f}"
+    if "." in s:
+        s = s.rstrip("0").rstrip(".")
+    return "0" if s in ("-0", "") else s
+
+
+def hex_color(rgba) -> str:
+    r, g, b = (min(max(float(c), 0.0), 1.0) for c in _finite(rgba)[:3])
+    return "#{:02x}{:02x}{:02x}".format(*(int(round(c * 255)) for c in (r, g, b)))
+
+
+def matrix(m) -> str:
+    a = _finite(m)
+    return "matrix({})".format(" ".join(fmt(v, 6) for v in
+                                        (a[0, 0], a[1, 0], a[0, 1], a[1, 1], a[0, 2], a[1, 2])))
+
+
+def _finite(t) -> np.ndarray:
+    a = t.detach().cpu().double().numpy() if isinstance(t, torch.Tensor) else np.asarray(t, float)
+    if not np.isfinite(a).all():
+        raise VecfitError("cannot write non-finite values (NaN or infinity) to SVG")
+    return a
+
+
+def path_data(path: Path) -> str:
+    """Absolute M/L/Q/C/Z path data; a closed subpath's closing line is Z."""
+    pts = _finite(path.points)
+    out, p = [], 0
+    letters = {1: "L", 2: "Q", 3: "C"}
+    for first, count, closed in path.subpaths:
+        degrees = [int(d) for d in path.degrees[first:first + count]]
+        out.append(f"M{fmt(pts[p, 0])} {fmt(pts[p, 1])}")
+        p += 1
+        body = degrees[:-1] if closed and degrees else degrees
+        for d in body:
+            coords = " ".join(f"{fmt(x)} {fmt(y)}" for x, y in pts[p:p + d])
+            out.append(letters[d] + coords)
+            p += d
+        if closed and degrees:
+            if degrees[-1] != 1:  # the reader always closes with a line
+                raise VecfitError("a closed subpath must end with a line segment")
+            out.append("Z")
+    return " ".join(out)
+
+
+# ---------------------------------------------------------------------- comparison
+
+def _same(a, b) -> bool:
+    if a is None or b is None:
+        return a is b
+    return a.shape == b.shape and torch.equal(a.detach().cpu(), b.detach().cpu())
+
+
+def _same_geometry(a, b) -> bool:
+    if type(a) is not type(b):
+        return False
+    if isinstance(a, Path):
+        return (_same(a.points, b.points) and np.array_equal(a.degrees, b.degrees)
+                and list(a.subpaths) == list(b.subpaths))
+    if isinstance(a, Circle):
+        return _same(a.center, b.center) and _same(a.radius, b.radius)
+    if isinstance(a, Ellipse):
+        return _same(a.center, b.center) and _same(a.radii, b.radii)
+    return (_same(a.p_min, b.p_min) and _same(a.p_max, b.p_max)
+            and _same(a.corner_radii, b.corner_radii))
+
+
+def _same_paint_ref(a, b) -> bool:
+    """The same kind of paint (and colour, or gradient element)."""
+    if type(a) is not type(b):
+        return False
+    if isinstance(a, Solid):
+        return _same(a.color, b.color)
+    if isinstance(a, (LinearGradient, RadialGradient)):
+        return a.source == b.source
+    return True
+
+
+def _same_gradient(a, b) -> bool:
+    if type(a) is not type(b):
+        return False
+    common = (_same(a.offsets, b.offsets) and _same(a.colors, b.colors)
+              and _same(a.transform, b.transform) and a.units == b.units)
+    if isinstance(a, LinearGradient):
+        return common and _same(a.start, b.start) and _same(a.end, b.end)
+    return (common and _same(a.center, b.center) and _same(a.radius, b.radius)
+            and _same(a.focal, b.focal))
+
+
+# ------------------------------------------------------------------------ document
+
+def _parse(data: bytes):
+    """Element tree with comments and processing instructions; namespace prefixes."""
+    prefixes = []
+    for _, (prefix, uri) in ET.iterparse(io.BytesIO(data), events=("start-ns",)):
+        prefixes.append((prefix, uri))
+    parser = ET.XMLParser(target=ET.TreeBuilder(insert_comments=True, insert_pis=True))
+    parser.feed(data)
+    return parser.close(), prefixes
+
+
+_PROLOG_ITEM = re.compile(
+    rb"\s+|<\?.*?\?>|<!--.*?-->|<!DOCTYPE(?:[^\[>]|\[.*?\])*>", re.DOTALL | re.IGNORECASE)
+
+
+def _prolog(data: bytes) -> str:
+    """What comes before the root element (comments, DOCTYPE), without the XML declaration,
+    which ElementTree does not keep."""
+    i, parts = 0, []
+    if data.startswith(b"\xef\xbb\xbf"):
+        i = 3
+    while True:
+        m = _PROLOG_ITEM.match(data, i)
+        if not m:
+            break
+        item = m.group(0)
+        if not item.startswith(b"<?xml ") and not item.startswith(b"<?xml?"):
+            parts.append(item)
+        i = m.end()
+    try:
+        text = b"".join(parts).decode("utf-8").strip()
+    except UnicodeDecodeError:
+        return ""
+    return text + "\n" if text else ""
+
+
+def _elements(element):
+    return [c for c in element if isinstance(c.tag, str)]
+
+
+def _handles(root) -> dict[str, ET.Element]:
+    """handle -> element, computed exactly as the reader does (element children only)."""
+    every = [e for e in root.iter() if isinstance(e.tag, str)]
+    counts = Counter(e.get("id") for e in every if e.get("id") is not None)
+    out, todo = {}, [(root, "")]
+    while todo:
+        element, position = todo.pop()
+        i = element.get("id")
+        out[i if i is not None and counts[i] == 1 else (position or "/")] = element
+        todo += [(c, f"{position}/{k}") for k, c in enumerate(_elements(element))]
+    return out
+
+
+def _split_style(text: str | None) -> list[list[str]]:
+    """style attribute -> [[name, value]] (raw, in order)."""
+    out = []
+    for item in (text or "").split(";"):
+        name, sep, value = item.partition(":")
+        if sep and name.strip():
+            out.append([name.strip(), value.strip()])
+    return out
+
+
+class _Document:
+    def __init__(self, root, cascade):
+        self.root = root
+        self.cascade = cascade
+        self.parents = {}
+        for e in root.iter():
+            for c in e:
+                self.parents[id(c)] = e
+        self._computed = {}
+
+    def computed(self, element) -> dict:
+        key = id(element)
+        if key not in self._computed:
+            parent = self.parents.get(key)
+            self._computed[key] = self.cascade.computed(
+                element, self.computed(parent) if parent is not None else None)
+        return self._computed[key]
+
+    def set_property(self, element, name: str, value: str | None):
+        """Make ``name`` compute to ``value`` on ``element``; None: its initial value, by
+        removing the element's own declarations where that suffices."""
+        decls = _split_style(element.get("style"))
+        in_style = any(n.lower() == name for n, _ in decls)
+        normal, important = self.cascade.sheet.declarations_for(element, local_name(element.tag))
+        from_css = any(n == name for n, _ in normal + important)
+        if any(n == name for n, _ in important):
+            warnings.warn(f"{name} of {element.get('id') or local_name(element.tag)} is set by "
+                          f"an !important CSS rule: the written value may not apply",
+                          stacklevel=3)
+        if value is None:
+            parent = self.parents.get(id(element))
+            inherited = (name in INHERITED and parent is not None
+                         and self.computed(parent).get(name) not in (None, INITIAL.get(name)))
+            if not (from_css or inherited):
+                if in_style:
+                    self._set_style(element, [d for d in decls if d[0].lower() != name])
+                element.attrib.pop(name, None)
+                return
+            value = INITIAL[name]
+        if in_style or from_css:
+            if in_style:
+                for d in decls:
+                    if d[0].lower() == name:
+                        d[1] = value
+            else:
+                decls.append([name, value])
+            self._set_style(element, decls)
+            if name in element.attrib:
+                element.set(name, value)  # kept consistent, though the style wins
+        else:
+            element.set(name, value)
+
+    @staticmethod
+    def _set_style(element, decls):
+        if decls:
+            element.set("style", ";".join(f"{n}:{v}" for n, v in decls))
+        else:
+            element.attrib.pop("style", None)
+
+
+# -------------------------------------------------------------------------- writer
+
+def write_svg(scene: Scene, source_path, out_path, *, full: bool = False) -> None:
+    """Write ``scene``'s values into a copy of the SVG at ``source_path`` (which the scene
+    was read from) and save it atomically at ``out_path``.
+
+    Raises VecfitError for non-finite values (nothing is written then) or a scene that
+    does not match the source file.
+    """
+    from .read import _Reader  # the reader's own cascade, viewport and original scene
+
+    for tensors in scene.parameters().values():
+        for t in tensors:
+            _finite(t)
+    plain = read_root(source_path)
+    reader = _Reader(source_path, plain)
+    original = reader.read()
+    if (len(original.shapes) != len(scene.shapes) or len(original.groups) != len(scene.groups)
+            or any(a.source != b.source for a, b in zip(original.shapes, scene.shapes))
+            or any(a.source != b.source for a, b in zip(original.groups, scene.groups))):
+        raise VecfitError(f"{source_path}: the scene was not read from this file "
+                          f"(its shapes and groups do not match)")
+
+    data = FsPath(source_path).read_bytes()
+    if data[:2] == b"\x1f\x8b":
+        data = gzip.decompress(data)
+    root, prefixes = _parse(data)
+    for prefix, uri in prefixes:
+        try:
+            ET.register_namespace(prefix, uri)
+        except ValueError:
+            pass  # ns0-style prefixes: ElementTree makes its own
+    handles = _handles(root)
+    doc = _Document(root, reader.cascade)
+    writer = _Writer(doc, handles, reader.viewport, full)
+
+    done: set = set()
+    for shape, orig in zip(scene.shapes, original.shapes):
+        if shape.source in done:
+            continue  # <use> instances of an element already written
+        if writer.shape(shape, orig):
+            done.add(shape.source)
+    done = set()
+    for group, orig in zip(scene.groups, original.groups):
+        if group.source in done:
+            continue
+        if writer.group(group, orig):
+            done.add(group.source)
+    gradients_before = {}
+    for s in original.shapes:
+        for p in (s.fill, s.stroke):
+            if isinstance(p, (LinearGradient, RadialGradient)):
+                gradients_before.setdefault(p.source, p)
+    written = set()
+    for s in scene.shapes:
+        for p in (s.fill, s.stroke):
+            if isinstance(p, (LinearGradient, RadialGradient)) and p.source not in written:
+                before = gradients_before.get(p.source)
+                if full or before is None or not _same_gradient(p, before):
+                    writer.gradient(p, before)
+                written.add(p.source)
+
+    text = ET.tostring(root, encoding="unicode")
+    payload = ('<?xml version="1.0" encoding="UTF-8"?>\n' + _prolog(data) + text + "\n").encode("utf-8")
+    if str(out_path).endswith(".svgz"):
+        payload = gzip.compress(payload)
+
+    def write(tmp):
+        with open(tmp, "wb") as f:
+            f.write(payload)
+
+    atomic_write(out_path, write)
+
+
+class _Writer:
+    def __init__(self, doc: _Document, handles, viewport, full: bool):
+        self.doc = doc
+        self.handles = handles
+        self.viewport = viewport
+        self.full = full
+
+    def _element(self, source):
+        element = self.handles.get(source)
+        if element is None:
+            raise VecfitError(f"no element {source!r} in the source SVG")
+        return element
+
+    # ------------------------------------------------------------------ shapes
+
+    def shape(self, shape, orig) -> bool:
+        """Write what changed; True when anything was written."""
+        full, e, wrote = self.full, self._element(shape.source), False
+        if full or not _same_geometry(shape.geometry, orig.geometry):
+            self._geometry(e, shape.geometry)
+            wrote = True
+        for prop, paint, opacity, paint0, opacity0 in (
+                ("fill", shape.fill, shape.fill_opacity, orig.fill, orig.fill_opacity),
+                ("stroke", shape.stroke, shape.stroke_opacity, orig.stroke, orig.stroke_opacity)):
+            if full or not _same_paint_ref(paint, paint0) or not _same(opacity, opacity0):
+                self._paint(e, prop, paint, opacity)
+                wrote = True
+        if shape.stroke is not None and (full or not _same(shape.stroke_width, orig.stroke_width)):
+            self.doc.set_property(e, "stroke-width", fmt(_finite(shape.stroke_width), 4))
+            wrote = True
+        if full or not _same(shape.opacity, orig.opacity):
+            self._opacity(e, "opacity", shape.opacity)
+            wrote = True
+        for prop, attr in (("fill-rule", "fill_rule"), ("stroke-linecap", "linecap"),
+                           ("stroke-linejoin", "linejoin")):
+            if getattr(shape, attr) != getattr(orig, attr):
+                self.doc.set_property(e, prop, getattr(shape, attr))
+                wrote = True
+        if shape.miter_limit != orig.miter_limit:
+            self.doc.set_property(e, "stroke-miterlimit", fmt(shape.miter_limit, 6))
+        if not _same(shape.transform, orig.transform) or (full and e.get("transform") is not None):
+            self._transform(e, _finite(shape.transform))
+            wrote = True
+        return wrote
+
+    def _opacity(self, e, prop, value):
+        v = float(_finite(value))
+        self.doc.set_property(e, prop, None if v >= 1 else fmt(min(max(v, 0.0), 1.0), 6))
+
+    def _paint(self, e, prop, paint, opacity):
+        op = float(_finite(opacity))
+        if paint is None:
+            self.doc.set_property(e, prop, "none")
+            return
+        if isinstance(paint, Solid):
+            color = _finite(paint.color)
+            self.doc.set_property(e, prop, hex_color(color))
+            op *= float(color[3])
+        else:
+            if paint.source is None:
+                raise VecfitError("a gradient paint without a source element cannot be written")
+            self.doc.set_property(e, prop, f"url(#{paint.source})")
+        self.doc.set_property(e, f"{prop}-opacity",
+                              None if op >= 1 else fmt(min(max(op, 0.0), 1.0), 6))
+
+    def _transform(self, e, m):
+        if np.array_equal(m, np.eye(3)) and e.get("transform") is None:
+            return
+        e.set("transform", matrix(m))
+
+    def _geometry(self, e, g):
+        tag = local_name(e.tag)
+        if isinstance(g, Rect):
+            p0, p1, r = _finite(g.p_min), _finite(g.p_max), _finite(g.corner_radii)
+            for name, v in (("x", p0[0]), ("y", p0[1]), ("width", p1[0] - p0[0]),
+                            ("height", p1[1] - p0[1])):
+                e.set(name, fmt(v))
+            for name, v in (("rx", r[0]), ("ry", r[1])):
+                if v != 0 or e.get(name) is not None:
+                    e.set(name, fmt(v))
+        elif isinstance(g, Circle):
+            c = _finite(g.center)
+            e.set("cx", fmt(c[0]))
+            e.set("cy", fmt(c[1]))
+            e.set("r", fmt(_finite(g.radius)))
+        elif isinstance(g, Ellipse):
+            c, r = _finite(g.center), _finite(g.radii)
+            for name, v in (("cx", c[0]), ("cy", c[1]), ("rx", r[0]), ("ry", r[1])):
+                e.set(name, fmt(v))
+        else:
+            self._path(e, tag, g)
+
+    def _path(self, e, tag, g: Path):
+        pts = _finite(g.points)
+        degrees = [int(d) for d in g.degrees]
+        lines = all(d == 1 for d in degrees) and len(g.subpaths) == 1
+        closed = bool(g.subpaths[0][2]) if g.subpaths else False
+        pairs = lambda: " ".join(f"{fmt(x)},{fmt(y)}" for x, y in pts)  # noqa: E731
+        if tag == "line" and lines and not closed and len(degrees) == 1:
+            for name, v in zip(("x1", "y1", "x2", "y2"), pts.reshape(-1)):
+                e.set(name, fmt(v))
+            return
+        if tag == "polyline" and lines and not closed and len(pts) >= 2:
+            e.set("points", pairs())
+            return
+        if tag == "polygon" and lines and closed and len(pts) >= 2:
+            e.set("points", pairs())
+            return
+        if tag != "path":  # the structure changed: becomes a <path>, attributes kept
+            e.tag = e.tag[: len(e.tag) - len(tag)] + "path"
+            for name in ("x1", "y1", "x2", "y2", "points"):
+                e.attrib.pop(name, None)
+        e.set("d", path_data(g))
+
+    # ------------------------------------------------------------------ groups
+
+    def group(self, group, orig) -> bool:
+        e, wrote = self._element(group.source), False
+        if self.full or not _same(group.opacity, orig.opacity):
+            self._opacity(e, "opacity", group.opacity)
+            wrote = True
+        if not _same(group.transform, orig.transform) or (self.full and e.get("transform")):
+            m = _finite(group.transform)
+            tag = local_name(e.tag)
+            if tag == "use":
+                x = parse_length(e.get("x"), self.viewport[0]) or 0.0
+                y = parse_length(e.get("y"), self.viewport[1]) or 0.0
+                m = m @ translate(-x, -y)
+            elif tag in ("svg", "symbol") and e is not self.doc.root:
+                # The group's transform includes the viewBox mapping: not writable as is.
+                if not _same(group.transform, orig.transform):
+                    warnings.warn(f"the transform of <{tag}> {group.source} is not written back",
+                                  stacklevel=3)
+                return wrote
+            self._transform(e, m)
+            wrote = True
+        return wrote
+
+    # --------------------------------------------------------------- gradients
+
+    def gradient(self, paint, before):
+        from .dom import href_id
+        chain, seen = [], set()
+        e = self.handles.get(paint.source)
+        if e is None:
+            e = _by_id(self.doc.root, paint.source)
+        while e is not None and local_name(e.tag) in GRADIENTS and id(e) not in seen:
+            seen.add(id(e))
+            chain.append(e)
+            e = _by_id(self.doc.root, href_id(e))
+        if not chain:
+            raise VecfitError(f"no gradient element #{paint.source} in the source SVG")
+        g = chain[0]
+        full = self.full or before is None
+        if isinstance(paint, LinearGradient):
+            fields = ((("x1", "y1"), paint.start, before and before.start),
+                      (("x2", "y2"), paint.end, before and before.end))
+        else:
+            fields = ((("cx", "cy"), paint.center, before and before.center),
+                      (("r",), paint.radius.reshape(1), before and before.radius.reshape(1)),
+                      (("fx", "fy"), paint.focal, before and before.focal))
+        for names, value, old in fields:
+            if full or not _same(value, old):
+                for name, v in zip(names, _finite(value).reshape(-1)):
+                    g.set(name, fmt(v, 6))
+        if full or not _same(paint.transform, before.transform):
+            m = _finite(paint.transform)
+            has = any(x.get("gradientTransform") is not None for x in chain)
+            if has or not np.array_equal(m, np.eye(3)):
+                g.set("gradientTransform", matrix(m))
+        if full or not (_same(paint.offsets, before.offsets) and _same(paint.colors, before.colors)):
+            holder = next((x for x in chain if any(local_name(s.tag) == "stop" for s in x)), None)
+            if holder is None:
+                raise VecfitError(f"gradient #{paint.source} has no stops to write")
+            stops = [s for s in holder if isinstance(s.tag, str) and local_name(s.tag) == "stop"]
+            offsets, colors = _finite(paint.offsets), _finite(paint.colors)
+            if len(stops) != len(offsets):
+                raise VecfitError(f"gradient #{paint.source}: {len(offsets)} stops in the scene, "
+                                  f"{len(stops)} in the file")
+            for s, o, c in zip(stops, offsets, colors):
+                s.set("offset", fmt(min(max(o, 0.0), 1.0), 6))
+                self.doc.set_property(s, "stop-color", hex_color(c))
+                a = float(c[3])
+                self.doc.set_property(s, "stop-opacity",
+                                      None if a >= 1 else fmt(min(max(a, 0.0), 1.0), 6))
+
+
+def _by_id(root, i):
+    if i is None:
+        return None
+    for e in root.iter():
+        if isinstance(e.tag, str) and e.get("id") == i:
+            return e
+    return None
