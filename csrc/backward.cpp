@@ -19,6 +19,7 @@
 
 #include "backward.h"
 #include "coverage.h"
+#include "layers.h"
 #include "paint.h"
 #include "sampling.h"
 #include "stroke.h"
@@ -29,7 +30,6 @@ namespace vf {
 namespace {
 
 constexpr double EPS_NORMAL = 1e-4;  // pixels: how far p+ and p- lie from the boundary
-constexpr int MAX_DEPTH = 64;
 
 struct Hit {
     int draw;
@@ -213,15 +213,11 @@ void composite(const PreparedScene& sc, const std::vector<Hit>& hits, Tape* tape
     struct Frame {
         int layer;
         double c[4];
-    } stack[MAX_DEPTH];
+    } stack[MAX_LAYER_DEPTH];
     int top = 0;
     stack[0].layer = 0;
     for (double& v : stack[0].c) v = 0;
     if (tape) tape->ops.clear();
-    auto is_ancestor_or_self = [&](int a, int l) {
-        while (sc.layer_depth[l] > sc.layer_depth[a]) l = sc.layer_parent[l];
-        return l == a;
-    };
     auto pop = [&] {
         Frame& child = stack[top];
         Frame& parent = stack[top - 1];
@@ -237,12 +233,12 @@ void composite(const PreparedScene& sc, const std::vector<Hit>& hits, Tape* tape
     };
     for (int h = (int)hits.size() - 1; h >= 0; --h) {
         int layer = sc.draws[hits[h].draw].layer;
-        while (!is_ancestor_or_self(stack[top].layer, layer)) pop();
-        int chain[MAX_DEPTH], n = 0;
-        for (int l = layer; l != stack[top].layer && n < MAX_DEPTH; l = sc.layer_parent[l]) chain[n++] = l;
-        while (n > 0 && top + 1 < MAX_DEPTH) {
+        while (!layer_contains(sc, stack[top].layer, layer)) pop();
+        int chain[MAX_LAYER_DEPTH];
+        int n = layers_between(sc, stack[top].layer, layer, chain);
+        for (int i = 0; i < n; ++i) {
             Frame& f = stack[++top];
-            f.layer = chain[--n];
+            f.layer = chain[i];
             for (double& v : f.c) v = 0;
             if (tape) tape->ops.push_back({Tape::PUSH, f.layer, {}, {}});
         }
@@ -264,7 +260,7 @@ void composite(const PreparedScene& sc, const std::vector<Hit>& hits, Tape* tape
 void composite_backward(const PreparedScene& sc, const std::vector<Hit>& hits, const Tape& tape, const double g[4],
                         std::vector<std::array<double, 4>>& g_hits, SceneGrads& grads) {
     g_hits.assign(hits.size(), {0, 0, 0, 0});
-    double adj[MAX_DEPTH][4];
+    double adj[MAX_LAYER_DEPTH][4];
     int top = 0;
     for (int i = 0; i < 4; ++i) adj[0][i] = g[i];
     for (int k = (int)tape.ops.size() - 1; k >= 0; --k) {

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "coverage.h"
+#include "layers.h"
 #include "paint.h"
 #include "render.h"
 #include "sampling.h"
@@ -12,8 +13,6 @@
 
 namespace vf {
 namespace {
-
-constexpr int MAX_LAYER_DEPTH = 64;
 
 // Parabolic prefilter kernel: coverage of a half-plane at signed distance d (in units of
 // the kernel radius, positive outside): 1/2 + (d^3 - 3d)/4 on [-1, 1].
@@ -46,19 +45,14 @@ struct Compositor {
         for (int i = 0; i < 4; ++i) parent.c[i] += k * child.c[i];
     }
 
-    bool is_ancestor_or_self(int a, int l) const {
-        while (sc.layer_depth[l] > sc.layer_depth[a]) l = sc.layer_parent[l];
-        return l == a;
-    }
-
     void enter(int layer) {
         if (stack[top].layer == layer) return;
-        while (!is_ancestor_or_self(stack[top].layer, layer)) pop();
-        int chain[MAX_LAYER_DEPTH], n = 0;
-        for (int l = layer; l != stack[top].layer && n < MAX_LAYER_DEPTH; l = sc.layer_parent[l]) chain[n++] = l;
-        while (n > 0 && top + 1 < MAX_LAYER_DEPTH) {
+        while (!layer_contains(sc, stack[top].layer, layer)) pop();
+        int chain[MAX_LAYER_DEPTH];
+        int n = layers_between(sc, stack[top].layer, layer, chain);
+        for (int i = 0; i < n; ++i) {
             Frame& f = stack[++top];
-            f.layer = chain[--n];
+            f.layer = chain[i];
             for (double& v : f.c) v = 0;
         }
     }

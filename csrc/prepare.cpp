@@ -3,6 +3,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "layers.h"
 #include "scene.h"
 #include "stroke.h"
 
@@ -229,6 +230,7 @@ PreparedScene prepare_scene(const SceneArrays& a) {
     for (int l = 1; l < a.n_layers; ++l) {
         check(sc.layer_parent[l] >= 0 && sc.layer_parent[l] < l, "a layer's parent must come before it");
         sc.layer_depth[l] = sc.layer_depth[sc.layer_parent[l]] + 1;
+        check(sc.layer_depth[l] < MAX_LAYER_DEPTH, "groups with opacity nested too deeply");
     }
 
     for (int di = 0; di < a.n_draws; ++di) {

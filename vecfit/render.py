@@ -40,7 +40,10 @@ def _core_render(settings: dict, structure: dict, floats, brute_force: bool = Fa
     scene = dict(structure)
     for name, t in zip(FLOAT_INPUTS, floats):
         scene[name] = t.detach().cpu().numpy()
-    return scene, _core.render(scene, **settings, brute_force=brute_force)
+    try:
+        return scene, _core.render(scene, **settings, brute_force=brute_force)
+    except ValueError as e:  # the core refused the scene (e.g. layers nested too deeply)
+        raise VecfitError(str(e)) from None
 
 
 class _Render(torch.autograd.Function):
