@@ -69,6 +69,8 @@ def test_non_finite_values_are_refused():
 
 def test_bad_options_are_refused():
     scene = Scene(width=8, height=8)
+    with pytest.raises(VecfitError, match="too large"):
+        vecfit.render(scene, 100_000, 100_000)
     with pytest.raises(VecfitError):
         vecfit.render(scene, mode="fast")
     with pytest.raises(VecfitError):

@@ -17,6 +17,7 @@ from .scene import Scene
 
 MODES = ("mc", "analytic")
 FILTERS = ("box", "tent", "gaussian")
+MAX_PIXELS = 64_000_000  # a float RGBA image of that size already takes 1 GB
 
 
 def output_size(scene: Scene, width: int | None, height: int | None) -> tuple[int, int]:
@@ -92,6 +93,9 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     if not (filter_radius > 0 and math.isfinite(filter_radius)):
         raise VecfitError("filter radius must be a positive number")
     width, height = output_size(scene, width, height)
+    if width * height > MAX_PIXELS:
+        raise VecfitError(f"{width} x {height} pixels is too large to render "
+                          f"(at most {MAX_PIXELS // 1_000_000} million pixels)")
     if background is not None:
         bg = [float(v) for v in background]
         if len(bg) == 3:
