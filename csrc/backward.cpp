@@ -333,10 +333,10 @@ struct BoundarySample {
     Vec2 p, n;
     double weight = 0;  // length element / samples
     int draw = -1;
-    Velocity v[24];
+    Velocity v[32];
     int nv = 0;
     void add(std::vector<double>* t, size_t i, double value) {
-        if (nv < 24 && value != 0) v[nv++] = {t, i, value};
+        if (nv < 32 && value != 0) v[nv++] = {t, i, value};
     }
 };
 
@@ -497,6 +497,20 @@ private:
         bs.add(&g.points, 2 * (size_t)idx + 1, w * factor * m.y);
     }
 
+    // Normal velocity per entry of the stroke metric M (stroke space = M pixel space): the
+    // point is p = M^-1 q with q built from M times pixel geometry, and normal changes are
+    // tangential, so dv/dM_rc = factor n_q[r] (anchor - p)[c], where anchor is the pixel
+    // point the piece is built around (the curve point, or the vertex).
+    void add_metric(const PreparedDraw& d, int draw, SceneGrads& g, BoundarySample& bs, Vec2 n_q, double factor,
+                    Vec2 anchor_minus_p) const {
+        if (d.metric_identity) return;
+        size_t base = DRAW_FCOLS * (size_t)draw + 2;
+        bs.add(&g.draw_params, base + 0, factor * n_q.x * anchor_minus_p.x);
+        bs.add(&g.draw_params, base + 1, factor * n_q.x * anchor_minus_p.y);
+        bs.add(&g.draw_params, base + 2, factor * n_q.y * anchor_minus_p.x);
+        bs.add(&g.draw_params, base + 3, factor * n_q.y * anchor_minus_p.y);
+    }
+
     bool fill_sample(const PreparedSegment& s, double t, int count, SceneGrads& g, BoundarySample& bs) const {
         Vec2 dp = seg_deriv(s.seg, t);
         double speed = length(dp);
@@ -540,7 +554,10 @@ private:
         bs.add(&g.ellipses, row + 3, factor * mt.x * u.y);
         bs.add(&g.ellipses, row + 4, factor * mt.y * u.x);
         bs.add(&g.ellipses, row + 5, factor * mt.y * u.y);
-        if (d.kind == DRAW_STROKE) bs.add(&g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * factor);
+        if (d.kind == DRAW_STROKE) {
+            bs.add(&g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * factor);
+            add_metric(d, pc.draw, g, bs, n_side, factor, (c + A * u) - bs.p);
+        }
         return true;
     }
 
@@ -566,6 +583,7 @@ private:
         for (int i = 0; i <= s.seg.degree; ++i)
             add_point_dir(d, g, bs, idx[i], n_q, factor, bernstein(s.seg.degree, i, whole_t(s, t)));
         bs.add(&g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * factor);
+        add_metric(d, pc.draw, g, bs, n_q, factor, to_pixel(d, seg_eval(s.seg, t)) - bs.p);
         return true;
     }
 
@@ -682,18 +700,21 @@ private:
         };
         double rate_in = normal_rate(rotate(eg.in.t, h), t_out, rotate(eg.in.t, -h), t_out, hw, hw, h);
         // dtheta = N . (d head - d tail) / L for the frame's control points (stroke space)
-        auto add_frame = [&](const EndFrame& f, const int32_t* fidx, double rate) {
+        add_metric(d, pc.draw, g, bs, n, factor, to_pixel(d, eg.at) - bs.p);
+        auto add_frame = [&](const EndFrame& f, const int32_t* fidx, double rate, const Segment& w) {
             if (f.length <= 0 || rate == 0) return;
             Vec2 N = perp(f.t);
             add_point_dir(d, g, bs, fidx[f.head], N, factor, rate / f.length);
             add_point_dir(d, g, bs, fidx[f.tail], N, factor, -rate / f.length);
+            // the frame's direction is M (head - tail) in pixel terms
+            add_metric(d, pc.draw, g, bs, N, factor * rate / f.length, to_pixel(d, w.p[f.head] - w.p[f.tail]));
         };
-        add_frame(eg.in, idx, rate_in);
+        add_frame(eg.in, idx, rate_in, whole_segment(sc_, d, s));
         if (eg.join) {
             double rate_out = normal_rate(eg.in.t, rotate(t_out, h), eg.in.t, rotate(t_out, -h), hw, hw, h);
             int32_t nidx[4];
             stroke_item_indices(sc_, sc_.stroke_items[s.next], nidx);
-            add_frame(eg.out, nidx, rate_out);
+            add_frame(eg.out, nidx, rate_out, whole_segment(sc_, d, sc_.stroke_items[s.next]));
         }
         double rate_w = normal_rate(eg.in.t, t_out, eg.in.t, t_out, hw + dw, hw - dw, dw);
         bs.add(&g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * rate_w * factor);
@@ -744,13 +765,30 @@ void sdf_backward(const PreparedScene& sc, const Hit& h, Vec2 p, double g_sd, Sc
     Vec2 q = d.metric_identity ? p : d.metric * p;
     double hw = d.half_width;
     double* gw = g.draw_params.data() + DRAW_FCOLS * (size_t)h.draw;  // width = 2 hw
+    // The stroke metric M: stroke-space geometry is M times pixel geometry, q = M p, and
+    // metric_scale = |det M|^-1/2. d sd_s / d M[r][c] = v[r] (anchor - p)[c] for a piece
+    // built around `anchor` whose stroke-space gradient is v.
+    auto add_metric = [&](Vec2 v, Vec2 anchor_minus_p, double k) {
+        if (d.metric_identity) return;
+        gw[2] += k * v.x * anchor_minus_p.x;
+        gw[3] += k * v.x * anchor_minus_p.y;
+        gw[4] += k * v.y * anchor_minus_p.x;
+        gw[5] += k * v.y * anchor_minus_p.y;
+    };
+    if (!d.metric_identity) {  // metric_scale: d ms / dM = -ms/2 M^-T
+        double sd_s = h.sd / d.metric_scale, k = -0.5 * g_sd * sd_s * d.metric_scale;
+        Mat2 it = inverse(d.metric);  // (M^-T)[r][c] = (M^-1)[c][r]
+        gw[2] += k * it.a; gw[3] += k * it.c; gw[4] += k * it.b; gw[5] += k * it.d;
+    }
     if (arg.kind == SdfArg::ELLIPSE || arg.kind == SdfArg::SWEEP) {
         double dist = distance(arg.closest, q);
         gw[0] += -0.5 * gs;
         if (dist <= 0) return;
         Vec2 dir = (1 / dist) * (arg.closest - q);
+        Vec2 anchor = d.metric_identity ? arg.closest : d.metric_inv * arg.closest;
+        add_metric(dir, anchor - p, gs);
         if (arg.kind == SdfArg::ELLIPSE) {
-            Vec2 local = d.metric_identity ? arg.closest : d.metric_inv * arg.closest;
+            Vec2 local = anchor;
             Vec2 u = inverse(d.ellipse_axes) * (local - d.ellipse_center);
             Vec2 m = mt(dir);
             double* ge = g.ellipses.data() + ELLIPSE_COLS * (size_t)d.ellipse_row;
@@ -797,19 +835,25 @@ void sdf_backward(const PreparedScene& sc, const Hit& h, Vec2 p, double g_sd, Sc
     int32_t idx[4];
     stroke_item_indices(sc, s, idx);
     add_pixel_point(side == 0 ? idx[0] : idx[s.seg.degree], (-gs) * mt(Vec2{dqx, dqy}));
+    // q = M p and V = M V_pix enter as q - V: d/dM = (d sd/dq) (p - V_pix)
+    add_metric(Vec2{dqx, dqy}, p - (d.metric_identity ? V : d.metric_inv * V), gs);
     double dw = (value(q, in.t, to, hw + hq) - value(q, in.t, to, hw - hq)) / (2 * hq);
     gw[0] += 0.5 * gs * dw;
-    auto add_frame = [&](const EndFrame& f, const int32_t* fidx, double rate) {
+    auto add_frame = [&](const EndFrame& f, const int32_t* fidx, double rate, const Segment& w) {
         if (f.length <= 0 || rate == 0 || point) return;
         Vec2 N = mt(perp(f.t));
         add_pixel_point(fidx[f.head], (gs * rate / f.length) * N);
         add_pixel_point(fidx[f.tail], (-gs * rate / f.length) * N);
+        Vec2 span = w.p[f.head] - w.p[f.tail];
+        add_metric(perp(f.t), d.metric_identity ? span : d.metric_inv * span, gs * rate / f.length);
     };
-    add_frame(in, idx, (value(q, rotate(in.t, ha), to, hw) - value(q, rotate(in.t, -ha), to, hw)) / (2 * ha));
+    add_frame(in, idx, (value(q, rotate(in.t, ha), to, hw) - value(q, rotate(in.t, -ha), to, hw)) / (2 * ha),
+              whole_segment(sc, d, s));
     if (join) {
         int32_t nidx[4];
         stroke_item_indices(sc, sc.stroke_items[s.next], nidx);
-        add_frame(out, nidx, (value(q, in.t, rotate(to, ha), hw) - value(q, in.t, rotate(to, -ha), hw)) / (2 * ha));
+        add_frame(out, nidx, (value(q, in.t, rotate(to, ha), hw) - value(q, in.t, rotate(to, -ha), hw)) / (2 * ha),
+                  whole_segment(sc, d, sc.stroke_items[s.next]));
     }
 }
 
