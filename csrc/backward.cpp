@@ -448,8 +448,8 @@ public:
 
     // Fills bs for sample j of the piece; false if the sample does not exist.
     bool sample(const Piece& pc, int j, uint64_t key, SceneGrads& g, BoundarySample& bs) const {
-        double u, v;
-        sample_uniform2(o_.seed ^ 0xb0b0b0b0ull, key, (uint64_t)j, u, v);
+        double u, unused;
+        sample_uniform2(o_.seed ^ 0xb0b0b0b0ull, key, (uint64_t)j, u, unused);
         double t = (j + u) / pc.count;
         bs.nv = 0;
         bs.draw = pc.draw;
@@ -458,7 +458,7 @@ public:
             case Piece::FILL_SEGMENT: return fill_sample(sc_.fill_items[d.first_item + pc.item], t, pc.count, g, bs);
             case Piece::ELLIPSE: return ellipse_sample(pc, d, t, g, bs);
             case Piece::OFFSET: return offset_sample(pc, d, t, g, bs);
-            default: return end_sample(pc, d, t, v, g, bs);
+            default: return end_sample(pc, d, t, g, bs);
         }
     }
 
@@ -667,8 +667,7 @@ private:
         return 0;
     }
 
-    bool end_sample(const Piece& pc, const PreparedDraw& d, double t, double, SceneGrads& g,
-                    BoundarySample& bs) const {
+    bool end_sample(const Piece& pc, const PreparedDraw& d, double t, SceneGrads& g, BoundarySample& bs) const {
         const StrokeSegment& s = sc_.stroke_items[d.first_item + pc.item];
         EndGeometry eg = end_geometry(d, s, pc.side);
         if (!eg.valid) return false;

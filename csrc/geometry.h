@@ -427,36 +427,6 @@ VF_HD int seg_extrema(const Segment& s, int axis, double* ts) {
     return m;
 }
 
-// t in [t0, t1] where the coordinate `axis` of a segment monotone on that interval
-// equals `value` (value lies between the coordinates at t0 and t1).
-VF_HD double seg_solve_monotone(const Segment& s, int axis, double value, double t0, double t1) {
-    auto coord = [&](double t) {
-        Vec2 q = seg_eval(s, t);
-        return axis == 0 ? q.x : q.y;
-    };
-    if (s.degree == 1) {
-        double a = axis == 0 ? s.p[0].x : s.p[0].y, b = axis == 0 ? s.p[1].x : s.p[1].y;
-        return b != a ? (value - a) / (b - a) : t0;
-    }
-    double f0 = coord(t0) - value, f1 = coord(t1) - value;
-    double a = t0, b = t1;
-    // Start from the secant: pieces are usually nearly straight at this scale.
-    double t = f1 != f0 ? t0 + (t1 - t0) * f0 / (f0 - f1) : 0.5 * (a + b);
-    if (!(t > a && t < b)) t = 0.5 * (a + b);
-    for (int it = 0; it < 50; ++it) {
-        double f = coord(t) - value;
-        if (f == 0) return t;
-        if ((f < 0) == (f0 < 0)) a = t; else b = t;
-        Vec2 dv = seg_deriv(s, t);
-        double df = axis == 0 ? dv.x : dv.y;
-        double next = df != 0 ? t - f / df : 0.5 * (a + b);
-        if (!(next > a && next < b)) next = 0.5 * (a + b);
-        if (std::fabs(next - t) < 1e-12 || b - a < 1e-12) return next;
-        t = next;
-    }
-    return t;
-}
-
 // Power-basis coefficients of one coordinate of a segment: coord(t) = sum a[k] t^k.
 VF_HD void seg_axis_poly(const Segment& s, int axis, double* a) {
     Vec2 v[4];

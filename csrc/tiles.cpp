@@ -29,7 +29,8 @@ TileRange tiles_of(const Box& b, double margin, const TileRange& clip) {
 
 // Crossings of the vertical line x = X, for heights in (y_low, y_high]: x-monotone
 // pieces count on [x_low, x_high); direction +1 where the curve moves towards +x.
-int vertical_crossings(const Segment& s, double X, double y_low, double y_high, double* ys, int8_t* dirs) {
+int vertical_crossings(const PreparedSegment& ps, double X, double y_low, double y_high, double* ys, int8_t* dirs) {
+    const Segment& s = ps.seg;
     double ts[4] = {0, 0, 0, 0};
     double ext[2];
     int n_ext = seg_extrema(s, 0, ext);
@@ -45,8 +46,8 @@ int vertical_crossings(const Segment& s, double X, double y_low, double y_high, 
         if (xa <= X && X < xb) dir = 1;
         else if (xb <= X && X < xa) dir = -1;
         else continue;
-        double t = seg_solve_monotone(s, 0, X, ts[k], ts[k + 1]);
-        double y = seg_eval(s, t).y;
+        double t = monotone_root(ps.ax, X, ts[k], ts[k + 1], xa - X, xb - X);
+        double y = ((ps.ay[3] * t + ps.ay[2]) * t + ps.ay[1]) * t + ps.ay[0];
         if (y > y_low && y <= y_high && count < 3) {
             ys[count] = y;
             dirs[count] = (int8_t)dir;
@@ -105,8 +106,9 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
                     if (ya <= y && y < yb) dir = 1;
                     else if (yb <= y && y < ya) dir = -1;
                     else continue;
-                    double t = seg_solve_monotone(s.seg, 1, y, s.split[j], s.split[j + 1]);
-                    row_crossings[ty - range.y0].push_back({seg_eval(s.seg, t).x, dir});
+                    double t = monotone_root(s.ay, y, s.split[j], s.split[j + 1], ya - y, yb - y);
+                    double x = ((s.ax[3] * t + s.ax[2]) * t + s.ax[1]) * t + s.ax[0];
+                    row_crossings[ty - range.y0].push_back({x, dir});
                 }
             }
         }
@@ -138,7 +140,7 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
                 if (fill) {
                     const PreparedSegment& s = sc.fill_items[d.first_item + li.item];
                     if (s.box.x0 <= region.x1 && region.x1 <= s.box.x1)
-                        li.n_cross = vertical_crossings(s.seg, region.x1, region.y0, region.y1, li.cross_y, li.cross_dir);
+                        li.n_cross = vertical_crossings(s, region.x1, region.y0, region.y1, li.cross_y, li.cross_dir);
                 }
                 items.push_back(li);
             }

@@ -123,16 +123,19 @@ def test_closed_stroke_and_fill_with_transparency():
           {"points": 0.4, "width": 0.3, "stroke_color": 0.05})
 
 
+def circle_and_ellipse(center, radius, e_center, radii):
+    """A filled circle and a filled, stroked ellipse under a rotation."""
+    return Scene(width=40, height=40, shapes=[
+        background(),
+        Shape(geometry=Circle(center, radius), fill=solid(0.9, 0.5, 0.1, 1)),
+        Shape(geometry=Ellipse(e_center, radii), fill=solid(0.1, 0.4, 0.8, 0.8),
+              stroke=solid(0, 0, 0, 1), stroke_width=torch.tensor(2.0),
+              transform=torch.tensor([[0.9, -0.4, 8.0], [0.4, 0.9, -4.0], [0.0, 0.0, 1.0]]))])
+
+
 def test_circle_and_ellipse():
-    def build(center, radius, e_center, radii):
-        return Scene(width=40, height=40, shapes=[
-            background(),
-            Shape(geometry=Circle(center, radius), fill=solid(0.9, 0.5, 0.1, 1)),
-            Shape(geometry=Ellipse(e_center, radii), fill=solid(0.1, 0.4, 0.8, 0.8),
-                  stroke=solid(0, 0, 0, 1), stroke_width=torch.tensor(2.0),
-                  transform=torch.tensor([[0.9, -0.4, 8.0], [0.4, 0.9, -4.0], [0.0, 0.0, 1.0]]))])
-    check(build, {"center": torch.tensor([14.0, 15.0]), "radius": torch.tensor(8.0),
-                  "e_center": torch.tensor([20.0, 24.0]), "radii": torch.tensor([9.0, 5.0])},
+    check(circle_and_ellipse, {"center": torch.tensor([14.0, 15.0]), "radius": torch.tensor(8.0),
+                               "e_center": torch.tensor([20.0, 24.0]), "radii": torch.tensor([9.0, 5.0])},
           {"center": 0.4, "radius": 0.4, "e_center": 0.4, "radii": 0.4})
 
 
@@ -261,15 +264,8 @@ def test_analytic_strokes(cap, join):
 
 
 def test_analytic_circle_and_ellipse():
-    def build(center, radius, e_center, radii):
-        return Scene(width=40, height=40, shapes=[
-            background(),
-            Shape(geometry=Circle(center, radius), fill=solid(0.9, 0.5, 0.1, 1)),
-            Shape(geometry=Ellipse(e_center, radii), fill=solid(0.1, 0.4, 0.8, 0.8),
-                  stroke=solid(0, 0, 0, 1), stroke_width=torch.tensor(2.0),
-                  transform=torch.tensor([[0.9, -0.4, 8.0], [0.4, 0.9, -4.0], [0.0, 0.0, 1.0]]))])
-    check(build, {"center": torch.tensor([14.13, 15.29]), "radius": torch.tensor(8.0),
-                  "e_center": torch.tensor([20.0, 24.0]), "radii": torch.tensor([9.0, 5.0])},
+    check(circle_and_ellipse, {"center": torch.tensor([14.13, 15.29]), "radius": torch.tensor(8.0),
+                               "e_center": torch.tensor([20.0, 24.0]), "radii": torch.tensor([9.0, 5.0])},
           {"center": 0.01, "radius": 0.01, "e_center": 0.01, "radii": 0.01}, rtol=0.02, atol=0.01,
           mode="analytic")
 
