@@ -26,6 +26,7 @@ test: install
 
 bench: install
 	$(PY) benchmarks/render.py
+	$(PY) benchmarks/gradients.py
 
 clean:
 	rm -rf build out tests/failures
