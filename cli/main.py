@@ -11,6 +11,8 @@ from pathlib import Path
 import click
 
 EXIT_FAILURE = 1
+EXIT_USAGE = 2
+EXIT_INTERRUPTED = 130  # as a shell reports a process stopped by Ctrl-C
 
 
 def _echo_err(message: str) -> None:
@@ -102,6 +104,141 @@ def info(svg):
         _echo_err(f"error: {e}")
         sys.exit(EXIT_FAILURE)
     click.echo(describe(scene))
+
+
+
+# ------------------------------------------------------------------ optimising commands
+
+def optimize_options(f):
+    """Options shared by refine, trace and paint; each overrides the config's value."""
+    options = [
+        click.option("-o", "--output", type=click.Path(dir_okay=False),
+                     help="Output SVG (default: NAME.vecfit.svg next to the target)."),
+        click.option("--report", type=click.Path(dir_okay=False),
+                     help="JSON report (default: the output's name + .report.json)."),
+        click.option("--comparison", type=click.Path(dir_okay=False),
+                     help="Comparison PNG (default: the output's name + .compare.png)."),
+        click.option("--config", "config_file", type=click.Path(dir_okay=False),
+                     help="TOML file overriding the defaults in configs/."),
+        click.option("--iterations", "--iters", type=click.IntRange(min=0), help="Adam iterations."),
+        click.option("--loss", type=click.Choice(["l2", "l1", "ssim", "pyramid"]), help="Image loss."),
+        click.option("--mode", type=click.Choice(["mc", "analytic"]),
+                     help="Anti-aliasing while optimising."),
+        click.option("--samples", type=click.IntRange(1, 16), help="N: N x N samples per pixel."),
+        click.option("--max-size", type=click.IntRange(min=0),
+                     help="Optimise on the target downscaled to this longest side (0: full size)."),
+        click.option("--background", help="auto (the target's corners), none, white or #rrggbb."),
+        click.option("--lr", "learning_rates", multiple=True, metavar="KIND=RATE",
+                     help="Learning rate of a parameter kind, e.g. --lr points=1 (repeatable)."),
+        click.option("--seed", type=int, help="Random seed."),
+        click.option("--threads", type=click.IntRange(min=0), help="Threads (0: all cores)."),
+        click.option("-q", "--quiet", is_flag=True, help="No progress bar."),
+    ]
+    for option in reversed(options):
+        f = option(f)
+    return f
+
+
+def _parse_learning_rates(items) -> dict:
+    out = {}
+    for item in items:
+        kind, sep, value = item.partition("=")
+        try:
+            out[kind.strip()] = float(value)
+        except ValueError:
+            sep = ""
+        if not sep:
+            raise click.BadParameter(f"expected KIND=RATE, not {item!r}", param_hint="--lr")
+    return out
+
+
+def _resolve_config(command, preset, config_file, options, extra=None):
+    """Defaults, preset, --config file, options; a bad setting is a usage error."""
+    from vecfit.config import resolve
+    from vecfit.errors import VecfitError
+
+    overrides = {"optimize": {
+        "iterations": options["iterations"], "loss": options["loss"], "mode": options["mode"],
+        "samples": options["samples"], "max_size": options["max_size"],
+        "background": options["background"], "seed": options["seed"],
+        "threads": options["threads"], "lr": _parse_learning_rates(options["learning_rates"]),
+    }, **(extra or {})}
+    try:
+        config = resolve(command, preset=preset, config_file=config_file, overrides=overrides)
+        from vecfit.colors import parse_background
+        if config["optimize"]["background"].strip().lower() != "auto":
+            parse_background(config["optimize"]["background"])
+        from vecfit.optimize import Settings
+        Settings.from_config(config["optimize"])
+    except VecfitError as e:
+        _echo_err(f"error: {e}")
+        sys.exit(EXIT_USAGE)
+    return config
+
+
+class _ProgressBar:
+    """An Adam progress bar on stderr, with the loss; silent when quiet."""
+
+    def __init__(self, label: str, iterations: int, quiet: bool):
+        self.bar = None if quiet or iterations == 0 else click.progressbar(
+            length=iterations, label=label, file=sys.stderr, show_pos=True, show_eta=True,
+            item_show_func=lambda p: None if p is None else f"loss {p.loss:.5g}")
+
+    def __enter__(self):
+        if self.bar is not None:
+            self.bar.__enter__()
+        return self
+
+    def __exit__(self, *exc):
+        if self.bar is not None:
+            self.bar.__exit__(*exc)
+
+    def __call__(self, progress) -> None:
+        if self.bar is not None:
+            self.bar.update(1, current_item=progress)
+
+
+def _run_job(label, iterations, quiet, job):
+    """Runs an optimising job with a progress bar; user errors and Ctrl-C end it cleanly."""
+    from vecfit.errors import VecfitError
+
+    try:
+        with _ProgressBar(label, iterations, quiet) as bar:
+            report = job(bar)
+    except VecfitError as e:
+        _echo_err(f"error: {e}")
+        sys.exit(EXIT_FAILURE)
+    except KeyboardInterrupt:
+        _echo_err("interrupted: nothing written")
+        sys.exit(EXIT_INTERRUPTED)
+    _summarise(report)
+    if report["interrupted"]:
+        _echo_err(f"interrupted after {report['iterations']} iterations: wrote the best result so far")
+        sys.exit(EXIT_INTERRUPTED)
+
+
+def _summarise(report) -> None:
+    a, b = report["initial"], report["optimized"]
+    _echo_err(f"PSNR {a['psnr']:.2f} -> {b['psnr']:.2f} dB, MSE {a['mse']:.5f} -> {b['mse']:.5f}, "
+              f"SSIM {a['ssim']:.4f} -> {b['ssim']:.4f} "
+              f"({report['iterations']} iterations, {report['seconds']['total']:.1f} s)")
+    click.echo(f"svg: {report['output']}")
+    click.echo(f"report: {report['report']}")
+    click.echo(f"comparison: {report['comparison']}")
+
+
+@main.command()
+@click.argument("target", type=click.Path(dir_okay=False))
+@click.argument("init_svg", type=click.Path(dir_okay=False))
+@optimize_options
+def refine(target, init_svg, output, report, comparison, config_file, quiet, **options):
+    """Optimise INIT_SVG's control points, colours and stroke widths to match TARGET."""
+    from vecfit.refine import Outputs, refine as run_refine
+
+    config = _resolve_config("refine", None, config_file, options)
+    outputs = Outputs.beside(Path(target), output, report, comparison)
+    _run_job("refine", config["optimize"]["iterations"], quiet,
+             lambda bar: run_refine(target, init_svg, config, outputs, progress=bar))
 
 
 if __name__ == "__main__":

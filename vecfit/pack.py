@@ -473,3 +473,23 @@ def _rect_as_path(rect: Rect) -> Path | None:
 
 def pack_scene(scene: Scene, width: int, height: int) -> Packed:
     return Packer(scene, width, height).pack()
+
+
+def shape_pixel_scales(scene: Scene, width: int, height: int) -> np.ndarray:
+    """Pixels per unit of each shape's own space (sqrt |det| of its map to the canvas)."""
+    packer = Packer(scene, width, height)
+    with torch.no_grad():
+        packer._prepare_groups()
+        lin = packer._shape_matrices()[:, :2, :2]
+        det = lin[:, 0, 0] * lin[:, 1, 1] - lin[:, 0, 1] * lin[:, 1, 0]
+    return torch.sqrt(torch.abs(det)).numpy().astype(np.float64)
+
+
+def local_bbox_size(geometry) -> float | None:
+    """Geometric mean of the geometry's bounding-box sides (for bounding-box units)."""
+    with torch.no_grad():
+        box = _local_bbox(geometry)
+    if box is None:
+        return None
+    size = (box[1] - box[0]).double()
+    return float(torch.sqrt(torch.clamp(size[0], min=0) * torch.clamp(size[1], min=0)))

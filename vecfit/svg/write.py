@@ -265,9 +265,12 @@ class _Document:
 
 # -------------------------------------------------------------------------- writer
 
-def write_svg(scene: Scene, source_path, out_path, *, full: bool = False) -> None:
+def write_svg(scene: Scene, source_path, out_path, *, full: bool = False, background=None) -> None:
     """Write ``scene``'s values into a copy of the SVG at ``source_path`` (which the scene
     was read from) and save it atomically at ``out_path``.
+
+    background: an RGB(A) colour to put behind everything as a first ``<rect>`` covering
+    the viewBox (for scenes optimised over a background they do not cover themselves).
 
     Raises VecfitError for non-finite values (nothing is written then) or a scene that
     does not match the source file.
@@ -325,6 +328,8 @@ def write_svg(scene: Scene, source_path, out_path, *, full: bool = False) -> Non
                     writer.gradient(p, before)
                 written.add(p.source)
 
+    if background is not None:
+        _add_background(root, background)
     text = ET.tostring(root, encoding="unicode")
     payload = ('<?xml version="1.0" encoding="UTF-8"?>\n' + _prolog(data) + text + "\n").encode("utf-8")
     if str(out_path).endswith(".svgz"):
@@ -335,6 +340,30 @@ def write_svg(scene: Scene, source_path, out_path, *, full: bool = False) -> Non
             f.write(payload)
 
     atomic_write(out_path, write)
+
+
+def _add_background(root, color) -> None:
+    """A full-canvas rect, drawn first, named so that it is recognisable (and not added
+    twice when a file written so is refined again: the rect is then part of the scene)."""
+    if any(e.get("id") == "vecfit-background" for e in root.iter()):
+        return
+    ns = root.tag[:root.tag.index("}") + 1] if root.tag.startswith("{") else ""
+    box = re.split(r"[\s,]+", (root.get("viewBox") or "").strip())
+    rect = ET.Element(f"{ns}rect")
+    try:
+        x, y, w, h = (float(v) for v in box)
+        if w <= 0 or h <= 0:
+            raise ValueError
+        rect.attrib.update(x=fmt(x), y=fmt(y), width=fmt(w), height=fmt(h))
+    except ValueError:
+        rect.attrib.update(x="0", y="0", width="100%", height="100%")
+    rect.set("id", "vecfit-background")
+    rect.set("fill", hex_color(color))
+    alpha = float(color[3]) if len(color) > 3 else 1.0
+    if alpha < 1:
+        rect.set("fill-opacity", fmt(alpha))
+    rect.tail = root.text
+    root.insert(0, rect)
 
 
 class _Writer:

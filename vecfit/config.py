@@ -1,0 +1,110 @@
+"""Settings of the optimising commands, from TOML files in configs/.
+
+Resolution, last wins: configs/refine.toml (the optimisation defaults every command starts
+from), the command's own file (configs/trace.toml, ...), a preset from that file's
+``[presets.NAME]`` tables, the user's ``--config`` file, then command-line options. Every
+key must exist in the defaults, with a value of the same type, so a typo is an error
+naming the file and the key rather than a setting silently ignored.
+"""
+from __future__ import annotations
+
+import copy
+import tomllib
+from pathlib import Path
+
+from .errors import VecfitError
+
+
+def configs_dir() -> Path:
+    """configs/ of a source checkout or an editable install, else the installed copy."""
+    here = Path(__file__).resolve().parent
+    for candidate in (here / "configs", here.parent / "configs"):
+        if (candidate / "refine.toml").is_file():
+            return candidate
+    raise VecfitError("the default settings (configs/refine.toml) are missing from this installation")
+
+
+def read_toml(path) -> dict:
+    try:
+        with open(path, "rb") as f:
+            return tomllib.load(f)
+    except FileNotFoundError:
+        raise VecfitError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise VecfitError(f"{path}: is a folder, not a TOML file") from None
+    except tomllib.TOMLDecodeError as e:
+        raise VecfitError(f"{path}: not valid TOML ({e})") from None
+    except (OSError, UnicodeDecodeError) as e:
+        raise VecfitError(f"{path}: cannot read ({e})") from None
+
+
+def merge(base: dict, changes: dict, schema: dict, source: str, prefix: str = "") -> dict:
+    """base updated with changes, each key checked against schema (the defaults)."""
+    out = copy.deepcopy(base)
+    for key, value in changes.items():
+        name = f"{prefix}{key}"
+        if key not in schema:
+            known = ", ".join(sorted(schema))
+            raise VecfitError(f"{source}: unknown setting {name!r} (known here: {known})")
+        expected = schema[key]
+        if isinstance(expected, dict):
+            if not isinstance(value, dict):
+                raise VecfitError(f"{source}: {name} must be a table")
+            out[key] = merge(out.get(key, {}), value, expected, source, name + ".")
+        else:
+            out[key] = _checked(value, expected, name, source)
+    return out
+
+
+def _checked(value, expected, name: str, source: str):
+    if isinstance(expected, bool):
+        ok = isinstance(value, bool)
+    elif isinstance(expected, float):
+        ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+        value = float(value) if ok else value
+    elif isinstance(expected, int):
+        ok = isinstance(value, int) and not isinstance(value, bool)
+    else:
+        ok = isinstance(value, type(expected))
+    if not ok:
+        raise VecfitError(f"{source}: {name} must be {type(expected).__name__}, not {value!r}")
+    return value
+
+
+def resolve(command: str, *, preset: str | None = None, config_file=None,
+            overrides: dict | None = None) -> dict:
+    """The settings of ``command`` (refine, trace, paint): defaults, its file, a preset,
+    the user's file and the overrides (a nested dict like the files), in that order."""
+    root = configs_dir()
+    settings = read_toml(root / "refine.toml")
+    schema = copy.deepcopy(settings)
+    presets: dict = {}
+    if command != "refine":
+        own = read_toml(root / f"{command}.toml")
+        presets = own.pop("presets", {})
+        for key, value in own.items():  # the command's own tables join the schema
+            if key not in schema:
+                schema[key] = copy.deepcopy(value)
+        settings = merge(settings, own, schema, f"configs/{command}.toml")
+    if preset is not None:
+        if preset not in presets:
+            known = ", ".join(sorted(presets)) or "none"
+            raise VecfitError(f"unknown preset {preset!r} for {command} (known: {known})")
+        settings = merge(settings, presets[preset], schema, f"preset {preset!r}")
+    if config_file is not None:
+        settings = merge(settings, read_toml(config_file), schema, str(config_file))
+    if overrides:
+        settings = merge(settings, _drop_none(overrides), schema, "command line")
+    return settings
+
+
+def _drop_none(d: dict) -> dict:
+    out = {}
+    for k, v in d.items():
+        if isinstance(v, dict):
+            v = _drop_none(v)
+            if v:
+                out[k] = v
+        elif v is not None:
+            out[k] = v
+    return out

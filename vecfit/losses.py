@@ -1,0 +1,76 @@
+"""Image losses for optimisation: images are [H, W, C] float tensors in [0, 1]."""
+from __future__ import annotations
+
+import torch
+import torch.nn.functional as F
+
+from .errors import VecfitError
+
+LOSSES = ("l2", "l1", "ssim", "pyramid")
+
+
+def l2(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
+    return torch.mean((a - b) ** 2)
+
+
+def l1(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
+    return torch.mean(torch.abs(a - b))
+
+
+def _gaussian_window(size: int = 11, sigma: float = 1.5) -> torch.Tensor:
+    x = torch.arange(size, dtype=torch.float32) - (size - 1) / 2
+    g = torch.exp(-x ** 2 / (2 * sigma ** 2))
+    return g / g.sum()
+
+
+def _blur(x: torch.Tensor, window: torch.Tensor) -> torch.Tensor:
+    """Separable Gaussian blur of [1, C, H, W] per channel, valid region only."""
+    c = x.shape[1]
+    k = window.to(x.dtype)
+    x = F.conv2d(x, k.view(1, 1, 1, -1).expand(c, 1, 1, -1), groups=c)
+    return F.conv2d(x, k.view(1, 1, -1, 1).expand(c, 1, -1, 1), groups=c)
+
+
+def ssim(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
+    """Mean SSIM (Wang et al. 2004: 11-tap Gaussian window, sigma 1.5, K1 0.01, K2 0.03,
+    data range 1), as scikit-image computes it with gaussian_weights=True."""
+    window = _gaussian_window()
+    if min(a.shape[0], a.shape[1]) < window.numel():
+        raise VecfitError("the SSIM loss needs images of at least 11 x 11 pixels")
+    x = a.permute(2, 0, 1)[None]
+    y = b.permute(2, 0, 1)[None]
+    c1, c2 = 0.01 ** 2, 0.03 ** 2
+    mx, my = _blur(x, window), _blur(y, window)
+    # scikit-image uses the unbiased (sample) covariance: N / (N - 1) over the window
+    n = window.numel() ** 2
+    cov = n / (n - 1)
+    sxx = cov * (_blur(x * x, window) - mx * mx)
+    syy = cov * (_blur(y * y, window) - my * my)
+    sxy = cov * (_blur(x * y, window) - mx * my)
+    s = ((2 * mx * my + c1) * (2 * sxy + c2)) / ((mx * mx + my * my + c1) * (sxx + syy + c2))
+    return s.mean()
+
+
+def ssim_loss(a, b):
+    return 1 - ssim(a, b)
+
+
+def pyramid(a: torch.Tensor, b: torch.Tensor, levels: int = 4) -> torch.Tensor:
+    """L2 summed over a Gaussian-ish image pyramid (2x2 average pooling): coarse levels
+    give strokes far from where they belong a signal to move."""
+    x = a.permute(2, 0, 1)[None]
+    y = b.permute(2, 0, 1)[None]
+    total = torch.mean((x - y) ** 2)
+    for _ in range(levels - 1):
+        if min(x.shape[-2:]) < 2:
+            break
+        x, y = F.avg_pool2d(x, 2), F.avg_pool2d(y, 2)
+        total = total + torch.mean((x - y) ** 2)
+    return total
+
+
+def get(name: str):
+    table = {"l2": l2, "l1": l1, "ssim": ssim_loss, "pyramid": pyramid}
+    if name not in table:
+        raise VecfitError(f"loss must be one of {', '.join(LOSSES)}, not {name!r}")
+    return table[name]

@@ -1,0 +1,217 @@
+"""The refine job: an SVG fitted to a target image, with its SVG, report and comparison
+picture written next to each other. `vecfit trace` and `vecfit paint` end in the same job
+with an initial SVG of their own making."""
+from __future__ import annotations
+
+import math
+import time
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+import torch
+from PIL import Image, UnidentifiedImageError
+
+from . import __version__
+from .colors import parse_background
+from .errors import VecfitError
+from .metrics import compare, to_rgb
+from .optimize import Progress, Settings, Target, optimize
+from .render import output_size, render
+from .report import save_comparison, save_report
+from .scene import Scene
+from .svg.read import load_svg
+from .svg.write import write_svg
+
+OPAQUE = 0.999  # a target whose every alpha is at least this is treated as opaque
+ASPECT_TOLERANCE = 0.01
+
+
+@dataclass
+class Outputs:
+    svg: Path
+    report: Path
+    comparison: Path
+
+    @classmethod
+    def beside(cls, target: Path, svg: Path | None = None, report: Path | None = None,
+               comparison: Path | None = None) -> "Outputs":
+        """Defaults: NAME.vecfit.svg next to the target; the report and the picture
+        take the SVG's name with .report.json and .compare.png."""
+        svg = Path(svg) if svg else target.with_name(target.stem + ".vecfit.svg")
+        stem = svg.with_suffix("") if svg.suffix.lower() in (".svg", ".svgz") else svg
+        return cls(svg, Path(report) if report else stem.with_name(stem.name + ".report.json"),
+                   Path(comparison) if comparison else stem.with_name(stem.name + ".compare.png"))
+
+    def check_against(self, *inputs) -> None:
+        """Refuses outputs that would overwrite an input or each other."""
+        paths = [self.svg, self.report, self.comparison]
+        for out in paths:
+            for src in inputs:
+                if src is not None and _same_file(out, Path(src)):
+                    raise VecfitError(f"{out}: output would overwrite the input {src}; choose another name")
+        if len({p.resolve() for p in paths}) < len(paths):
+            raise VecfitError("the SVG, report and comparison outputs must be different files")
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return a.resolve() == b.resolve()
+    except OSError:
+        return False
+
+
+# ------------------------------------------------------------------------- target
+
+def load_target(path) -> np.ndarray:
+    """An image file as float32 straight RGBA [H, W, 4] in [0, 1]."""
+    path = Path(path)
+    if not path.exists():
+        raise VecfitError(f"{path}: no such file")
+    if path.is_dir():
+        raise VecfitError(f"{path}: is a folder, not an image")
+    try:
+        with Image.open(path) as im:
+            im.load()
+            rgba = im.convert("RGBA")
+    except UnidentifiedImageError:
+        raise VecfitError(f"{path}: not an image file (or a format that cannot be read)") from None
+    except (OSError, ValueError, Image.DecompressionBombError) as e:
+        raise VecfitError(f"{path}: cannot read the image ({e})") from None
+    a = np.asarray(rgba, dtype=np.float32) / 255.0
+    if a.shape[0] < 2 or a.shape[1] < 2:
+        raise VecfitError(f"{path}: the image is too small ({a.shape[1]}x{a.shape[0]} pixels)")
+    return a
+
+
+def corner_color(image: np.ndarray) -> tuple:
+    """The median colour of the four corner patches (5% of each side, at least 1 pixel)."""
+    h, w = image.shape[:2]
+    ph, pw = max(1, h // 20), max(1, w // 20)
+    patches = [image[:ph, :pw], image[:ph, -pw:], image[-ph:, :pw], image[-ph:, -pw:]]
+    rgb = np.median(np.concatenate([p.reshape(-1, 4) for p in patches])[:, :3], axis=0)
+    return (float(rgb[0]), float(rgb[1]), float(rgb[2]), 1.0)
+
+
+def background_for(image: np.ndarray, setting: str) -> tuple | None:
+    """'auto': transparent for a target with transparency, else its corners' colour."""
+    if setting.strip().lower() == "auto":
+        return None if float(image[..., 3].min()) < OPAQUE else corner_color(image)
+    return parse_background(setting)
+
+
+def downscaled(image: np.ndarray, max_size: int) -> np.ndarray:
+    """The image with its longest side at most max_size (area-averaged, premultiplied)."""
+    h, w = image.shape[:2]
+    if max_size <= 0 or max(h, w) <= max_size:
+        return image
+    scale = max_size / max(h, w)
+    size = (max(1, round(w * scale)), max(1, round(h * scale)))
+    pre = np.concatenate([image[..., :3] * image[..., 3:], image[..., 3:]], axis=2)
+    small = cv2.resize(pre, size, interpolation=cv2.INTER_AREA)
+    a = small[..., 3:]
+    rgb = np.where(a > 0, small[..., :3] / np.maximum(a, 1e-12), 0)
+    return np.concatenate([np.clip(rgb, 0, 1), np.clip(a, 0, 1)], axis=2).astype(np.float32)
+
+
+def check_sizes(scene: Scene, target: np.ndarray, svg_path, target_path) -> None:
+    h, w = target.shape[:2]
+    if scene.width <= 0 or scene.height <= 0:
+        raise VecfitError(f"{svg_path}: the SVG has no size")
+    a, b = scene.width / scene.height, w / h
+    if abs(a - b) > ASPECT_TOLERANCE * max(a, b):
+        raise VecfitError(f"{svg_path} is {scene.width:g}x{scene.height:g} but {target_path} is "
+                          f"{w}x{h}: their aspect ratios differ")
+
+
+# --------------------------------------------------------------------------- run
+
+def _rgb(image: torch.Tensor, background) -> np.ndarray:
+    """A render as RGB for metrics and pictures: over its background, else over white."""
+    return to_rgb(image.numpy(), background[:3] if background is not None else (1.0, 1.0, 1.0))
+
+
+def _render_full(scene, w, h, background, config) -> torch.Tensor:
+    with torch.no_grad():
+        return render(scene, w, h, samples=config["eval_samples"], background=background,
+                      seed=config["seed"], threads=config["threads"])
+
+
+def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Outputs,
+        progress=None, inputs: dict | None = None) -> dict:
+    """Optimise ``scene`` (read from ``source_svg``) against ``target`` with the
+    ``[optimize]`` settings of ``config``; writes the SVG, the comparison picture and the
+    report (last, so a report means a finished run). Returns the report."""
+    started = time.perf_counter()
+    opt = config["optimize"]
+    settings = Settings.from_config(opt)
+    background = background_for(target, opt["background"])
+    h, w = target.shape[:2]
+    small = downscaled(target, opt["max_size"])
+    sh, sw = small.shape[:2]
+    goal = Target(torch.from_numpy(small), background)
+    target_rgb = to_rgb(target, background[:3] if background is not None else (1.0, 1.0, 1.0))
+
+    initial_image = _render_full(scene, w, h, background, opt)
+    initial = compare(_rgb(initial_image, background), target_rgb)
+    result = optimize(scene, goal, settings, progress=progress)
+    final_image = _render_full(scene, w, h, background, opt)
+    final = compare(_rgb(final_image, background), target_rgb)
+
+    # The SVG must look like what was optimised: where the shapes leave the canvas
+    # uncovered, the background is written in as a first rect.
+    svg_background = None
+    if background is not None and background[3] > 0:
+        with torch.no_grad():
+            bare = render(scene, w, h, samples=1, threads=opt["threads"])
+        if float(bare[..., 3].min()) < OPAQUE:
+            svg_background = background
+    write_svg(scene, source_svg, outputs.svg, background=svg_background)
+    save_comparison(outputs.comparison, target_rgb, _rgb(initial_image, background),
+                    _rgb(final_image, background))
+    seconds = time.perf_counter() - started
+    report = {
+        "vecfit": __version__,
+        **(inputs or {}),
+        "output": str(outputs.svg),
+        "comparison": str(outputs.comparison),
+        "report": str(outputs.report),
+        "size": [w, h],
+        "optimized_size": [sw, sh],
+        "background": None if background is None else "#%02x%02x%02x" % tuple(
+            round(c * 255) for c in background[:3]),
+        "initial": initial,
+        "optimized": final,
+        "psnr_gain_db": final["psnr"] - initial["psnr"],
+        "mse_ratio": initial["mse"] / final["mse"] if final["mse"] > 0 else None,
+        "iterations": result.iterations,
+        "interrupted": result.interrupted,
+        "skipped_steps": result.skipped_steps,
+        "seconds": {"total": seconds, "optimize": result.seconds,
+                    "per_iteration": result.seconds / max(result.iterations, 1)},
+        "shapes": len(scene.shapes),
+        "parameters": {**result.parameters, "total": sum(result.parameters.values())},
+        "loss": settings.loss,
+        "loss_curve": result.losses,
+        "seed": opt["seed"],
+        "config": config,
+    }
+    save_report(outputs.report, report)
+    return report
+
+
+def refine(target_path, svg_path, config: dict, outputs: Outputs, progress=None) -> dict:
+    """`vecfit refine`: load, check and fit; see ``fit``."""
+    target_path, svg_path = Path(target_path), Path(svg_path)
+    outputs.check_against(target_path, svg_path)
+    target = load_target(target_path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        scene = load_svg(svg_path)
+    if not scene.shapes:
+        raise VecfitError(f"{svg_path}: the SVG has no shapes to optimise")
+    check_sizes(scene, target, svg_path, target_path)
+    return fit(scene, svg_path, target, config, outputs, progress,
+               inputs={"command": "refine", "target": str(target_path), "init": str(svg_path)})

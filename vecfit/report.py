@@ -1,0 +1,71 @@
+"""Outputs of an optimisation run besides the SVG: the JSON report and the comparison
+picture (target | initial | optimised | error map). Both are written atomically."""
+from __future__ import annotations
+
+import json
+import math
+
+import cv2
+import numpy as np
+from PIL import Image
+
+from .imageio import atomic_write, to_uint8
+
+PANEL_MAX = 512   # longest side of one panel of the comparison picture
+GAP = 4           # pixels between panels
+ERROR_GAIN = 4.0  # the error map shows |difference| x 4 (a 0.25 difference is full scale)
+
+
+def _panel(rgb: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    if rgb.shape[1::-1] != size:
+        rgb = cv2.resize(rgb.astype(np.float32), size, interpolation=cv2.INTER_AREA)
+    return np.clip(rgb, 0, 1)
+
+
+def error_map(result: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """Mean absolute RGB difference, amplified and coloured (inferno: dark is right)."""
+    err = np.clip(np.abs(result - target).mean(axis=2) * ERROR_GAIN, 0, 1)
+    coloured = cv2.applyColorMap(to_uint8(err), cv2.COLORMAP_INFERNO)
+    return coloured[..., ::-1].astype(np.float32) / 255.0
+
+
+def comparison_image(target: np.ndarray, initial: np.ndarray, optimized: np.ndarray) -> np.ndarray:
+    """Four panels side by side, RGB float: target, initial, optimised, error map."""
+    h, w = target.shape[:2]
+    scale = min(1.0, PANEL_MAX / max(h, w))
+    size = (max(1, round(w * scale)), max(1, round(h * scale)))
+    panels = [_panel(target, size), _panel(initial, size), _panel(optimized, size),
+              _panel(error_map(optimized, target), size)]
+    pw, ph = size
+    out = np.ones((ph, 4 * pw + 3 * GAP, 3), dtype=np.float32)
+    for i, p in enumerate(panels):
+        out[:, i * (pw + GAP):i * (pw + GAP) + pw] = p
+    return out
+
+
+def save_comparison(path, target, initial, optimized) -> None:
+    pixels = to_uint8(comparison_image(target, initial, optimized))
+    atomic_write(path, lambda tmp: Image.fromarray(pixels, "RGB").save(tmp, format="PNG"))
+
+
+def _jsonable(value):
+    if isinstance(value, dict):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, (np.floating, float)):
+        v = float(value)
+        return v if math.isfinite(v) else None  # JSON has no NaN / Infinity
+    if isinstance(value, np.integer):
+        return int(value)
+    return value
+
+
+def save_report(path, report: dict) -> None:
+    text = json.dumps(_jsonable(report), indent=2, allow_nan=False) + "\n"
+
+    def write(tmp):
+        with open(tmp, "w", encoding="utf-8") as f:
+            f.write(text)
+
+    atomic_write(path, write)
