@@ -241,5 +241,28 @@ def refine(target, init_svg, output, report, comparison, config_file, quiet, **o
              lambda bar: run_refine(target, init_svg, config, outputs, progress=bar))
 
 
+
+@main.command()
+@click.argument("target", type=click.Path(dir_okay=False))
+@click.option("--paths", type=click.IntRange(min=1), help="Number of strokes or shapes.")
+@click.option("--kind", type=click.Choice(["strokes", "shapes"]),
+              help="Open cubic strokes or closed filled shapes.")
+@click.option("--preset", help="A preset of configs/paint.toml.")
+@click.option("--frames", type=click.Path(file_okay=False),
+              help="Save the optimisation as frame_NNNNN.png and optimization.gif in this folder.")
+@optimize_options
+def paint(target, paths, kind, preset, frames, output, report, comparison, config_file, quiet,
+          **options):
+    """Paint TARGET with random strokes or shapes fitted by gradient descent."""
+    from vecfit.paint_job import paint as run_paint
+    from vecfit.refine import Outputs
+
+    config = _resolve_config("paint", preset, config_file, options,
+                             extra={"paint": {"paths": paths, "kind": kind}})
+    outputs = Outputs.beside(Path(target), output, report, comparison)
+    _run_job("paint", config["optimize"]["iterations"], quiet,
+             lambda bar: run_paint(target, config, outputs, progress=bar, frames=frames))
+
+
 if __name__ == "__main__":
     main()

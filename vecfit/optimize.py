@@ -95,6 +95,19 @@ class Progress:
 
 
 @dataclass
+class Step:
+    """What an iteration hook sees after an Adam step: the image rendered for this
+    iteration's loss (detached, [H, W, 4] at the optimised size), the Scene (already
+    stepped), and ``reset(tensor)``, which clears Adam's memory of a tensor that the hook
+    re-initialised. Hooks change the Scene's tensors in place, under no_grad."""
+    iteration: int
+    image: torch.Tensor
+    scene: Scene
+    target: "Target"
+    reset: Callable[[torch.Tensor], None]
+
+
+@dataclass
 class Result:
     losses: list            # loss of each iteration (before its step)
     best_loss: float
@@ -123,6 +136,7 @@ class _Kind:
             offset += n
         self.m = torch.zeros_like(self.flat)
         self.v = torch.zeros_like(self.flat)
+        self.steps = torch.zeros_like(self.flat)
 
     def gradient(self) -> torch.Tensor:
         return torch.cat([(t.grad if t.grad is not None else torch.zeros_like(t)).reshape(-1)
@@ -170,8 +184,9 @@ class Adam:
     def step(self, grads: list[torch.Tensor]) -> None:
         factor = self.factor()
         self.t += 1
-        c1, c2 = 1 - self.b1 ** self.t, 1 - self.b2 ** self.t
         for kind, g in zip(self.kinds, grads):
+            kind.steps += 1  # per element: a re-seeded element starts its bias correction anew
+            c1, c2 = 1 - self.b1 ** kind.steps, 1 - self.b2 ** kind.steps
             kind.m.mul_(self.b1).add_(g, alpha=1 - self.b1)
             kind.v.mul_(self.b2).addcmul_(g, g, value=1 - self.b2)
             step = (kind.m / c1) / (torch.sqrt(kind.v / c2) + self.eps)
@@ -224,9 +239,11 @@ def _kinds(scene: Scene, lr: dict, width: int, height: int) -> list[_Kind]:
 
 
 def optimize(scene: Scene, target: Target, settings: Settings,
-             progress: Callable[[Progress], None] | None = None) -> Result:
+             progress: Callable[[Progress], None] | None = None,
+             hooks: tuple[Callable[[Step], None], ...] = ()) -> Result:
     """Fit ``scene`` to ``target`` in place; returns the loss curve and counts. The Scene
-    ends at the best parameters seen. Ctrl-C stops early (``Result.interrupted``)."""
+    ends at the best parameters seen. Ctrl-C stops early (``Result.interrupted``).
+    ``hooks`` run after every iteration (see Step): re-seeding, saving frames."""
     settings.check()
     loss_fn = losses.get(settings.loss)
     height, width = target.image.shape[:2]
@@ -242,12 +259,28 @@ def optimize(scene: Scene, target: Target, settings: Settings,
     interrupted = False
     start = time.perf_counter()
 
+    frame = {}
+
     def evaluate(iteration: int, grad: bool):
         with torch.set_grad_enabled(grad):
             image = render(scene, width, height, samples=settings.samples, mode=settings.mode,
                            seed=settings.seed + iteration, background=target.background,
                            threads=settings.threads, boundary_samples=settings.boundary_samples)
+            frame["image"] = image.detach()
             return loss_fn(target.compared(image), goal)
+
+    where = {}
+    for i, k in enumerate(kinds):
+        offset = 0
+        for t in k.tensors:
+            where[id(t)] = (i, offset, t.numel())
+            offset += t.numel()
+
+    def reset(tensor: torch.Tensor) -> None:
+        if id(tensor) in where:
+            i, offset, n = where[id(tensor)]
+            for state in (kinds[i].m, kinds[i].v, kinds[i].steps):
+                state[offset:offset + n] = 0
 
     def restore_best():
         for k, b in zip(kinds, best):
@@ -291,6 +324,12 @@ def optimize(scene: Scene, target: Target, settings: Settings,
                     skipped += 1
                     restore_best()
                     adam.rate *= 0.5
+            if hooks and "image" in frame:
+                with torch.no_grad():
+                    for hook in hooks:
+                        hook(Step(it, frame["image"], scene, target, reset))
+                    for k in kinds:
+                        k.project()
             if progress is not None:
                 progress(Progress(it + 1, settings.iterations, value, best_loss,
                                   time.perf_counter() - start))

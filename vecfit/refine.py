@@ -140,10 +140,12 @@ def _render_full(scene, w, h, background, config) -> torch.Tensor:
 
 
 def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Outputs,
-        progress=None, inputs: dict | None = None) -> dict:
+        progress=None, inputs: dict | None = None, hooks=()) -> dict:
     """Optimise ``scene`` (read from ``source_svg``) against ``target`` with the
     ``[optimize]`` settings of ``config``; writes the SVG, the comparison picture and the
-    report (last, so a report means a finished run). Returns the report."""
+    report (last, so a report means a finished run). Returns the report. ``inputs`` are
+    extra report entries (a callable value is called when the report is made); ``hooks``
+    go to the optimisation loop."""
     started = time.perf_counter()
     opt = config["optimize"]
     settings = Settings.from_config(opt)
@@ -156,7 +158,7 @@ def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Out
 
     initial_image = _render_full(scene, w, h, background, opt)
     initial = compare(_rgb(initial_image, background), target_rgb)
-    result = optimize(scene, goal, settings, progress=progress)
+    result = optimize(scene, goal, settings, progress=progress, hooks=hooks)
     final_image = _render_full(scene, w, h, background, opt)
     final = compare(_rgb(final_image, background), target_rgb)
 
@@ -174,7 +176,7 @@ def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Out
     seconds = time.perf_counter() - started
     report = {
         "vecfit": __version__,
-        **(inputs or {}),
+        **{k: v() if callable(v) else v for k, v in (inputs or {}).items()},
         "output": str(outputs.svg),
         "comparison": str(outputs.comparison),
         "report": str(outputs.report),

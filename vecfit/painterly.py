@@ -1,0 +1,227 @@
+"""Painterly rendering (Li et al. 2020, section 6.3): random strokes or closed shapes fitted
+to a target with the shared optimisation loop. This module makes the random initial SVG,
+re-seeds primitives that stopped contributing, and saves frames of the optimisation.
+
+Re-seeding: every ``reseed_every`` iterations (not in the last fifth of the run, so the
+final shapes settle), a primitive that has left the canvas, faded below ``reseed_alpha``
+or thinned below ``reseed_width`` pixels is placed anew where the current error is
+largest: a pixel is drawn with probability proportional to the squared error (blurred,
+so a region of error beats a lone noisy pixel), the primitive is rebuilt around it with
+the target's colour there, and the error around that spot is cleared before the next draw
+so that several re-seeds do not land on one place.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import cv2
+import numpy as np
+import torch
+from PIL import Image
+
+from .errors import VecfitError
+from .imageio import atomic_write, to_uint8
+from .scene import Path as PathGeometry
+
+KINDS = ("strokes", "shapes")
+
+
+@dataclass
+class PaintSettings:
+    paths: int = 256
+    kind: str = "strokes"
+    stroke_segments: int = 3        # strokes: 1 to this many cubic segments
+    shape_segments_min: int = 3     # shapes: closed paths of min..max cubic segments
+    shape_segments_max: int = 5
+    min_width: float = 1.0          # stroke widths drawn uniformly in [min, max] pixels
+    max_width: float = 5.0
+    radius: float = 0.05            # control-point spread, as a fraction of the longer side
+    reseed_every: int = 50          # 0: never re-seed
+    reseed_alpha: float = 0.05
+    reseed_width: float = 0.3
+    frames_every: int = 5
+    seed: int = 0
+
+    def check(self) -> None:
+        if self.kind not in KINDS:
+            raise VecfitError(f"kind must be one of {', '.join(KINDS)}, not {self.kind!r}")
+        if self.paths < 1:
+            raise VecfitError("paths must be at least 1")
+        if self.stroke_segments < 1 or not 1 <= self.shape_segments_min <= self.shape_segments_max:
+            raise VecfitError("segment counts must be at least 1 (and min <= max)")
+        if not 0 <= self.min_width <= self.max_width:
+            raise VecfitError("stroke widths need 0 <= min_width <= max_width")
+        if not self.radius > 0:
+            raise VecfitError("radius must be positive")
+
+
+# ----------------------------------------------------------------- initial SVG
+
+def _color(rgb, alpha) -> str:
+    r, g, b = (int(round(float(c) * 255)) for c in rgb)
+    return f"rgba({r},{g},{b},{float(alpha):.3f})"
+
+
+def _stroke_points(rng, center, segments, spread) -> np.ndarray:
+    """A random walk of 3 * segments + 1 control points starting at center."""
+    steps = rng.uniform(-0.5, 0.5, size=(3 * segments, 2)) * spread
+    return np.vstack([center, center + np.cumsum(steps, axis=0)])
+
+
+def _shape_points(rng, center, segments, spread) -> np.ndarray:
+    """3 * segments control points of a closed blob around center (angles sorted so the
+    outline does not start out tangled)."""
+    n = 3 * segments
+    angles = np.sort(rng.uniform(0, 2 * math.pi, n))
+    radii = spread * rng.uniform(0.25, 0.5, n)
+    return center + np.stack([np.cos(angles) * radii, np.sin(angles) * radii], axis=1)
+
+
+def _path_data(points: np.ndarray, closed: bool) -> str:
+    f = lambda v: f"{v:.2f}"  # noqa: E731
+    parts = [f"M {f(points[0, 0])} {f(points[0, 1])}"]
+    body = np.vstack([points[1:], points[:1]]) if closed else points[1:]
+    for i in range(0, len(body), 3):
+        c = body[i:i + 3]
+        parts.append("C " + " ".join(f"{f(x)} {f(y)}" for x, y in c))
+    return " ".join(parts) + (" Z" if closed else "")
+
+
+def initial_svg(target: np.ndarray, settings: PaintSettings) -> str:
+    """Random primitives over the canvas of ``target`` ([H, W, 4]); colours are random,
+    as in the paper (the optimisation finds the right ones)."""
+    settings.check()
+    h, w = target.shape[:2]
+    rng = np.random.default_rng(settings.seed)
+    spread = settings.radius * max(w, h)
+    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}">']
+    for i in range(settings.paths):
+        center = rng.uniform([0, 0], [w, h])
+        rgb, alpha = rng.uniform(0, 1, 3), rng.uniform(0.3, 1.0)
+        if settings.kind == "strokes":
+            pts = _stroke_points(rng, center, int(rng.integers(1, settings.stroke_segments + 1)), spread)
+            width = rng.uniform(settings.min_width, settings.max_width)
+            out.append(f'<path id="s{i}" d="{_path_data(pts, False)}" fill="none" stroke="{_color(rgb, alpha)}" '
+                       f'stroke-width="{width:.2f}" stroke-linecap="round" stroke-linejoin="round"/>')
+        else:
+            segs = int(rng.integers(settings.shape_segments_min, settings.shape_segments_max + 1))
+            pts = _shape_points(rng, center, segs, spread)
+            out.append(f'<path id="s{i}" d="{_path_data(pts, True)}" fill="{_color(rgb, alpha)}"/>')
+    out.append("</svg>")
+    return "\n".join(out) + "\n"
+
+
+# --------------------------------------------------------------------- re-seeding
+
+@dataclass
+class Reseeder:
+    """An optimisation hook (vecfit.optimize.Step) that re-seeds wasted primitives."""
+    settings: PaintSettings
+    iterations: int
+    reseeded: int = 0
+    history: list = field(default_factory=list)  # (iteration, count)
+
+    def __post_init__(self):
+        self.rng = np.random.default_rng(self.settings.seed + 1)
+
+    def __call__(self, step) -> None:
+        every = self.settings.reseed_every
+        if every <= 0 or (step.iteration + 1) % every or step.iteration + 1 > 0.8 * self.iterations:
+            return
+        scene = step.scene
+        wasted = [s for s in scene.shapes if self._wasted(s, scene.width, scene.height)]
+        if not wasted:
+            return
+        error = self._error_map(step)
+        sh, sw = error.shape
+        to_units = scene.width / sw
+        goal = step.target.image.numpy()
+        spread = self.settings.radius * max(scene.width, scene.height)
+        for shape in wasted:
+            flat = error.reshape(-1)
+            total = float(flat.sum())
+            if total <= 0:
+                break
+            k = int(self.rng.choice(flat.size, p=flat / total))
+            y, x = divmod(k, sw)
+            center = np.array([(x + 0.5) * to_units, (y + 0.5) * to_units])
+            self._rebuild(shape, center, goal[y, x, :3], spread, step.reset)
+            r = max(1, int(round(spread / to_units)))
+            error[max(0, y - r):y + r + 1, max(0, x - r):x + r + 1] = 0
+            self.reseeded += 1
+        self.history.append((step.iteration + 1, len(wasted)))
+
+    def _wasted(self, shape, width, height) -> bool:
+        g = shape.geometry
+        if not isinstance(g, PathGeometry):
+            return False
+        p = g.points.detach()
+        outside = bool((p[:, 0].max() < 0) | (p[:, 0].min() > width) | (p[:, 1].max() < 0)
+                       | (p[:, 1].min() > height))
+        paint = shape.stroke if shape.stroke is not None else shape.fill
+        alpha = float(paint.color[3]) * float(shape.opacity) if hasattr(paint, "color") else 1.0
+        thin = shape.stroke is not None and float(shape.stroke_width) < self.settings.reseed_width
+        return outside or alpha < self.settings.reseed_alpha or thin
+
+    @staticmethod
+    def _error_map(step) -> np.ndarray:
+        diff = step.target.compared(step.image) - step.target.compared(step.target.image)
+        err = (diff.numpy() ** 2).sum(axis=2).astype(np.float32)
+        return cv2.GaussianBlur(err, (0, 0), 2.0).astype(np.float64)
+
+    def _rebuild(self, shape, center, rgb, spread, reset) -> None:
+        g = shape.geometry
+        n = g.points.shape[0]
+        if shape.stroke is not None:
+            pts = _stroke_points(self.rng, center, (n - 1) // 3, spread)
+            shape.stroke.color.copy_(torch.tensor([*rgb, 1.0], dtype=torch.float32))
+            shape.stroke_width.fill_(float(self.rng.uniform(self.settings.min_width, self.settings.max_width)))
+            reset(shape.stroke.color)
+            reset(shape.stroke_width)
+        else:
+            pts = _shape_points(self.rng, center, n // 3, spread)
+            shape.fill.color.copy_(torch.tensor([*rgb, 1.0], dtype=torch.float32))
+            reset(shape.fill.color)
+        shape.opacity.fill_(1.0)
+        g.points.copy_(torch.as_tensor(pts[:n], dtype=torch.float32))
+        reset(g.points)
+
+
+# ------------------------------------------------------------------------- frames
+
+class FrameSaver:
+    """An optimisation hook that saves every ``every``-th render as a PNG and, at the end
+    (``finish``), an animated GIF of them."""
+
+    GIF_MAX = 256  # longest side of the GIF's frames
+
+    def __init__(self, folder, every: int):
+        self.folder, self.every = Path(folder), max(1, every)
+        self.files: list[Path] = []
+
+    def __call__(self, step) -> None:
+        if step.iteration % self.every:
+            return
+        bg = step.target.background
+        img = step.image.numpy()
+        a = img[..., 3:]
+        base = np.asarray(bg[:3] if bg is not None else (1.0, 1.0, 1.0), dtype=np.float32)
+        rgb = to_uint8(img[..., :3] * a + base * (1 - a))
+        path = self.folder / f"frame_{step.iteration:05d}.png"
+        atomic_write(path, lambda tmp: Image.fromarray(rgb, "RGB").save(tmp, format="PNG"))
+        self.files.append(path)
+
+    def finish(self) -> Path | None:
+        if not self.files:
+            return None
+        frames = []
+        for f in self.files:
+            with Image.open(f) as im:
+                im.thumbnail((self.GIF_MAX, self.GIF_MAX))
+                frames.append(im.convert("P", palette=Image.ADAPTIVE))
+        gif = self.folder / "optimization.gif"
+        atomic_write(gif, lambda tmp: frames[0].save(tmp, format="GIF", save_all=True,
+                                                     append_images=frames[1:], duration=60, loop=0))
+        return gif
