@@ -317,13 +317,13 @@ def test_interrupted_cli_run_writes_best_result(tmp_path, monkeypatch):
     import vecfit.refine as refine_module
     real = refine_module.optimize
 
-    def interrupted(scene, target, settings, progress=None):
+    def interrupted(scene, target, settings, progress=None, hooks=()):
         def stop(p):
             if progress:
                 progress(p)
             if p.iteration == 5:
                 raise KeyboardInterrupt
-        return real(scene, target, settings, progress=stop)
+        return real(scene, target, settings, progress=stop, hooks=hooks)
 
     monkeypatch.setattr(refine_module, "optimize", interrupted)
     target = disc_image(tmp_path / "t.png")
