@@ -244,6 +244,32 @@ def refine(target, init_svg, output, report, comparison, config_file, quiet, **o
 
 @main.command()
 @click.argument("target", type=click.Path(dir_okay=False))
+@click.option("--preset", help="A preset of configs/trace.toml: photo, poster or bw.")
+@click.option("--paths", type=click.IntRange(min=1), help="Path budget: at most this many shapes.")
+@click.option("--colors", type=click.IntRange(min=1), help="Colours of the k-means quantisation.")
+@click.option("--min-area", type=click.FloatRange(min=0), help="Speckle removal: smallest region (pixels).")
+@click.option("--tolerance", type=click.FloatRange(min=0, min_open=True),
+              help="Largest curve-fitting error (pixels).")
+@click.option("--refine/--no-refine", default=True, show_default=True,
+              help="Refine the trace against the image (else write the trace as it is).")
+@optimize_options
+def trace(target, preset, paths, colors, min_area, tolerance, refine, output, report, comparison,
+          config_file, quiet, **options):
+    """Trace TARGET into an SVG (colour regions fitted with cubic curves), then refine it."""
+    from vecfit.refine import Outputs
+    from vecfit.trace_job import trace as run_trace
+
+    config = _resolve_config("trace", preset, config_file, options, extra={"trace": {
+        "paths": paths, "colors": colors, "min_area": min_area, "tolerance": tolerance}})
+    outputs = Outputs.beside(Path(target), output, report, comparison)
+    iterations = config["optimize"]["iterations"] if refine else 0
+    status = None if quiet else _echo_err
+    _run_job("refine", iterations, quiet,
+             lambda bar: run_trace(target, config, outputs, progress=bar, refine=refine, status=status))
+
+
+@main.command()
+@click.argument("target", type=click.Path(dir_okay=False))
 @click.option("--paths", type=click.IntRange(min=1), help="Number of strokes or shapes.")
 @click.option("--kind", type=click.Choice(["strokes", "shapes"]),
               help="Open cubic strokes or closed filled shapes.")
@@ -262,6 +288,78 @@ def paint(target, paths, kind, preset, frames, output, report, comparison, confi
     outputs = Outputs.beside(Path(target), output, report, comparison)
     _run_job("paint", config["optimize"]["iterations"], quiet,
              lambda bar: run_paint(target, config, outputs, progress=bar, frames=frames))
+
+
+
+# ------------------------------------------------------------------------------ batch
+
+@main.command()
+@click.argument("in_dir", type=click.Path(exists=True, file_okay=False))
+@click.option("-o", "--out-dir", required=True, type=click.Path(file_okay=False),
+              help="Folder for the outputs and the summary (not IN_DIR).")
+@click.option("--mode", required=True, type=click.Choice(["trace", "refine", "paint"]),
+              help="The command run on each image.")
+@click.option("--config", "config_file", type=click.Path(dir_okay=False),
+              help="TOML file overriding the defaults in configs/.")
+@click.option("--preset", help="A preset of the mode's file in configs/.")
+@click.option("--init-dir", type=click.Path(exists=True, file_okay=False),
+              help="refine: the folder of the SVGs (default: IN_DIR).")
+@click.option("-j", "--jobs", type=click.IntRange(min=0), default=1, show_default=True,
+              help="Worker processes (0: one per core); 1 works in this process.")
+@click.option("--threads", type=click.IntRange(min=1),
+              help="Threads per worker (default: the cores divided between the workers; "
+                   "1 per task with --scheduler).")
+@click.option("--resume/--no-resume", default=True, show_default=True,
+              help="Skip images finished with the same settings.")
+@click.option("--scheduler", metavar="ADDRESS",
+              help="Run the images on this Dask distributed scheduler (needs the "
+                   "'distributed' package; paths must be the same on the workers).")
+@click.option("-q", "--quiet", is_flag=True, help="No progress bar or per-image lines.")
+def batch(in_dir, out_dir, mode, config_file, preset, init_dir, jobs, threads, resume, scheduler,
+          quiet):
+    """Run refine, trace or paint on every image in IN_DIR (*.png, *.jpg, *.jpeg, *.bmp,
+    *.tif, *.tiff, *.webp; not recursive), writing NAME.svg, NAME.report.json and
+    NAME.compare.png per image, and summary.csv, summary.json and index.html (with
+    thumbs/) into OUT_DIR. For refine, each image is paired with the SVG of the same name
+    in IN_DIR (or --init-dir); an image without one is reported as unpaired. A failing
+    image is recorded with its reason and the others go on.
+
+    \b
+    Exit codes:
+      0    every image done, or skipped as finished
+      1    some image failed or was unpaired (the others are done)
+      2    bad usage: no IN_DIR, bad options or config, no Dask scheduler
+      130  interrupted (Ctrl-C): finished images are kept, nothing half-written
+    """
+    reporter = None
+    try:
+        from vecfit.batch import BatchUsageError, run_batch
+        from vecfit.batch.progress import Progress
+
+        reporter = Progress(quiet=quiet)
+        try:
+            result = run_batch(in_dir, out_dir, mode, config_file=config_file, preset=preset,
+                               jobs=jobs, threads=threads, resume=resume, init_dir=init_dir,
+                               scheduler=scheduler, reporter=reporter)
+        except BatchUsageError as e:
+            _echo_err(f"error: {e}")
+            sys.exit(EXIT_USAGE)
+    except KeyboardInterrupt:  # before the run started, or while the summary was written
+        if reporter is not None:
+            reporter.finish()
+        _echo_err("interrupted")
+        sys.exit(EXIT_INTERRUPTED)
+    counts = ", ".join(f"{n} {status}" for status, n in result.counts.items() if n)
+    if not result.rows:
+        _echo_err(f"warning: no images in {in_dir}")
+    else:
+        n = len(result.rows)
+        _echo_err(f"{n} image{'s' if n != 1 else ''}: {counts}")
+    for path in result.summary.values():
+        click.echo(f"summary: {path}")
+    if result.interrupted:
+        _echo_err("interrupted: finished images are kept; run again to resume")
+    sys.exit(result.exit_code)
 
 
 if __name__ == "__main__":

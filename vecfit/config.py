@@ -84,6 +84,8 @@ def resolve(command: str, *, preset: str | None = None, config_file=None,
         presets = own.pop("presets", {})
         for key, value in own.items():  # the command's own tables join the schema
             if key not in schema:
+                if not isinstance(value, dict):
+                    raise VecfitError(f"configs/{command}.toml: {key!r} must be inside a table")
                 schema[key] = copy.deepcopy(value)
         settings = merge(settings, own, schema, f"configs/{command}.toml")
     if preset is not None:

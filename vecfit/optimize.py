@@ -40,12 +40,15 @@ class Settings:
     seed: int = 0
     threads: int = 0
     lr_decay: float = 0.1
+    lr_warmup: int = 0
+    fixed_alpha: bool = False
     lr: dict = field(default_factory=lambda: {"points": 2.0, "colors": 0.02})
 
     @classmethod
     def from_config(cls, table: dict) -> "Settings":
         s = cls(**{k: table[k] for k in ("iterations", "loss", "mode", "samples", "boundary_samples",
-                                         "seed", "threads", "lr_decay") if k in table},
+                                         "seed", "threads", "lr_decay", "lr_warmup", "fixed_alpha")
+                                         if k in table},
                 lr=dict(table.get("lr", {})))
         s.check()
         return s
@@ -60,6 +63,8 @@ class Settings:
             raise VecfitError("samples must be at least 1")
         if not 0 < self.lr_decay <= 1:
             raise VecfitError("lr_decay must be in (0, 1]")
+        if self.lr_warmup < 0:
+            raise VecfitError("lr_warmup must be 0 or more")
         for kind, value in self.lr.items():
             if kind not in KINDS:
                 raise VecfitError(f"unknown parameter kind {kind!r} (known: {', '.join(KINDS)})")
@@ -170,16 +175,20 @@ class Adam:
     """Adam (Kingma & Ba) over the flat kinds, with a per-element scale of the learning
     rate (lengths in each tensor's own units) and a cosine fall of the rates."""
 
-    def __init__(self, kinds: list[_Kind], iterations: int, decay: float,
+    def __init__(self, kinds: list[_Kind], iterations: int, decay: float, warmup: int = 0,
                  betas=(0.9, 0.999), eps: float = 1e-8):
-        self.kinds, self.iterations, self.decay = kinds, max(iterations, 1), decay
+        self.kinds, self.iterations, self.decay, self.warmup = kinds, max(iterations, 1), decay, warmup
         self.b1, self.b2, self.eps = betas[0], betas[1], eps
         self.t = 0
         self.rate = 1.0  # lowered after a step that produced non-finite values
 
     def factor(self) -> float:
+        """Linear warm-up, then a cosine fall to ``decay``. The warm-up matters: Adam's
+        first steps move every coordinate by the full rate whatever its gradient, which
+        throws a good initial trace out of place before the moments have settled."""
         frac = min(self.t / self.iterations, 1.0)
-        return self.rate * (self.decay + (1 - self.decay) * 0.5 * (1 + math.cos(math.pi * frac)))
+        warm = min(1.0, (self.t + 1) / self.warmup) if self.warmup > 0 else 1.0
+        return self.rate * warm * (self.decay + (1 - self.decay) * 0.5 * (1 + math.cos(math.pi * frac)))
 
     def step(self, grads: list[torch.Tensor]) -> None:
         factor = self.factor()
@@ -218,7 +227,7 @@ def _learning_rate_scales(scene: Scene, width: int, height: int) -> dict[int, fl
     return out
 
 
-def _kinds(scene: Scene, lr: dict, width: int, height: int) -> list[_Kind]:
+def _kinds(scene: Scene, lr: dict, width: int, height: int, fixed_alpha: bool = False) -> list[_Kind]:
     scales = _learning_rate_scales(scene, width, height)
     kinds = []
     for name, tensors in scene.parameters().items():
@@ -234,6 +243,8 @@ def _kinds(scene: Scene, lr: dict, width: int, height: int) -> list[_Kind]:
         kind = _Kind(name, tensors, per_tensor, rate)
         if name == "transforms":  # the last row of an affine matrix stays 0 0 1
             kind.scale.view(-1, 3, 3)[:, 2, :] = 0.0
+        if name == "colors" and fixed_alpha:  # colours are RGBA rows: keep the A
+            kind.scale.view(-1, 4)[:, 3] = 0.0
         kinds.append(kind)
     return kinds
 
@@ -248,10 +259,10 @@ def optimize(scene: Scene, target: Target, settings: Settings,
     loss_fn = losses.get(settings.loss)
     height, width = target.image.shape[:2]
     goal = target.compared(target.image.float())
-    kinds = _kinds(scene, settings.lr, width, height)
+    kinds = _kinds(scene, settings.lr, width, height, settings.fixed_alpha)
     if not kinds:
         raise VecfitError("nothing to optimise: the scene has no parameters with a learning rate above 0")
-    adam = Adam(kinds, settings.iterations, settings.lr_decay)
+    adam = Adam(kinds, settings.iterations, settings.lr_decay, settings.lr_warmup)
     best = [k.flat.clone() for k in kinds]
     best_loss = math.inf
     curve: list[float] = []

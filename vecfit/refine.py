@@ -147,6 +147,9 @@ def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Out
     extra report entries (a callable value is called when the report is made); ``hooks``
     go to the optimisation loop."""
     started = time.perf_counter()
+    # The report marks a finished run: an old one must not sit beside new outputs if this
+    # run dies before it writes its own.
+    outputs.report.unlink(missing_ok=True)
     opt = config["optimize"]
     settings = Settings.from_config(opt)
     background = background_for(target, opt["background"])
@@ -161,6 +164,8 @@ def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Out
     result = optimize(scene, goal, settings, progress=progress, hooks=hooks)
     final_image = _render_full(scene, w, h, background, opt)
     final = compare(_rgb(final_image, background), target_rgb)
+    if not all(math.isfinite(final[k]) or (k == "psnr" and final["mse"] == 0) for k in final):
+        raise VecfitError(f"the optimised image has non-finite values ({final}); nothing written")
 
     # The SVG must look like what was optimised: where the shapes leave the canvas
     # uncovered, the background is written in as a first rect.

@@ -1,0 +1,98 @@
+"""`vecfit trace` end to end: trace, refine, outputs, budgets, presets and bad input."""
+from __future__ import annotations
+
+import json
+import os
+import warnings
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from PIL import Image
+
+import vecfit
+from vecfit.cli.main import main
+from vecfit.metrics import compare
+
+
+def run(*args):
+    return CliRunner().invoke(main, [str(a) for a in args], catch_exceptions=False)
+
+
+@pytest.fixture(scope="module")
+def coffee(tmp_path_factory):
+    from skimage.data import coffee as load
+    d = tmp_path_factory.mktemp("coffee")
+    Image.fromarray(load()).resize((96, 64), Image.LANCZOS).save(d / "coffee.png")
+    return d / "coffee.png"
+
+
+def load(path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return vecfit.load_svg(path)
+
+
+def test_trace_and_refine(coffee, tmp_path):
+    """A 96 x 64 photo, at most 60 paths: the trace parses, renders, keeps the budget, and
+    30 iterations of refinement gain >= 1 dB (measured ~2.5 dB)."""
+    out = tmp_path / "c.svg"
+    r = run("trace", coffee, "-o", out, "--paths", 60, "--iterations", 30, "--threads", 2, "-q")
+    assert r.exit_code == 0, r.output
+    report = json.loads((tmp_path / "c.report.json").read_text())
+    assert report["command"] == "trace" and report["trace"]["paths"] <= 60
+    scene = load(out)
+    assert 10 <= len(scene.shapes) <= 60
+    assert report["optimized"]["psnr"] >= report["initial"]["psnr"] + 1.0
+    assert report["initial"]["psnr"] > 18  # the trace alone already resembles the photo
+    target = np.asarray(Image.open(coffee).convert("RGB"), np.float64) / 255
+    img = vecfit.render(scene, 96, 64, samples=4, background=[1, 1, 1, 1]).numpy()[..., :3]
+    assert abs(compare(img.astype(np.float64), target)["psnr"] - report["optimized"]["psnr"]) < 0.5
+
+
+def test_no_refine_writes_the_trace(coffee, tmp_path):
+    out = tmp_path / "t.svg"
+    r = run("trace", coffee, "-o", out, "--no-refine", "--preset", "poster", "-q")
+    assert r.exit_code == 0, r.output
+    report = json.loads((tmp_path / "t.report.json").read_text())
+    assert report["iterations"] == 0 and report["loss_curve"] == []
+    assert report["optimized"] == report["initial"]
+    assert report["config"]["trace"]["palette"] is True
+    scene = load(out)
+    colors = {tuple(np.round(s.fill.color.numpy(), 3)) for s in scene.shapes if s.fill is not None}
+    assert len(colors) <= 12  # the poster preset's palette
+
+
+def test_transparent_target_stays_transparent(tmp_path):
+    a = np.zeros((40, 40, 4), np.uint8)
+    yy, xx = np.mgrid[0:40, 0:40]
+    a[(xx - 20) ** 2 + (yy - 20) ** 2 < 100] = (200, 30, 30, 255)
+    Image.fromarray(a, "RGBA").save(tmp_path / "dot.png")
+    r = run("trace", tmp_path / "dot.png", "--iterations", 10, "-q")
+    assert r.exit_code == 0, r.output
+    scene = load(tmp_path / "dot.vecfit.svg")
+    img = vecfit.render(scene, 40, 40, samples=2).numpy()
+    assert img[0, 0, 3] == 0 and img[20, 20, 3] > 0.99
+    assert "vecfit-background" not in (tmp_path / "dot.vecfit.svg").read_text()
+
+
+@pytest.mark.parametrize("case", ["missing", "not an image", "folder"])
+def test_bad_target(case, tmp_path):
+    path = {"missing": tmp_path / "nope.png", "not an image": tmp_path / "x.png",
+            "folder": tmp_path / "d"}[case]
+    if case == "not an image":
+        path.write_bytes(b"\x89PNG but not really")
+    if case == "folder":
+        path.mkdir()
+    before = sorted(os.listdir(tmp_path))
+    r = run("trace", path, "-q")
+    assert r.exit_code in (1, 2), r.output
+    assert "Traceback" not in r.output and ("nope.png" in r.output or "x.png" in r.output or "d" in r.output)
+    assert sorted(os.listdir(tmp_path)) == before
+
+
+def test_bad_trace_setting_is_a_usage_error(coffee, tmp_path):
+    cfg = tmp_path / "t.toml"
+    cfg.write_text("[trace]\ncolours = 5\n")
+    r = run("trace", coffee, "--config", cfg)
+    assert r.exit_code == 2 and "unknown setting 'trace.colours'" in r.output

@@ -1,0 +1,57 @@
+"""Colour quantisation: k-means in CIELAB, so that clusters follow perceived colour
+differences rather than RGB distances (dark tones are not lumped together)."""
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+OPAQUE = 0.5  # pixels at least this opaque are traced; the others stay transparent
+
+
+def prefilter(rgb: np.ndarray, blur: float) -> np.ndarray:
+    """A light Gaussian blur (sigma in pixels) that calms noise and texture before
+    clustering, so fewer one-pixel speckles come out of it. 0 leaves the image as is."""
+    if blur <= 0:
+        return rgb
+    return cv2.GaussianBlur(rgb, (0, 0), sigmaX=blur, sigmaY=blur, borderType=cv2.BORDER_REFLECT)
+
+
+def to_lab(rgb: np.ndarray) -> np.ndarray:
+    """sRGB float in [0, 1] to CIELAB (L in [0, 100], a and b about [-128, 127])."""
+    return cv2.cvtColor(np.ascontiguousarray(rgb, dtype=np.float32), cv2.COLOR_RGB2Lab)
+
+
+def quantize(rgb: np.ndarray, opaque: np.ndarray, colors: int, seed: int,
+             sample: int = 20_000, attempts: int = 1) -> np.ndarray:
+    """Cluster label of each pixel, int32 [H, W]; -1 where the pixel is not opaque.
+
+    k-means runs on at most `sample` opaque pixels (a seeded random subset, for speed),
+    then every opaque pixel takes the nearest centre."""
+    labels = np.full(opaque.shape, -1, np.int32)
+    lab = to_lab(rgb)[opaque]
+    if len(lab) == 0:
+        return labels
+    rng = np.random.default_rng(seed)
+    data = lab if len(lab) <= sample else lab[rng.choice(len(lab), sample, replace=False)]
+    distinct = np.unique(data, axis=0)
+    if len(distinct) <= colors:
+        centres = distinct  # few colours (flat art, tiny images): each is its own cluster
+    else:
+        cv2.setRNGSeed(seed)  # cv2.kmeans draws its k-means++ seeds from OpenCV's global RNG
+        criteria = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 30, 0.05)
+        _, _, centres = cv2.kmeans(np.ascontiguousarray(data), colors, None, criteria, attempts,
+                                   cv2.KMEANS_PP_CENTERS)
+    labels[opaque] = nearest_centre(lab, centres)
+    return labels
+
+
+def nearest_centre(points: np.ndarray, centres: np.ndarray, chunk: int = 1 << 16) -> np.ndarray:
+    """Index of the nearest centre for each point (ties go to the lower index), in chunks
+    to bound the memory of the distance matrix."""
+    out = np.empty(len(points), np.int32)
+    c2 = (centres ** 2).sum(1)
+    for start in range(0, len(points), chunk):
+        p = points[start:start + chunk]
+        d = c2[None, :] - 2.0 * p @ centres.T
+        out[start:start + chunk] = d.argmin(1)
+    return out

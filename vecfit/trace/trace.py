@@ -1,0 +1,116 @@
+"""trace_image: a raster image to an initial vector graphic (SVG text).
+
+Pipeline: colour quantisation (k-means in CIELAB) -> connected regions of each colour ->
+speckles and slivers merged into neighbours, then merges until the path budget holds ->
+regions stacked by filled area, largest first, each drawn as its filled outer outline,
+grown a pixel under the regions on top of it -> outlines fitted with cubic Béziers.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ..errors import VecfitError
+from .bezier import fit_outlines
+from .outlines import crack_outlines, drawing_order, grown_mask, region_boxes
+from .quantize import OPAQUE, prefilter, quantize
+from .regions import build_regions, palette_colors
+from .settings import TraceResult, TraceSettings, check_settings
+from .subpixel import refine_outlines
+from .svgtext import hex_color, path_data, path_element, rect_element, svg_document
+
+
+def check_image(image) -> np.ndarray:
+    """The image as float32 RGBA [H, W, 4]; RGB is taken as opaque."""
+    a = np.asarray(image)
+    if a.ndim != 3 or a.shape[2] not in (3, 4):
+        raise VecfitError("trace: expected an RGBA image of shape [H, W, 4], "
+                          f"got shape {list(a.shape)}")
+    if a.shape[0] == 0 or a.shape[1] == 0:
+        raise VecfitError(f"trace: the image is empty ({a.shape[1]}x{a.shape[0]} pixels)")
+    if not np.issubdtype(a.dtype, np.floating):
+        raise VecfitError(f"trace: expected float values in [0, 1], got {a.dtype} "
+                          "(divide 8-bit images by 255)")
+    a = a.astype(np.float32)
+    if not np.isfinite(a).all():
+        raise VecfitError("trace: the image has NaN or infinite values")
+    if a.min() < -1e-3 or a.max() > 1 + 1e-3:
+        raise VecfitError(f"trace: values must lie in [0, 1], found [{a.min():g}, {a.max():g}]")
+    a = np.clip(a, 0, 1)
+    if a.shape[2] == 3:
+        a = np.concatenate([a, np.ones_like(a[..., :1])], 2)
+    return a
+
+
+def trace_image(image: np.ndarray, settings: TraceSettings = TraceSettings(),
+                progress=None) -> TraceResult:
+    """Trace an image into SVG text.
+
+    image: float32 RGBA [H, W, 4], straight alpha in [0, 1] (what vecfit.imageio.load_rgba
+    returns). Pixels with alpha >= 0.5 are traced as opaque shapes; the others get no shape,
+    so a transparent background stays transparent. Raises VecfitError for a bad image or
+    settings.
+
+    progress, if given, is called as progress(stage, fraction): stage is one of
+    "quantise", "regions", "order", "outline", "fit", fraction how much of the whole
+    trace is done, in [0, 1].
+    """
+    start = time.perf_counter()
+    check_settings(settings)
+    image = check_image(image)
+    s = settings
+    report = progress or (lambda stage, fraction: None)
+    h, w = image.shape[:2]
+    rgb = np.ascontiguousarray(image[..., :3])
+    alpha = image[..., 3]
+    opaque = alpha >= OPAQUE
+
+    report("quantise", 0.0)
+    classes = quantize(prefilter(rgb, s.blur), opaque, int(s.colors), int(s.seed))
+    report("regions", 0.15)
+    regions = build_regions(classes, rgb, int(s.paths), s.min_area, s.merge_thin)
+    report("order", 0.35)
+    boxes = region_boxes(regions.labels, regions.count)
+    order = drawing_order(regions.labels, regions.count, boxes)
+    rank = np.empty(regions.count, np.int64)
+    rank[order] = np.arange(regions.count)
+    # over an opaque image, everything else is drawn over the largest region: a
+    # full-canvas rect will do for that one
+    background = order[0] if regions.count and opaque.all() else None
+
+    report("outline", 0.4)
+    shapes, outlines = [], []  # shapes: (region, its outlines' slice of `outlines`)
+    for j, i in enumerate(order):
+        if i == background:
+            continue
+        mask, origin = grown_mask(regions.labels, rank, i, boxes[i], int(s.overlap))
+        found = crack_outlines(mask, origin)
+        shapes.append((i, slice(len(outlines), len(outlines) + len(found))))
+        outlines.extend(found)
+        if j % 64 == 0:
+            report("outline", 0.4 + 0.3 * j / regions.count)
+    if s.subpixel:
+        owners = np.array([i for i, sl in shapes for _ in range(sl.start, sl.stop)], np.int64)
+        outlines = refine_outlines(outlines, owners, regions.labels, rank, regions.color, rgb, alpha)
+    report("fit", 0.7)
+    # one batched fit of all outlines (see bezier.py)
+    fitted = fit_outlines(outlines, s.tolerance, s.corner_angle, s.smoothing)
+
+    paint = palette_colors(regions, classes, rgb) if s.palette else regions.color
+    elements, segments, fills = [], 0, set()
+    if background is not None:
+        fills.add(hex_color(paint[background]))
+        elements.append(rect_element("p0", w, h, hex_color(paint[background])))
+        segments += 4
+    for i, sl in shapes:
+        subpaths = [sp for sp in fitted[sl] if len(sp)]
+        if not subpaths:
+            continue
+        fill = hex_color(paint[i])
+        fills.add(fill)
+        elements.append(path_element(f"p{len(elements)}", path_data(subpaths), fill))
+        segments += sum(len(sp) for sp in subpaths)
+    report("fit", 1.0)
+    return TraceResult(svg=svg_document(w, h, elements), paths=len(elements), colors=len(fills),
+                       segments=segments, seconds=time.perf_counter() - start)

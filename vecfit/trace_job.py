@@ -1,0 +1,51 @@
+"""The trace job: a raster image traced into an SVG (vecfit.trace), then refined against
+it with the same loop as `vecfit refine` (vecfit.refine.fit)."""
+from __future__ import annotations
+
+import dataclasses
+import tempfile
+import warnings
+from pathlib import Path
+
+from .errors import VecfitError
+from .refine import Outputs, fit, load_target
+from .svg.read import load_svg
+from .trace import TraceSettings, trace_image
+
+
+def trace_settings(table: dict, seed: int) -> TraceSettings:
+    known = {f.name for f in dataclasses.fields(TraceSettings)}
+    unknown = sorted(set(table) - known)
+    if unknown:
+        raise VecfitError(f"unknown trace settings: {', '.join(unknown)}")
+    return TraceSettings(**{**table, "seed": seed})
+
+
+def trace(target_path, config: dict, outputs: Outputs, progress=None, refine: bool = True,
+          status=None) -> dict:
+    """`vecfit trace`: trace TARGET, refine the trace (unless ``refine`` is False, which
+    writes the trace as it is, with its report), write SVG, report and comparison."""
+    target_path = Path(target_path)
+    outputs.check_against(target_path)
+    target = load_target(target_path)
+    settings = trace_settings(config["trace"], config["optimize"]["seed"])
+    if status is not None:
+        status(f"tracing {target_path} ({target.shape[1]}x{target.shape[0]})")
+    traced = trace_image(target, settings)
+    if status is not None:
+        status(f"traced: {traced.paths} paths, {traced.segments} segments, {traced.colors} colours "
+               f"in {traced.seconds:.1f} s")
+    if not refine:
+        config = {**config, "optimize": {**config["optimize"], "iterations": 0}}
+    with tempfile.TemporaryDirectory(prefix="vecfit-trace-") as tmp:
+        source = Path(tmp) / (target_path.stem + ".trace.svg")
+        source.write_text(traced.svg, encoding="utf-8")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            scene = load_svg(source)
+        if not scene.shapes:
+            raise VecfitError(f"{target_path}: nothing to trace (the image is fully transparent)")
+        return fit(scene, source, target, config, outputs, progress,
+                   inputs={"command": "trace", "target": str(target_path),
+                           "trace": {"paths": traced.paths, "segments": traced.segments,
+                                     "colors": traced.colors, "seconds": traced.seconds}})
