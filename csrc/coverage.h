@@ -36,8 +36,8 @@
 // where |hw'| is small against |B'| (the envelope lies outside the sweep by about
 // hw (1/cos - 1) of that angle: 0.5% of hw at a slope of 0.1) and differ where the width
 // changes fast. The signed distance is then a pseudo-distance: exact along the normal,
-// too large by 1/cos of the same angle across a slanted edge (the prefilter's edge is
-// correspondingly sharper there; it still integrates to the same area to first order).
+// too large by sqrt(1 + (hw' / |B'|)^2) across a slanted edge (the prefilter's edge is
+// that much sharper there; it still integrates to the same area to first order).
 // Why this form: the inside test and the distance need only the critical points the
 // uniform stroke already finds, the pieces stay a union of simple sets with known
 // boundaries, and with equal widths it is the uniform stroke exactly. Caps and joins sit

@@ -48,14 +48,18 @@ def test_tapered_line_covers_the_trapezoid(mode):
 
 
 def mixed_paths(widths, cap, join, transform=None):
-    """An open cubic-and-lines path, a closed polygon and a zero-length subpath, with
+    """An open cubic-and-lines path, a closed polygon, a zero-length subpath and a
+    quadratic followed by a nearly straight cubic, with
     per-point widths (widths: a callable giving a path's widths from its point count) or
     the uniform stroke width 3.5."""
     paths = [Path(points=torch.tensor([[6.0, 30.0], [11.0, 5.0], [20.0, 31.0], [34.0, 12.0], [27.0, 8.0],
                                        [20.0, 20.0]]), degrees=np.array([3, 1, 1]), subpaths=[(0, 3, False)]),
              Path(points=torch.tensor([[5.0, 5.0], [15.0, 3.0], [12.0, 14.0], [4.0, 12.0]]),
                   degrees=np.array([1, 1, 1, 1]), subpaths=[(0, 4, True)]),
-             Path(points=torch.tensor([[30.0, 34.0], [30.0, 34.0]]), degrees=np.array([1]), subpaths=[(0, 1, False)])]
+             Path(points=torch.tensor([[30.0, 34.0], [30.0, 34.0]]), degrees=np.array([1]), subpaths=[(0, 1, False)]),
+             # a quadratic, then a cubic within 1e-3 px of its chord (stroked as a line)
+             Path(points=torch.tensor([[22.0, 36.0], [28.0, 24.0], [36.0, 30.0], [36.0004, 33.0], [35.9997, 35.0],
+                                       [36.0, 38.0]]), degrees=np.array([2, 3]), subpaths=[(0, 2, False)])]
     shapes = []
     for p in paths:
         if widths is not None:
@@ -141,6 +145,23 @@ def test_closed_tapered_polygon_gradients(mode, join):
     else:
         errors = check(build, {"points": POLYGON + OFF_GRID, "widths": POLYGON_WIDTHS},
                        {"points": 0.01, "widths": 0.01}, rtol=0.02, atol=0.01, mode="analytic")
+    report(errors)
+
+
+@pytest.mark.parametrize("mode", ["mc", "analytic"])
+def test_steep_taper_gradients(mode):
+    """Widths 1 -> 14 -> 2 over lines of 14 and 13 px (|hw'| / |B'| up to 0.46): the offset
+    curves' normals and length elements are tilted well away from the curve's."""
+    def build(points, widths):
+        path = Path(points=points, degrees=np.array([1, 1]), subpaths=[(0, 2, False)], widths=widths)
+        return Scene(width=40, height=40, shapes=[background(), Shape(
+            geometry=path, stroke=solid(0.1, 0.3, 0.9, 1), linecap="round", linejoin="round")])
+    pts, widths = torch.tensor([[10.0, 21.0], [24.0, 18.0], [30.0, 30.0]]), torch.tensor([1.0, 14.0, 2.0])
+    if mode == "mc":
+        errors = check(build, {"points": pts, "widths": widths}, {"points": 0.3, "widths": 0.3})
+    else:
+        errors = check(build, {"points": pts + OFF_GRID, "widths": widths}, {"points": 0.01, "widths": 0.01},
+                       rtol=0.02, atol=0.01, mode="analytic")
     report(errors)
 
 
