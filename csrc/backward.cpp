@@ -360,6 +360,17 @@ double bernstein(int n, int i, double t) {
     return v;
 }
 
+// d/dt of bernstein(n, i, t): n (b_{i-1}^{n-1} - b_i^{n-1}).
+double bernstein_deriv(int n, int i, double t) {
+    if (n == 0) return 0;
+    double a = i >= 1 ? bernstein(n - 1, i - 1, t) : 0.0, b = i <= n - 1 ? bernstein(n - 1, i, t) : 0.0;
+    return n * (a - b);
+}
+
+// Per-point widths: whether point k's width takes gradients. A negative input is clamped
+// to 0 (no gradient, as the clamp has none); 0 itself does, so a width can grow from 0.
+bool width_free(const PreparedScene& sc, int32_t k) { return k >= 0 && (size_t)k < sc.point_hw.size() && sc.point_hw[k] >= 0; }
+
 // Pixel-space control-point indices of a stroke item (its straightened form uses the ends).
 void stroke_item_indices(const PreparedScene& sc, const StrokeSegment& s, int32_t idx[4]) {
     const PreparedSegment& src = sc.segments[s.source];
@@ -376,7 +387,7 @@ void stroke_item_indices(const PreparedScene& sc, const StrokeSegment& s, int32_
 Segment whole_segment(const PreparedScene& sc, const PreparedDraw& d, const StrokeSegment& s) {
     Segment w = sc.segments[s.source].seg;
     if (!d.metric_identity) w = transformed(w, d.metric);
-    return straightened(w);
+    return straightened(w, d.varying);
 }
 
 // A piece's parameter t as a parameter of the whole segment.
@@ -432,14 +443,20 @@ public:
                 } else {
                     // Offset curves are about as long as the curve plus hw times its turning.
                     const StrokeSegment& s = sc_.stroke_items[d.first_item + k];
+                    // (Per-point widths: the largest half width, plus how much the width varies.)
                     Vec2 ta = seg_end_tangent(s.seg, false), tb = seg_end_tangent(s.seg, true);
                     double turn = std::acos(std::clamp(dot(ta, tb), -1.0, 1.0));
-                    double len = (polygon_length(s.seg) + d.half_width * turn) * d.metric_scale;
+                    double hw = d.varying ? s.hw_max : d.half_width, vary = 0;
+                    if (d.varying)
+                        for (int i = 0; i < s.seg.degree; ++i) vary += std::fabs(s.hw[i + 1] - s.hw[i]);
+                    double len = (polygon_length(s.seg) + hw * turn + vary) * d.metric_scale;
                     for (int side = -1; side <= 1; side += 2) out.push_back({Piece::OFFSET, di, k, side, count(len)});
                     // Caps and joins only where there are some (pieces of one curve meet smoothly).
-                    double end_len = (2 * M_PI * d.half_width + 4 * d.half_width * d.miter_limit) * d.metric_scale;
-                    if (s.start.kind != StrokeEnd::NONE || s.butt_start) out.push_back({Piece::END, di, k, 0, count(end_len)});
-                    if (s.end.kind != StrokeEnd::NONE || s.butt_end) out.push_back({Piece::END, di, k, 1, count(end_len)});
+                    auto end_len = [&](double h) { return (2 * M_PI * h + 4 * h * d.miter_limit) * d.metric_scale; };
+                    if (s.start.kind != StrokeEnd::NONE || s.butt_start)
+                        out.push_back({Piece::END, di, k, 0, count(end_len(s.start.hw))});
+                    if (s.end.kind != StrokeEnd::NONE || s.butt_end)
+                        out.push_back({Piece::END, di, k, 1, count(end_len(s.end.hw))});
                 }
             }
         }
@@ -563,6 +580,7 @@ private:
 
     bool offset_sample(const Piece& pc, const PreparedDraw& d, double t, SceneGrads& g, BoundarySample& bs) const {
         const StrokeSegment& s = sc_.stroke_items[d.first_item + pc.item];
+        if (d.varying) return offset_sample_varying(pc, d, s, t, g, bs);
         Vec2 b1 = seg_deriv(s.seg, t);
         double sp = length(b1);
         if (sp <= 0) return false;
@@ -584,6 +602,55 @@ private:
             add_point_dir(d, g, bs, idx[i], n_q, factor, bernstein(s.seg.degree, i, whole_t(s, t)));
         bs.add(&g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * factor);
         add_metric(d, pc.draw, g, bs, n_q, factor, to_pixel(d, seg_eval(s.seg, t)) - bs.p);
+        return true;
+    }
+
+    // Per-point widths: the offset curve o(t) = B(t) + side hw(t) N(t) (stroke space). Its
+    // tangent o' = B' + side (hw' N + hw N') is no longer parallel to B' (the width's
+    // slope tilts it), so the normal n_o, the length element |o'| and the velocities are
+    // the offset curve's own. Per unit displacement of control point i (stroke space):
+    // b_i moves B; N turns by -b_i' / |B'| (delta . N) T, which moves o along T, seen
+    // along n_o since T . n_o != 0; widths move o by side b_i N. Basis functions and B'
+    // are the whole segment's (the piece's parameter maps to it linearly, and only
+    // b_i' / |B'| enters).
+    bool offset_sample_varying(const Piece& pc, const PreparedDraw& d, const StrokeSegment& s, double t,
+                               SceneGrads& g, BoundarySample& bs) const {
+        const Segment& ps = s.seg;
+        Vec2 b1 = seg_deriv(ps, t);
+        double sp = length(b1);
+        if (sp <= 0) return false;
+        Vec2 T = (1 / sp) * b1, N = perp(T);
+        double side = pc.side;
+        double hw = bez_scalar(s.hw, ps.degree, t), hw1 = bez_scalar_deriv(s.hw, ps.degree, t);
+        Vec2 b2 = seg_deriv2(ps, t);
+        Vec2 tprime = (1 / sp) * (b2 - dot(b2, T) * T);
+        Vec2 q = seg_eval(ps, t) + (side * hw) * N;
+        Vec2 dq = b1 + side * (hw1 * N + hw * perp(tprime));
+        double dl = length(dq);
+        if (dl <= 0) return false;
+        Vec2 n_q = (1 / dl) * Vec2{dq.y, -dq.x};
+        if (dot(n_q, side * N) < 0) n_q = -n_q;  // outward: the side's normal, tilted
+        double factor;
+        bs.n = pixel_normal(d, n_q, factor);
+        bs.p = to_pixel(d, q);
+        bs.weight = length(d.metric_identity ? dq : d.metric_inv * dq) / pc.count;
+        Segment W = whole_segment(sc_, d, s);
+        int n = W.degree;
+        double T_whole = whole_t(s, t);
+        double wsp = length(seg_deriv(W, T_whole));
+        if (wsp <= 0) return false;
+        int32_t idx[4];
+        stroke_item_indices(sc_, s, idx);
+        double tilt = side * hw * dot(T, n_q) / wsp;  // the N-turning term's weight per b_i'
+        for (int i = 0; i <= n; ++i) {
+            double bi = bernstein(n, i, T_whole), dbi = bernstein_deriv(n, i, T_whole);
+            add_point_dir(d, g, bs, idx[i], bi * n_q - (tilt * dbi) * N, factor, 1.0);
+            if (width_free(sc_, idx[i]))
+                bs.add(&g.point_widths, (size_t)idx[i], 0.5 * side * bi * dot(N, n_q) * factor);
+        }
+        // Metric: sum_i c_i (x) P_i(pixel) - n_q (x) p, with sum b_i P_i = B and sum b_i' P_i = B'.
+        add_metric(d, pc.draw, g, bs, n_q, factor, to_pixel(d, seg_eval(W, T_whole)) - bs.p);
+        add_metric(d, pc.draw, g, bs, N, -factor * tilt, to_pixel(d, seg_deriv(W, T_whole)));
         return true;
     }
 
@@ -635,7 +702,7 @@ private:
         else if (stored.kind == StrokeEnd::SQUARE && s.seg.degree == 1 && s.seg.p[0].x == s.seg.p[1].x &&
                  s.seg.p[0].y == s.seg.p[1].y)
             e = stored;  // the dot of a zero-length subpath: axis fixed
-        else e = make_cap(eg.at, side == 0 ? -t_in : t_in, d.cap);
+        else e = make_cap(eg.at, side == 0 ? -t_in : t_in, d.cap, hw);
         if (e.kind == StrokeEnd::DISK) {
             double phi = 2 * M_PI * lam;
             n = {std::cos(phi), std::sin(phi)};
@@ -671,7 +738,8 @@ private:
         const StrokeSegment& s = sc_.stroke_items[d.first_item + pc.item];
         EndGeometry eg = end_geometry(d, s, pc.side);
         if (!eg.valid) return false;
-        double hw = d.half_width;
+        const StrokeEnd& stored = pc.side == 0 ? s.start : s.end;
+        double hw = stored.hw;  // the draw's, or the vertex's (per-point widths)
         Vec2 q, n;
         Vec2 t_out = eg.join ? eg.out.t : eg.in.t;
         double len = outline(d, eg, pc.side, s, eg.in.t, t_out, hw, t, q, n);
@@ -715,8 +783,12 @@ private:
             stroke_item_indices(sc_, sc_.stroke_items[s.next], nidx);
             add_frame(eg.out, nidx, rate_out, whole_segment(sc_, d, sc_.stroke_items[s.next]));
         }
-        double rate_w = normal_rate(eg.in.t, t_out, eg.in.t, t_out, hw + dw, hw - dw, dw);
-        bs.add(&g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * rate_w * factor);
+        // (one-sided where the width is about 0: a join of negative width does not exist)
+        double rate_w = hw > dw ? normal_rate(eg.in.t, t_out, eg.in.t, t_out, hw + dw, hw - dw, dw)
+                                : 2 * normal_rate(eg.in.t, t_out, eg.in.t, t_out, hw + dw, hw, dw);
+        if (!d.varying) bs.add(&g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * rate_w * factor);
+        else if (width_free(sc_, stored.width_index))
+            bs.add(&g.point_widths, (size_t)stored.width_index, 0.5 * rate_w * factor);
         return true;
     }
 };
@@ -779,6 +851,39 @@ void sdf_backward(const PreparedScene& sc, const Hit& h, Vec2 p, double g_sd, Sc
         Mat2 it = inverse(d.metric);  // (M^-T)[r][c] = (M^-1)[c][r]
         gw[2] += k * it.a; gw[3] += k * it.c; gw[4] += k * it.b; gw[5] += k * it.d;
     }
+    auto to_pix = [&](Vec2 v) { return d.metric_identity ? v : d.metric_inv * v; };
+    if (arg.kind == SdfArg::SWEEP && d.varying) {
+        // Per-point widths: sd = |B(t*) - q| - hw(t*) at a critical point t* of the
+        // distance, g(t) = (B(t) - q).B'(t) = 0. The distance is stationary in t there
+        // (no t* term, as above); hw(t*) is not: its term is hw'(t*) dt*/dtheta with
+        // dt*/dtheta = -(dg/dtheta) / (dg/dt) (implicit function theorem), dg/dt =
+        // |B'|^2 + (B - q).B'' and dg/dP_i = b_i B' + b_i' (B - q). On a straight tapered
+        // line this term is the slope hw'/|B'| times the tangential offset: not small.
+        // Widths: d sd / d w_i = -b_i(t*) / 2. Whole-segment basis and parameter.
+        const StrokeSegment& s = sc.stroke_items[arg.item];
+        Segment W = whole_segment(sc, d, s);
+        int n = W.degree;
+        int32_t idx[4];
+        stroke_item_indices(sc, s, idx);
+        double T = whole_t(s, arg.t);
+        double hc[4] = {0, 0, 0, 0};
+        for (int i = 0; i <= n; ++i) hc[i] = idx[i] >= 0 ? std::max(0.0, sc.point_hw[idx[i]]) : 0.0;
+        double hw1 = bez_scalar_deriv(hc, n, T);
+        Vec2 B = seg_eval(W, T), B1 = seg_deriv(W, T), B2 = seg_deriv2(W, T);
+        Vec2 r = B - q;
+        double dist = length(r), D = dot(B1, B1) + dot(r, B2);
+        Vec2 dir = dist > 0 ? (1 / dist) * r : Vec2{0, 0};  // on the curve: the kink of |.|
+        // dg/dt = 0 where q is a centre of curvature (t* not differentiable): no term.
+        double k = std::fabs(D) > 1e-9 * dot(B1, B1) ? hw1 / D : 0.0;
+        for (int i = 0; i <= n; ++i) {
+            double bi = bernstein(n, i, T), dbi = bernstein_deriv(n, i, T);
+            Vec2 v = bi * dir + k * (bi * B1 + dbi * r);  // d sd_s / d P_i (stroke space)
+            add_pixel_point(idx[i], gs * mt(v));
+            add_metric(v, to_pix(W.p[i]) - p, gs);
+            if (width_free(sc, idx[i])) g.point_widths[idx[i]] += -0.5 * gs * bi;
+        }
+        return;
+    }
     if (arg.kind == SdfArg::ELLIPSE || arg.kind == SdfArg::SWEEP) {
         double dist = distance(arg.closest, q);
         gw[0] += -0.5 * gs;
@@ -811,6 +916,8 @@ void sdf_backward(const PreparedScene& sc, const Hit& h, Vec2 p, double g_sd, Sc
     bool join = side == 1 && arg.kind == SdfArg::END && s.next >= 0 && s.end.kind != StrokeEnd::NONE;
     if (join) out = end_frame(whole_segment(sc, d, sc.stroke_items[s.next]), false);
     Vec2 V = side == 0 ? s.seg.p[0] : seg_end(s.seg);
+    const StrokeEnd& stored = side == 0 ? s.start : s.end;
+    hw = stored.hw;  // the draw's, or the vertex's (per-point widths)
     double sign = h.sd < 0 ? -1 : 1;
     auto value = [&](Vec2 qq, Vec2 t_in, Vec2 t_out, double w) {
         if (arg.kind == SdfArg::BUTT) {
@@ -819,9 +926,11 @@ void sdf_backward(const PreparedScene& sc, const Hit& h, Vec2 p, double g_sd, Sc
         }
         StrokeEnd e;
         if (join) e = make_join(V, t_in, t_out, d.join, w, d.miter_limit);
-        else if (point) e = side == 0 ? s.start : s.end;
-        else e = make_cap(V, side == 0 ? -t_in : t_in, d.cap);
-        return end_sdf(e, qq, w);
+        else if (point) {
+            e = stored;
+            e.hw = w;
+        } else e = make_cap(V, side == 0 ? -t_in : t_in, d.cap, w);
+        return end_sdf(e, qq);
     };
     auto rotate = [](Vec2 v, double a) {
         return Vec2{v.x * std::cos(a) - v.y * std::sin(a), v.x * std::sin(a) + v.y * std::cos(a)};
@@ -836,8 +945,11 @@ void sdf_backward(const PreparedScene& sc, const Hit& h, Vec2 p, double g_sd, Sc
     add_pixel_point(side == 0 ? idx[0] : idx[s.seg.degree], (-gs) * mt(Vec2{dqx, dqy}));
     // q = M p and V = M V_pix enter as q - V: d/dM = (d sd/dq) (p - V_pix)
     add_metric(Vec2{dqx, dqy}, p - (d.metric_identity ? V : d.metric_inv * V), gs);
-    double dw = (value(q, in.t, to, hw + hq) - value(q, in.t, to, hw - hq)) / (2 * hq);
-    gw[0] += 0.5 * gs * dw;
+    // (one-sided where the width is about 0: a join of negative width does not exist)
+    double dw = hw > hq ? (value(q, in.t, to, hw + hq) - value(q, in.t, to, hw - hq)) / (2 * hq)
+                        : (value(q, in.t, to, hw + hq) - value(q, in.t, to, hw)) / (hq - std::min(hw, 0.0));
+    if (!d.varying) gw[0] += 0.5 * gs * dw;
+    else if (width_free(sc, stored.width_index)) g.point_widths[stored.width_index] += 0.5 * gs * dw;
     auto add_frame = [&](const EndFrame& f, const int32_t* fidx, double rate, const Segment& w) {
         if (f.length <= 0 || rate == 0 || point) return;
         Vec2 N = mt(perp(f.t));

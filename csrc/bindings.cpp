@@ -46,12 +46,13 @@ int parse_filter(const std::string& f) {
 
 // The scene's arrays, kept alive for the duration of a call.
 struct SceneInput {
-    Array<float> points, ellipses, draw_params, paint_params, stop_offsets, stop_colors, layer_opacity;
+    Array<float> points, point_widths, ellipses, draw_params, paint_params, stop_offsets, stop_colors, layer_opacity;
     Array<int32_t> segments, subpaths, shapes, draws, paints, layer_parents;
 
     SceneArrays arrays() const {
         SceneArrays a;
         a.points = rows(points, 2, a.n_points, "points");
+        a.point_widths = rows(point_widths, 1, a.n_point_widths, "point_widths");
         a.segments = rows(segments, SEGMENT_COLS, a.n_segments, "segments");
         a.subpaths = rows(subpaths, SUBPATH_COLS, a.n_subpaths, "subpaths");
         a.shapes = rows(shapes, SHAPE_COLS, a.n_shapes, "shapes");
@@ -76,6 +77,8 @@ struct SceneInput {
 SceneInput scene_input(const py::dict& s) {
     SceneInput in;
     in.points = s["points"].cast<Array<float>>();
+    // optional: per-point stroke widths (absent or empty when no draw has them)
+    in.point_widths = s.contains("point_widths") ? s["point_widths"].cast<Array<float>>() : Array<float>(0);
     in.segments = s["segments"].cast<Array<int32_t>>();
     in.subpaths = s["subpaths"].cast<Array<int32_t>>();
     in.shapes = s["shapes"].cast<Array<int32_t>>();
@@ -152,6 +155,7 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
     };
     py::dict r;
     r["points"] = out(g.points, 2);
+    r["point_widths"] = out(g.point_widths, 1);
     r["ellipses"] = out(g.ellipses, ELLIPSE_COLS);
     r["draw_params"] = out(g.draw_params, DRAW_FCOLS);
     r["paint_params"] = out(g.paint_params, PAINT_FCOLS);

@@ -302,6 +302,25 @@ VF_HD Vec2 seg_deriv2(const Segment& s, double t) {
 
 VF_HD Vec2 seg_end(const Segment& s) { return s.p[s.degree]; }
 
+// A scalar Bézier of degree n (c[0..n]) at t, and its derivative in t: per-point stroke
+// widths along a segment use the segment's own degree and parameter.
+VF_HD double bez_scalar(const double* c, int n, double t) {
+    double u = 1 - t;
+    switch (n) {
+        case 1: return u * c[0] + t * c[1];
+        case 2: return u * u * c[0] + 2 * u * t * c[1] + t * t * c[2];
+        default: return u * u * u * c[0] + 3 * u * u * t * c[1] + 3 * u * t * t * c[2] + t * t * t * c[3];
+    }
+}
+VF_HD double bez_scalar_deriv(const double* c, int n, double t) {
+    double u = 1 - t;
+    switch (n) {
+        case 1: return c[1] - c[0];
+        case 2: return 2 * u * (c[1] - c[0]) + 2 * t * (c[2] - c[1]);
+        default: return 3 * u * u * (c[1] - c[0]) + 6 * u * t * (c[2] - c[1]) + 3 * t * t * (c[3] - c[2]);
+    }
+}
+
 // Power-basis coefficients a[k] of the segment relative to an origin o: B(t) - o = sum a[k] t^k.
 VF_HD void seg_power_basis(const Segment& s, Vec2 o, Vec2* a) {
     Vec2 p0 = s.p[0] - o;

@@ -79,9 +79,11 @@ namespace vf {
 // Gradients of the core's float inputs, laid out like SceneArrays (doubles, so that
 // accumulation over many samples keeps its precision).
 struct SceneGrads {
-    std::vector<double> points, ellipses, draw_params, paint_params, stop_offsets, stop_colors, layer_opacity;
+    std::vector<double> points, point_widths, ellipses, draw_params, paint_params, stop_offsets, stop_colors,
+        layer_opacity;
     void resize_like(const SceneArrays& a) {
         points.assign(2 * a.n_points, 0);
+        point_widths.assign(a.n_point_widths, 0);
         ellipses.assign(ELLIPSE_COLS * a.n_ellipses, 0);
         draw_params.assign(DRAW_FCOLS * a.n_draws, 0);
         paint_params.assign(PAINT_FCOLS * a.n_paints, 0);
@@ -93,7 +95,7 @@ struct SceneGrads {
         auto acc = [](std::vector<double>& x, const std::vector<double>& y) {
             for (size_t i = 0; i < x.size(); ++i) x[i] += y[i];
         };
-        acc(points, o.points); acc(ellipses, o.ellipses); acc(draw_params, o.draw_params);
+        acc(points, o.points); acc(point_widths, o.point_widths); acc(ellipses, o.ellipses); acc(draw_params, o.draw_params);
         acc(paint_params, o.paint_params); acc(stop_offsets, o.stop_offsets);
         acc(stop_colors, o.stop_colors); acc(layer_opacity, o.layer_opacity);
     }

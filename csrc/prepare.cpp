@@ -98,12 +98,21 @@ bool is_simple(const Segment& s, Vec2 u, double reach) {
 // Stroke pieces of one subpath of a stroke draw, appended to out.
 void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool closed,
                           const PreparedDraw& d, std::vector<StrokeSegment>& out) {
+    const bool var = d.varying;
+    double hw = d.half_width;
+    // Half width of point index k (per-point widths), or the draw's.
+    auto point_hw = [&](int32_t k) { return var && k >= 0 ? std::max(0.0, sc.point_hw[k]) : hw; };
     std::vector<StrokeSegment> segs;
     for (int g = first; g < first + count; ++g) {
         Segment s = sc.segments[g].seg;
         if (!d.metric_identity) s = transformed(s, d.metric);
         if (is_point(s)) continue;  // zero-length: no sweep, no direction
-        s = straightened(s);
+        s = straightened(s, var);
+        // The width profile as a 1-D Bézier (x coordinates) split along with the curve.
+        Segment w;
+        w.degree = s.degree;
+        const int32_t* idx = sc.segments[g].point_index;  // straightened(s, true) keeps the degree
+        for (int i = 0; i <= s.degree; ++i) w.p[i] = {point_hw(var ? idx[i] : -1), 0};
         // Curves are split into pieces of about 8 units (exactly, by de Casteljau): their
         // chord-frame bounds get tight, so far fewer samples need the quintic. Measured on
         // 256 random strokes: forward 4x (256 px) to 7x (512 px) faster.
@@ -115,11 +124,26 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
             ss.t0 = (double)k / pieces;
             ss.t1 = (double)(k + 1) / pieces;
             ss.seg = pieces == 1 ? s : seg_part(s, ss.t0, ss.t1);
+            Segment wp = pieces == 1 || !var ? w : seg_part(w, ss.t0, ss.t1);
+            ss.hw_max = 0;
+            for (int i = 0; i <= s.degree; ++i) {
+                ss.hw[i] = wp.p[i].x;
+                ss.hw_max = std::max(ss.hw_max, ss.hw[i]);
+            }
             ss.source = g;
             segs.push_back(ss);
         }
     }
-    double hw = d.half_width;
+    // Vertex widths at an item's start and end: the width of the point there.
+    auto start_index = [&](const StrokeSegment& ss) { return sc.segments[ss.source].point_index[0]; };
+    auto end_index = [&](const StrokeSegment& ss) {
+        const PreparedSegment& src = sc.segments[ss.source];
+        return src.point_index[src.seg.degree];
+    };
+    auto set_width = [&](StrokeEnd& e, int32_t k) {
+        e.hw = point_hw(k);
+        e.width_index = var ? k : -1;
+    };
     if (segs.empty()) {
         // A zero-length subpath: a dot with round caps, a square with square caps (aligned
         // with the stroke space's x axis, i.e. the user space), nothing with butt caps.
@@ -131,8 +155,13 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
         ss.seg.degree = 1;
         ss.seg.p[1] = ss.seg.p[0];
         ss.source = first;
-        ss.start = make_cap(s.p[0], {-1, 0}, d.cap);
-        ss.end = make_cap(s.p[0], {1, 0}, d.cap);
+        int32_t k = sc.segments[first].point_index[0];
+        double h = point_hw(k);
+        ss.hw[0] = ss.hw[1] = ss.hw_max = h;
+        ss.start = make_cap(s.p[0], {-1, 0}, d.cap, h);
+        ss.end = make_cap(s.p[0], {1, 0}, d.cap, h);
+        set_width(ss.start, k);
+        set_width(ss.end, k);
         segs.push_back(ss);
     } else {
         int n = (int)segs.size();
@@ -140,18 +169,31 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
             bool last = i + 1 == n;
             if (last && !closed) {
                 Vec2 t = seg_end_tangent(segs[i].seg, true);
-                segs[i].end = make_cap(seg_end(segs[i].seg), t, d.cap);
+                segs[i].end = make_cap(seg_end(segs[i].seg), t, d.cap, point_hw(end_index(segs[i])));
+                set_width(segs[i].end, end_index(segs[i]));
                 segs[i].butt_end = d.cap == CAP_BUTT;
             } else {
                 StrokeSegment& next = segs[last ? 0 : i + 1];
                 segs[i].next = (int)out.size() + (last ? 0 : i + 1);
+                if (var && !last && next.source == segs[i].source) {
+                    // Pieces of one curve meet smoothly: no join (a disk of the local width
+                    // could stick out of a sweep whose width changes fast).
+                    segs[i].end.hw = segs[i].hw[segs[i].seg.degree];
+                    continue;
+                }
+                // The vertex's width; where a zero-length segment was dropped between the
+                // two, the points on either side may differ: the join takes the larger.
+                int32_t k = end_index(segs[i]), k2 = start_index(next);
+                if (var && point_hw(k2) > point_hw(k)) k = k2;
                 segs[i].end = make_join(seg_end(segs[i].seg), seg_end_tangent(segs[i].seg, true),
-                                        seg_end_tangent(next.seg, false), d.join, hw, d.miter_limit);
+                                        seg_end_tangent(next.seg, false), d.join, point_hw(k), d.miter_limit);
+                set_width(segs[i].end, k);
             }
         }
         if (!closed) {
             Vec2 t = seg_end_tangent(segs[0].seg, false);
-            segs[0].start = make_cap(segs[0].seg.p[0], -t, d.cap);
+            segs[0].start = make_cap(segs[0].seg.p[0], -t, d.cap, point_hw(start_index(segs[0])));
+            set_width(segs[0].start, start_index(segs[0]));
             segs[0].butt_start = d.cap == CAP_BUTT;
         }
     }
@@ -169,10 +211,11 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
             ss.n_min = std::min(ss.n_min, cross(u, r));
             ss.n_max = std::max(ss.n_max, cross(u, r));
         }
-        ss.simple = is_simple(s, u, hw + 4.0);  // reach: the half width plus any prefilter radius used
-        Box b = grown(seg_bbox(ss.seg), hw);
-        add_end_to_box(b, ss.start, hw);
-        add_end_to_box(b, ss.end, hw);
+        double reach = ss.hw_max;
+        ss.simple = is_simple(s, u, reach + 4.0);  // reach: the half width plus any prefilter radius used
+        Box b = grown(seg_bbox(ss.seg), reach);
+        add_end_to_box(b, ss.start, ss.start.hw);
+        add_end_to_box(b, ss.end, ss.end.hw);
         ss.box = d.metric_identity ? b : to_pixel_box(b, d.metric_inv);
         out.push_back(ss);
     }
@@ -183,6 +226,12 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
 PreparedScene prepare_scene(const SceneArrays& a) {
     PreparedScene sc;
     check(a.n_points >= 0 && a.n_segments >= 0 && a.n_draws >= 0, "negative array size");
+    check(a.n_point_widths == 0 || a.n_point_widths == a.n_points, "point_widths must match points");
+    sc.point_hw.resize(a.n_point_widths);
+    for (int i = 0; i < a.n_point_widths; ++i) {
+        check(finite(a.point_widths[i]), "non-finite point width " + std::to_string(i));
+        sc.point_hw[i] = 0.5 * a.point_widths[i];  // unclamped: a negative one gets no gradient
+    }
     std::vector<Vec2> pts(a.n_points);
     for (int i = 0; i < a.n_points; ++i) {
         pts[i] = {a.points[2 * i], a.points[2 * i + 1]};
@@ -244,6 +293,7 @@ PreparedScene prepare_scene(const SceneArrays& a) {
         d.layer = row[4];
         d.cap = row[5];
         d.join = row[6];
+        d.varying = row[7] != 0;
         check(d.shape >= 0 && d.shape < a.n_shapes, "draw shape out of range");
         check(d.paint >= 0 && d.paint < a.n_paints, "draw paint out of range");
         check(d.layer >= 0 && d.layer < a.n_layers, "draw layer out of range");
@@ -258,6 +308,7 @@ PreparedScene prepare_scene(const SceneArrays& a) {
         const int32_t* shape = a.shapes + SHAPE_COLS * d.shape;
         if (shape[0] == SHAPE_ELLIPSE) {
             check(shape[3] >= 0 && shape[3] < a.n_ellipses, "ellipse index out of range");
+            check(!d.varying, "per-point widths need a stroked path");
             const float* e = a.ellipses + ELLIPSE_COLS * shape[3];
             Vec2 c{e[0], e[1]};
             Mat2 A{e[2], e[3], e[4], e[5]};
@@ -276,6 +327,8 @@ PreparedScene prepare_scene(const SceneArrays& a) {
             d.box = d.kind == DRAW_STROKE && !d.metric_identity ? to_pixel_box(b, d.metric_inv) : b;
         } else {
             check(shape[0] == SHAPE_PATH, "unknown shape kind");
+            check(!d.varying || (d.kind == DRAW_STROKE && a.n_point_widths == a.n_points),
+                  "per-point widths need a stroked path and point_widths");
             check(shape[1] >= 0 && shape[2] >= 0 && shape[1] + shape[2] <= a.n_subpaths,
                   "shape subpaths out of range");
             d.first_item = d.kind == DRAW_FILL ? (int)sc.fill_items.size() : (int)sc.stroke_items.size();
@@ -302,6 +355,13 @@ PreparedScene prepare_scene(const SceneArrays& a) {
                 }
             }
             d.n_items = (d.kind == DRAW_FILL ? (int)sc.fill_items.size() : (int)sc.stroke_items.size()) - d.first_item;
+            if (d.varying) {  // the draw's half width: the largest (zero: draws nothing)
+                d.half_width = 0;
+                for (int i = 0; i < d.n_items; ++i) {
+                    const StrokeSegment& ss = sc.stroke_items[d.first_item + i];
+                    d.half_width = std::max({d.half_width, ss.hw_max, ss.start.hw, ss.end.hw});
+                }
+            }
             for (int i = 0; i < d.n_items; ++i) {
                 const Box& b = d.kind == DRAW_FILL ? sc.fill_items[d.first_item + i].box
                                                    : sc.stroke_items[d.first_item + i].box;

@@ -22,13 +22,16 @@ constexpr int SEGMENT_COLS = 5;   // degree, point index of each control point (
 constexpr int SUBPATH_COLS = 3;   // first segment, segment count, closed (0/1)
 constexpr int SHAPE_COLS = 4;     // kind, first subpath, subpath count, ellipse index
 constexpr int ELLIPSE_COLS = 6;   // cx, cy, a, b, c, d: ellipse {c + (a b; c d)(cos, sin)}
-constexpr int DRAW_COLS = 7;      // shape, kind, fill rule, paint, layer, cap, join
-constexpr int DRAW_FCOLS = 6;     // stroke width, miter limit, metric (a b c d)
+constexpr int DRAW_COLS = 8;      // shape, kind, fill rule, paint, layer, cap, join, per-point widths (0/1)
+constexpr int DRAW_FCOLS = 6;     // stroke width (unused with per-point widths), miter limit, metric (a b c d)
 constexpr int PAINT_COLS = 3;     // kind, first stop, stop count
 constexpr int PAINT_FCOLS = 11;   // pixel->paint affine (6), then solid rgba | x1 y1 x2 y2 | cx cy r fx fy
 
 struct SceneArrays {
     const float* points = nullptr;       int n_points = 0;     // [P, 2]
+    // Full stroke width per point, in stroke-space units (as the draw's uniform width),
+    // for stroke draws with per-point widths; empty when no draw has them.
+    const float* point_widths = nullptr; int n_point_widths = 0;  // [P] or [0]
     const int32_t* segments = nullptr;   int n_segments = 0;   // [G, SEGMENT_COLS]
     const int32_t* subpaths = nullptr;   int n_subpaths = 0;   // [B, SUBPATH_COLS]
     const int32_t* shapes = nullptr;     int n_shapes = 0;     // [S, SHAPE_COLS]
@@ -62,6 +65,10 @@ struct StrokeEnd {
     Vec2 axis{1, 0};        // square: unit direction of one side pair
     Vec2 poly[4];           // polygon (bevel triangle or miter quadrilateral), convex
     int n_poly = 0;
+    // Half width of this end's piece (stroke space): the draw's, or with per-point widths
+    // the vertex's. Also set for butt ends (kind NONE), whose end line it bounds.
+    double hw = 0;
+    int32_t width_index = -1;  // per-point widths: the point whose width hw is (gradients)
 };
 
 // A stroke segment in stroke space (pixel space mapped by the draw's metric), with the
@@ -83,12 +90,18 @@ struct StrokeSegment {
     // Gently curved (radius of curvature above the piece's length plus its reach): the
     // distance to any point in reach has at most one critical point on the piece.
     bool simple = false;
+    // Half widths (stroke space) at the piece's control points: the width profile is a
+    // Bézier of the same degree, hw(t) = sum hw[i] b_i(t) (per-point widths; otherwise all
+    // equal to the draw's half width). hw_max bounds it (convex hull property).
+    double hw[4] = {0, 0, 0, 0};
+    double hw_max = 0;
 };
 
 struct PreparedDraw {
     int32_t shape = 0, kind = DRAW_FILL, fill_rule = NONZERO, paint = 0, layer = 0;
     int32_t cap = CAP_BUTT, join = JOIN_MITER;
-    double half_width = 0, miter_limit = 4;
+    double half_width = 0, miter_limit = 4;  // per-point widths: the largest half width
+    bool varying = false;       // stroke with per-point widths (StrokeSegment::hw, StrokeEnd::hw)
     Mat2 metric, metric_inv;    // pixel -> stroke space and back
     bool metric_identity = true;
     double metric_scale = 1;    // pixel length per stroke-space length (geometric mean)
@@ -112,6 +125,7 @@ struct PreparedPaint {
 
 struct PreparedScene {
     std::vector<PreparedSegment> segments;   // every path segment, pixel space
+    std::vector<double> point_hw;            // per-point half widths (as given: clamp at 0 to use), or empty
     std::vector<PreparedSegment> fill_items; // per fill draw: its segments and closing lines
     std::vector<StrokeSegment> stroke_items; // per stroke draw
     std::vector<PreparedDraw> draws;

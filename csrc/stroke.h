@@ -11,8 +11,12 @@ namespace vf {
 // The join at vertex v between a segment leaving along t_in and one leaving along t_out.
 inline StrokeEnd make_join(Vec2 v, Vec2 t_in, Vec2 t_out, int join, double hw, double miter_limit) {
     StrokeEnd e;
+    e.hw = hw;
     double c = cross(t_in, t_out), d = dot(t_in, t_out);
     if (std::fabs(c) < 1e-12 && d > 0) return e;  // no turn: the sweeps already meet
+    // No width (a per-point width of 0 at the vertex): nothing to join, and a polygon of
+    // coincident corners would pass convex_contains everywhere.
+    if (!(hw > 0)) return e;
     if (join == JOIN_ROUND) {
         e.kind = StrokeEnd::DISK;
         e.center = v;
@@ -40,8 +44,9 @@ inline StrokeEnd make_join(Vec2 v, Vec2 t_in, Vec2 t_out, int join, double hw, d
     return e;
 }
 
-inline StrokeEnd make_cap(Vec2 at, Vec2 outward, int cap) {
+inline StrokeEnd make_cap(Vec2 at, Vec2 outward, int cap, double hw) {
     StrokeEnd e;
+    e.hw = hw;
     if (cap == CAP_ROUND) {
         e.kind = StrokeEnd::DISK;
         e.center = at;
@@ -63,15 +68,31 @@ inline Segment transformed(const Segment& s, const Mat2& m) {
 // is stroked as that straight line, as Skia and resvg do: the direction at the end of
 // such a curve is decided by sub-pixel control-point offsets, and stroking it exactly
 // grows visible fins and rounds that those renderers (and users) do not expect.
-inline Segment straightened(const Segment& s) {
-    if (s.degree == 1) return s;
+inline bool nearly_straight(const Segment& s) {
+    if (s.degree == 1) return false;
     Vec2 a = s.p[0], b = seg_end(s), d = b - a;
     double l2 = dot(d, d);
-    if (l2 <= 0) return s;
+    if (l2 <= 0) return false;
     for (int i = 1; i < s.degree; ++i) {
         Vec2 r = s.p[i] - a;
         double along = dot(r, d) / l2, off = cross(d, r);
-        if (along < 0 || along > 1 || off * off > 1e-5 * l2 * l2) return s;
+        if (along < 0 || along > 1 || off * off > 1e-5 * l2 * l2) return false;
+    }
+    return true;
+}
+
+// With per-point widths (keep_degree), the width profile is a Bézier over the curve's
+// own parameter, so the straight line keeps the curve's degree and parametrisation: the
+// inner control points are projected onto the chord (the same line, the same end
+// directions, and the widths of the inner points still count).
+inline Segment straightened(const Segment& s, bool keep_degree = false) {
+    if (!nearly_straight(s)) return s;
+    Vec2 a = s.p[0], b = seg_end(s), d = b - a;
+    if (keep_degree) {
+        Segment out = s;
+        double l2 = dot(d, d);
+        for (int i = 1; i < s.degree; ++i) out.p[i] = a + (dot(s.p[i] - a, d) / l2) * d;
+        return out;
     }
     Segment line;
     line.degree = 1;

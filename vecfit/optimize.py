@@ -214,7 +214,7 @@ def _learning_rate_scales(scene: Scene, width: int, height: int) -> dict[int, fl
 
     for shape, ppu in zip(scene.shapes, pixels_per_unit):
         g = shape.geometry
-        for name in ("points", "center", "radius", "radii", "p_min", "p_max", "corner_radii"):
+        for name in ("points", "widths", "center", "radius", "radii", "p_min", "p_max", "corner_radii"):
             put(getattr(g, name, None), ppu)
         put(shape.stroke_width, ppu)
         for paint in (shape.fill, shape.stroke):

@@ -31,11 +31,12 @@ KAPPA = 0.5522847498307936  # cubic approximation of a quarter ellipse
 class Packed:
     """The core's input arrays. Float arrays are torch tensors (differentiable)."""
     points: list = field(default_factory=list)        # torch [n, 2] chunks
+    point_widths: list = field(default_factory=list)  # torch [n] chunks (empty: no draw has them)
     segments: list = field(default_factory=list)      # int arrays [k, 5]
     subpaths: list = field(default_factory=list)      # rows of 3 ints
     shapes: list = field(default_factory=list)        # rows of 4 ints
     ellipses: list = field(default_factory=list)      # torch [6]
-    draws: list = field(default_factory=list)         # rows of 7 ints
+    draws: list = field(default_factory=list)         # rows of 8 ints
     draw_params: list = field(default_factory=list)   # torch [6]
     paints: list = field(default_factory=list)        # rows of 3 ints
     paint_params: list = field(default_factory=list)  # torch [11]
@@ -58,12 +59,13 @@ class Packed:
 
         return {
             "points": cat(self.points, 2),
+            "point_widths": cat(self.point_widths, 1).reshape(-1),
             "segments": (np.concatenate(self.segments).astype(np.int32) if self.segments
                          else np.zeros((0, 5), dtype=np.int32)),
             "subpaths": ints(self.subpaths, 3),
             "shapes": ints(self.shapes, 4),
             "ellipses": cat(self.ellipses, 6),
-            "draws": ints(self.draws, 7),
+            "draws": ints(self.draws, 8),
             "draw_params": cat(self.draw_params, 6),
             "paints": ints(self.paints, 3),
             "paint_params": cat(self.paint_params, 11),
@@ -162,7 +164,7 @@ class Packer:
 
     def _draws_of(self, shape: Shape) -> int:
         n = 1 if shape.fill is not None else 0
-        if shape.stroke is not None and _value(shape.stroke_width) > 0:
+        if shape.stroke is not None and _stroke_width_positive(shape):
             n += 1
         return n
 
@@ -290,7 +292,7 @@ class Packer:
 
         for i, shape in enumerate(shapes):
             has_fill = shape.fill is not None
-            has_stroke = (shape.stroke is not None and _value(shape.stroke_width) > 0
+            has_stroke = (shape.stroke is not None and _stroke_width_positive(shape)
                           and scale_np[i] > 0)
             if not (has_fill or has_stroke):
                 continue
@@ -309,7 +311,7 @@ class Packer:
             if isinstance(geometry, Path):
                 if not geometry.subpaths:
                     continue
-                index = paths.add(geometry, i, len(out.shapes), len(out.subpaths))
+                index = paths.add(geometry, i, len(out.shapes), len(out.subpaths), with_widths=has_stroke)
                 out.shapes.append([SHAPE_PATH, len(out.subpaths), len(geometry.subpaths), -1])
                 out.subpaths.extend([None] * len(geometry.subpaths))  # filled by the batch
             else:
@@ -318,14 +320,15 @@ class Packer:
                     continue
             if has_fill:
                 paint = paint_index(shape.fill, factors + [shape.fill_opacity], i, shape.geometry)
-                out.draws.append([index, DRAW_FILL, FILL_RULES[shape.fill_rule], paint, layer, 0, 0])
+                out.draws.append([index, DRAW_FILL, FILL_RULES[shape.fill_rule], paint, layer, 0, 0, 0])
             if has_stroke:
                 paint = paint_index(shape.stroke, factors + [shape.stroke_opacity], i, shape.geometry)
                 stroke_rows.append((len(out.draws), i))
+                per_point = int(isinstance(geometry, Path) and geometry.widths is not None)
                 out.draws.append([index, DRAW_STROKE, 0, paint, layer,
-                                  CAPS[shape.linecap], JOINS[shape.linejoin]])
+                                  CAPS[shape.linecap], JOINS[shape.linejoin], per_point])
 
-        paths.finish(out, matrices)
+        paths.finish(out, matrices, scale)
         self._finish_paints(solid_colors, solid_alphas, gradient_rows)
         self._finish_draw_params(stroke_rows, matrices, scale, similar)
         return out
@@ -408,8 +411,15 @@ class _PathBatch:
         self.degrees: list[np.ndarray] = []
         self.subpaths: list[list] = []
         self.subpath_slot: list[int] = []       # first row in Packed.subpaths per path
+        self.widths: list = []                  # per-point stroke widths per path, or None
 
-    def add(self, path: Path, shape_index: int, core_shape: int, subpath_slot: int) -> int:
+    def add(self, path: Path, shape_index: int, core_shape: int, subpath_slot: int,
+            with_widths: bool = False) -> int:
+        widths = path.widths if with_widths else None
+        if widths is not None and widths.numel() != len(path.points):
+            raise VecfitError(f"a path's widths must have one value per point "
+                              f"({widths.numel()} widths for {len(path.points)} points)")
+        self.widths.append(widths)
         self.points.append(path.points)
         self.owner.append(shape_index)
         self.degrees.append(np.asarray(path.degrees, dtype=np.int64))
@@ -417,7 +427,7 @@ class _PathBatch:
         self.subpath_slot.append(subpath_slot)
         return core_shape
 
-    def finish(self, out: Packed, matrices: torch.Tensor) -> None:
+    def finish(self, out: Packed, matrices: torch.Tensor, scale: torch.Tensor) -> None:
         if not self.points:
             return
         counts = [len(p) for p in self.points]
@@ -425,6 +435,12 @@ class _PathBatch:
         owner = torch.repeat_interleave(torch.tensor(self.owner), torch.tensor(counts))
         m = matrices[owner]
         out.points.append(torch.einsum("nij,nj->ni", m[:, :2, :2], local) + m[:, :2, 2])
+        if any(w is not None for w in self.widths):
+            # Per-point widths, aligned with the points, in stroke-space units like the
+            # uniform width (times the shape's scale; zero where a path has none).
+            local_w = torch.cat([w.float().reshape(-1) if w is not None else torch.zeros(n)
+                                 for w, n in zip(self.widths, counts)])
+            out.point_widths.append(local_w * scale[owner])
         base = out.n_points
         out.n_points += len(local)
 
@@ -453,6 +469,14 @@ class _PathBatch:
         idx = sub_first_point[sub_of_seg][:, None] + local_idx
         idx = np.where(j <= deg[:, None], idx, -1)
         out.segments.append(np.concatenate([deg[:, None], idx], axis=1))
+
+
+def _stroke_width_positive(shape: Shape) -> bool:
+    """Whether the stroke has any width (per-point widths replace stroke_width)."""
+    g = shape.geometry
+    if isinstance(g, Path) and g.widths is not None:
+        return g.widths.numel() > 0 and _value(g.widths.detach().max()) > 0
+    return _value(shape.stroke_width) > 0
 
 
 def _stack(tensors: list) -> torch.Tensor:

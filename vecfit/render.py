@@ -32,8 +32,8 @@ def output_size(scene: Scene, width: int | None, height: int | None) -> tuple[in
     return int(width), int(height)
 
 
-FLOAT_INPUTS = ("points", "ellipses", "draw_params", "paint_params", "stop_offsets", "stop_colors",
-                "layer_opacity")
+FLOAT_INPUTS = ("points", "point_widths", "ellipses", "draw_params", "paint_params", "stop_offsets",
+                "stop_colors", "layer_opacity")
 
 
 def _core_render(settings: dict, structure: dict, floats, brute_force: bool = False):

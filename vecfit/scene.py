@@ -79,10 +79,19 @@ class Path:
     point, which is not stored again, so an open subpath stores sum(degrees) + 1 points
     and a closed one sum(degrees). SVG's ``Z`` is an explicit line segment back to the
     start (of zero length when the path already returned there).
+
+    ``widths`` (optional, [P], aligned with ``points``): a full stroke width per stored
+    point, in the path's own units like ``Shape.stroke_width``; a closed subpath's last
+    segment ends with its start point's width, as it ends at that point. When set, it
+    replaces ``Shape.stroke_width`` for this path's stroke: along each segment the width
+    is a Bézier of the segment's degree over its control points' widths (as diffvg's
+    per-point thickness), and caps and joins take their vertex's width. SVG cannot say
+    this: the SVG writer writes the mean width (with a warning).
     """
     points: torch.Tensor                 # [P, 2]
     degrees: np.ndarray                  # [G] int: 1 line, 2 quadratic, 3 cubic
     subpaths: list[tuple[int, int, bool]]  # (first segment, segment count, closed)
+    widths: Optional[torch.Tensor] = None  # [P] per-point stroke widths, or None
 
     def subpath_point_ranges(self) -> list[tuple[int, int]]:
         """(first point, point count) of each subpath in ``points``."""
@@ -134,7 +143,7 @@ class Shape:
     geometry: Geometry
     fill: Optional[Paint] = None
     stroke: Optional[Paint] = None
-    stroke_width: torch.Tensor = field(default_factory=lambda: torch.tensor(1.0))
+    stroke_width: torch.Tensor = field(default_factory=lambda: torch.tensor(1.0))  # unless Path.widths
     fill_rule: str = "nonzero"     # or "evenodd"
     linecap: str = "butt"          # butt | round | square
     linejoin: str = "miter"        # miter | round | bevel
@@ -189,6 +198,8 @@ class Scene:
             g = shape.geometry
             if isinstance(g, Path):
                 add("points", g.points)
+                if shape.stroke is not None and g.widths is not None:
+                    add("stroke_widths", g.widths)  # per point: replaces stroke_width
             elif isinstance(g, Circle):
                 add("points", g.center)
                 add("radii", g.radius)
@@ -201,7 +212,7 @@ class Scene:
                 add("radii", g.corner_radii)
             add_paint(shape.fill)
             add_paint(shape.stroke)
-            if shape.stroke is not None:
+            if shape.stroke is not None and not (isinstance(g, Path) and g.widths is not None):
                 add("stroke_widths", shape.stroke_width)
             add("opacities", shape.opacity)
             add("opacities", shape.fill_opacity)

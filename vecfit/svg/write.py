@@ -32,6 +32,7 @@ from ..imageio import atomic_write
 from ..scene import Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect, Scene, Solid
 from .dom import is_svg, local_name, read_root
 from .paint import GRADIENTS
+from .skips import VecfitWarning
 from .style import INHERITED
 from .units import parse_length, translate
 
@@ -308,6 +309,10 @@ def write_svg(scene: Scene, source_path, out_path, *, full: bool = False, backgr
             continue  # <use> instances of an element already written
         if writer.shape(shape, orig):
             done.add(shape.source)
+    if writer.averaged:
+        names = ", ".join(str(a) for a in writer.averaged[:5]) + (", ..." if len(writer.averaged) > 5 else "")
+        warnings.warn(f"SVG has no per-point stroke widths: {len(writer.averaged)} path(s) ({names}) "
+                      f"written with the mean of their widths as stroke-width", VecfitWarning, stacklevel=2)
     done = set()
     for group, orig in zip(scene.groups, original.groups):
         if group.source in done:
@@ -372,6 +377,7 @@ class _Writer:
         self.handles = handles
         self.viewport = viewport
         self.full = full
+        self.averaged = []  # sources of paths whose per-point widths were averaged
 
     def _element(self, source):
         element = self.handles.get(source)
@@ -393,8 +399,13 @@ class _Writer:
             if full or not _same_paint_ref(paint, paint0) or not _same(opacity, opacity0):
                 self._paint(e, prop, paint, opacity)
                 wrote = True
-        if shape.stroke is not None and (full or not _same(shape.stroke_width, orig.stroke_width)):
-            self.doc.set_property(e, "stroke-width", fmt(_finite(shape.stroke_width), 4))
+        width = shape.stroke_width
+        if shape.stroke is not None and isinstance(shape.geometry, Path) and shape.geometry.widths is not None:
+            # SVG has one stroke-width per element: per-point widths are averaged.
+            width = shape.geometry.widths.detach().double().mean()
+            self.averaged.append(shape.source)
+        if shape.stroke is not None and (full or not _same(width, orig.stroke_width)):
+            self.doc.set_property(e, "stroke-width", fmt(_finite(width), 4))
             wrote = True
         if full or not _same(shape.opacity, orig.opacity):
             self._opacity(e, "opacity", shape.opacity)
