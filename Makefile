@@ -18,8 +18,7 @@ $(STAMP): pyproject.toml CMakeLists.txt $(wildcard csrc/*)
 	touch $@
 
 demo: install
-	$(VENV)/bin/vecfit render examples/tiger.svg -o out/tiger.png --samples 4
-	@echo "demo output: out/tiger.png"
+	$(VENV)/bin/vecfit trace examples/chelsea.png -o out/chelsea.svg
 
 test: install
 	$(PY) -m pytest -q
@@ -27,6 +26,9 @@ test: install
 bench: install
 	$(PY) benchmarks/render.py
 	$(PY) benchmarks/gradients.py
+	$(PY) benchmarks/refine.py
+	$(PY) benchmarks/trace.py
+	$(PY) benchmarks/paint.py
 
 clean:
 	rm -rf build out tests/failures

@@ -214,11 +214,11 @@ def test_interrupted_image_is_not_taken_as_finished(folder, tmp_path, monkeypatc
     import vecfit.refine as refine_module
     real = refine_module.optimize
 
-    def interrupted(scene, target, settings, progress=None, hooks=()):
+    def interrupted(scene, target, settings, progress=None, **kwargs):
         def stop(p):
             if p.iteration == 2 and scene.shapes[0].fill.color[0] > 0.5:  # b's red circle
                 raise KeyboardInterrupt
-        return real(scene, target, settings, progress=stop, hooks=hooks)
+        return real(scene, target, settings, progress=stop, **kwargs)
 
     monkeypatch.setattr(refine_module, "optimize", interrupted)
     out = tmp_path / "out"

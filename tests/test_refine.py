@@ -126,7 +126,7 @@ def test_written_svg_matches_resvg(small_peppers, tmp_path):
 def test_background_rect_written_where_the_svg_leaves_canvas_bare(tmp_path):
     target = disc_image(tmp_path / "t.png", background=(0, 128, 0, 255))
     svg = circle_svg(tmp_path / "c.svg")
-    r = run("refine", target, svg, "--iterations", 30, "--threads", 1, "-q")
+    r = run("refine", target, svg, "--iterations", 60, "--threads", 1, "-q")
     assert r.exit_code == 0, r.output
     text = (tmp_path / "t.vecfit.svg").read_text()
     assert 'id="vecfit-background"' in text and "#008000" in text
@@ -317,13 +317,13 @@ def test_interrupted_cli_run_writes_best_result(tmp_path, monkeypatch):
     import vecfit.refine as refine_module
     real = refine_module.optimize
 
-    def interrupted(scene, target, settings, progress=None, hooks=()):
+    def interrupted(scene, target, settings, progress=None, **kwargs):
         def stop(p):
             if progress:
                 progress(p)
             if p.iteration == 5:
                 raise KeyboardInterrupt
-        return real(scene, target, settings, progress=stop, hooks=hooks)
+        return real(scene, target, settings, progress=stop, **kwargs)
 
     monkeypatch.setattr(refine_module, "optimize", interrupted)
     target = disc_image(tmp_path / "t.png")

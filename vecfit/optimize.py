@@ -227,7 +227,8 @@ def _learning_rate_scales(scene: Scene, width: int, height: int) -> dict[int, fl
     return out
 
 
-def _kinds(scene: Scene, lr: dict, width: int, height: int, fixed_alpha: bool = False) -> list[_Kind]:
+def _kinds(scene: Scene, lr: dict, width: int, height: int, fixed_alpha: bool = False,
+           keep_alpha=()) -> list[_Kind]:
     scales = _learning_rate_scales(scene, width, height)
     kinds = []
     for name, tensors in scene.parameters().items():
@@ -243,23 +244,32 @@ def _kinds(scene: Scene, lr: dict, width: int, height: int, fixed_alpha: bool = 
         kind = _Kind(name, tensors, per_tensor, rate)
         if name == "transforms":  # the last row of an affine matrix stays 0 0 1
             kind.scale.view(-1, 3, 3)[:, 2, :] = 0.0
-        if name == "colors" and fixed_alpha:  # colours are RGBA rows: keep the A
-            kind.scale.view(-1, 4)[:, 3] = 0.0
+        if name == "colors":  # colours are RGBA rows: keep the A of all, or of some
+            if fixed_alpha:
+                kind.scale.view(-1, 4)[:, 3] = 0.0
+            kept = {id(t) for t in keep_alpha}
+            offset = 0
+            for t in tensors:
+                if id(t) in kept:
+                    kind.scale[offset:offset + t.numel()].view(-1, 4)[:, 3] = 0.0
+                offset += t.numel()
         kinds.append(kind)
     return kinds
 
 
 def optimize(scene: Scene, target: Target, settings: Settings,
              progress: Callable[[Progress], None] | None = None,
-             hooks: tuple[Callable[[Step], None], ...] = ()) -> Result:
+             hooks: tuple[Callable[[Step], None], ...] = (), keep_alpha=()) -> Result:
     """Fit ``scene`` to ``target`` in place; returns the loss curve and counts. The Scene
     ends at the best parameters seen. Ctrl-C stops early (``Result.interrupted``).
-    ``hooks`` run after every iteration (see Step): re-seeding, saving frames."""
+    ``hooks`` run after every iteration (see Step): re-seeding, saving frames.
+    ``keep_alpha``: colour tensors whose alpha must not change (e.g. a backdrop that
+    has to keep the canvas covered)."""
     settings.check()
     loss_fn = losses.get(settings.loss)
     height, width = target.image.shape[:2]
     goal = target.compared(target.image.float())
-    kinds = _kinds(scene, settings.lr, width, height, settings.fixed_alpha)
+    kinds = _kinds(scene, settings.lr, width, height, settings.fixed_alpha, keep_alpha)
     if not kinds:
         raise VecfitError("nothing to optimise: the scene has no parameters with a learning rate above 0")
     adam = Adam(kinds, settings.iterations, settings.lr_decay, settings.lr_warmup)

@@ -140,12 +140,12 @@ def _render_full(scene, w, h, background, config) -> torch.Tensor:
 
 
 def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Outputs,
-        progress=None, inputs: dict | None = None, hooks=()) -> dict:
+        progress=None, inputs: dict | None = None, hooks=(), keep_alpha=()) -> dict:
     """Optimise ``scene`` (read from ``source_svg``) against ``target`` with the
     ``[optimize]`` settings of ``config``; writes the SVG, the comparison picture and the
     report (last, so a report means a finished run). Returns the report. ``inputs`` are
     extra report entries (a callable value is called when the report is made); ``hooks``
-    go to the optimisation loop."""
+    and ``keep_alpha`` go to the optimisation loop."""
     started = time.perf_counter()
     # The report marks a finished run: an old one must not sit beside new outputs if this
     # run dies before it writes its own.
@@ -161,7 +161,7 @@ def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Out
 
     initial_image = _render_full(scene, w, h, background, opt)
     initial = compare(_rgb(initial_image, background), target_rgb)
-    result = optimize(scene, goal, settings, progress=progress, hooks=hooks)
+    result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
     final_image = _render_full(scene, w, h, background, opt)
     final = compare(_rgb(final_image, background), target_rgb)
     if not all(math.isfinite(final[k]) or (k == "psnr" and final["mse"] == 0) for k in final):

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from .errors import VecfitError
 from .refine import Outputs, fit, load_target
+from .scene import Rect, Solid
 from .svg.read import load_svg
 from .trace import TraceSettings, trace_image
 
@@ -45,7 +46,12 @@ def trace(target_path, config: dict, outputs: Outputs, progress=None, refine: bo
             scene = load_svg(source)
         if not scene.shapes:
             raise VecfitError(f"{target_path}: nothing to trace (the image is fully transparent)")
-        return fit(scene, source, target, config, outputs, progress,
+        # The tracer's backdrop (an opaque rect past the canvas's edges) stays opaque, so
+        # the canvas stays covered; the regions above may turn translucent (blending
+        # neighbours is worth ~2 dB on photos).
+        backdrop = [s.fill.color for s in scene.shapes[:1]
+                    if isinstance(s.geometry, Rect) and isinstance(s.fill, Solid)]
+        return fit(scene, source, target, config, outputs, progress, keep_alpha=backdrop,
                    inputs={"command": "trace", "target": str(target_path),
                            "trace": {"paths": traced.paths, "segments": traced.segments,
                                      "colors": traced.colors, "seconds": traced.seconds}})
