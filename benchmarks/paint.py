@@ -3,7 +3,7 @@
 seconds per iteration, the PSNR curve, and the same runs without re-seeding.
 
 Usage: python benchmarks/paint.py [--iterations N] [--sizes 256,512] [--images astronaut,chelsea]
-       [--no-compare]   (skip the runs without re-seeding)
+       [--compare-sizes 256]   (sizes also run without re-seeding)
 """
 from __future__ import annotations
 
@@ -41,7 +41,8 @@ def main() -> None:
     ap.add_argument("--sizes", default="256,512")
     ap.add_argument("--images", default="astronaut,chelsea")
     ap.add_argument("--threads", type=int, default=2)
-    ap.add_argument("--no-compare", action="store_true")
+    ap.add_argument("--compare-sizes", default="256",
+                    help="sizes at which to run without re-seeding too ('' for none)")
     args = ap.parse_args()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -49,7 +50,8 @@ def main() -> None:
         for name in args.images.split(","):
             for size in (int(s) for s in args.sizes.split(",")):
                 target = target_file(name, size, tmp)
-                for reseed in ([50] if args.no_compare else [50, 0]):
+                compare_at = {int(c) for c in args.compare_sizes.split(",") if c}
+                for reseed in ([50, 0] if size in compare_at else [50]):
                     config = resolve("paint", overrides={
                         "optimize": {"iterations": args.iterations, "threads": args.threads},
                         "paint": {"reseed_every": reseed}})
