@@ -92,7 +92,8 @@ def strokes_workload(size, threads, repeats):
 
 def growth(size, threads, iterations=100):
     """Time per Adam iteration at the start and at the end of a run on the painterly
-    workload (diffvg's grows by half as the strokes spread)."""
+    workload (diffvg's grows by half as the strokes spread). Widths stay in the workload's
+    1-5 px, as diffvg's painterly script clamps them to [1, max_width]."""
     scene = strokes_scene(256, size, seed=3)
     params = scene.parameters()
     opt = torch.optim.Adam([{"params": params["points"], "lr": 1.0},
@@ -109,7 +110,7 @@ def growth(size, threads, iterations=100):
         opt.step()
         with torch.no_grad():
             for w in params["stroke_widths"]:
-                w.clamp_(0.5, 20)
+                w.clamp_(1.0, 5.0)  # the workload's 1-5 px, clamped as diffvg's painterly script does
             for c in params["colors"]:
                 c.clamp_(0, 1)
         times.append(time.perf_counter() - t0)
