@@ -19,3 +19,17 @@ def median_time(fn, repeats: int = 5, warmup: int = 1) -> float:
         fn()
         times.append(time.perf_counter() - start)
     return statistics.median(times)
+
+
+def resvg_rgb(svg, width: int, background=(1.0, 1.0, 1.0)):
+    """The SVG file rendered by resvg at ``width`` pixels, as float RGB over background."""
+    import io
+
+    import numpy as np
+    import resvg_py
+    from PIL import Image
+
+    from vecfit.metrics import to_rgb
+    png = bytes(resvg_py.svg_to_bytes(svg_path=str(svg), width=width))
+    rgba = np.asarray(Image.open(io.BytesIO(png)).convert("RGBA"), np.float64) / 255
+    return to_rgb(rgba, background)

@@ -18,7 +18,6 @@ from PIL import Image
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from vecfit.config import resolve  # noqa: E402
-from vecfit.metrics import compare  # noqa: E402
 from vecfit.paint_job import paint  # noqa: E402
 from vecfit.refine import Outputs  # noqa: E402
 

@@ -8,17 +8,14 @@ Usage: python benchmarks/refine.py [--iterations N] [--threads T] [--images kitt
 from __future__ import annotations
 
 import argparse
-import io
 import sys
 import tempfile
 import warnings
 from pathlib import Path
 
-import numpy as np
-from PIL import Image
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import ROOT  # noqa: E402
+from common import ROOT, resvg_rgb  # noqa: E402
 
 from vecfit.config import resolve  # noqa: E402
 from vecfit.metrics import compare, to_rgb  # noqa: E402
@@ -26,13 +23,6 @@ from vecfit.refine import Outputs, load_target, refine  # noqa: E402
 
 PHOTOS = ROOT.parent / "shared" / "data" / "photos"
 TARGETS = {"kitty": "kitty.jpg", "peppers": "peppers.png"}
-
-
-def resvg_rgb(svg: Path, width: int, background) -> np.ndarray:
-    import resvg_py
-    png = bytes(resvg_py.svg_to_bytes(svg_path=str(svg), width=width))
-    rgba = np.asarray(Image.open(io.BytesIO(png)).convert("RGBA"), np.float64) / 255
-    return to_rgb(rgba, background)
 
 
 def parse_sets(items) -> dict:

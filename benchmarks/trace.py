@@ -115,7 +115,7 @@ def main():
 
 def refine_table(budgets, images, iterations, threads):
     """Trace + refine with the defaults: PSNR before / after and wall time per image."""
-    import io
+    import sys
     from pathlib import Path
 
     from PIL import Image
@@ -124,6 +124,8 @@ def refine_table(budgets, images, iterations, threads):
     from vecfit.metrics import compare
     from vecfit.refine import Outputs
     from vecfit.trace_job import trace
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from common import resvg_rgb
 
     print("| image | budget | paths | PSNR trace | PSNR refined (vecfit) | PSNR refined (resvg) "
           "| trace s | refine s | s/iter | total s |")
@@ -141,11 +143,8 @@ def refine_table(budgets, images, iterations, threads):
                 config = resolve("trace", overrides=overrides)
                 out = Outputs.beside(target, Path(tmp) / f"{name}_{b}.svg")
                 rep = trace(target, config, out)
-                import resvg_py
-                png = bytes(resvg_py.svg_to_bytes(svg_path=str(out.svg), width=image.shape[1]))
-                rgba = np.asarray(Image.open(io.BytesIO(png)).convert("RGBA"), np.float64) / 255
-                bg = np.array([int(rep["background"][i:i + 2], 16) / 255 for i in (1, 3, 5)])
-                theirs = rgba[..., :3] * rgba[..., 3:] + bg * (1 - rgba[..., 3:])
+                bg = [int(rep["background"][i:i + 2], 16) / 255 for i in (1, 3, 5)]
+                theirs = resvg_rgb(out.svg, image.shape[1], bg)
                 resvg_psnr = compare(theirs, image[..., :3].astype(np.float64))["psnr"]
                 means[b].append(resvg_psnr)
                 opt = rep["seconds"]["optimize"]

@@ -164,16 +164,10 @@ def _resolve_config(command, preset, config_file, options, extra=None):
         "threads": options["threads"], "lr": _parse_learning_rates(options["learning_rates"]),
     }, **(extra or {})}
     try:
-        config = resolve(command, preset=preset, config_file=config_file, overrides=overrides)
-        from vecfit.colors import parse_background
-        if config["optimize"]["background"].strip().lower() != "auto":
-            parse_background(config["optimize"]["background"])
-        from vecfit.optimize import Settings
-        Settings.from_config(config["optimize"])
+        return resolve(command, preset=preset, config_file=config_file, overrides=overrides)
     except VecfitError as e:
         _echo_err(f"error: {e}")
         sys.exit(EXIT_USAGE)
-    return config
 
 
 class _ProgressBar:

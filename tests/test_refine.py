@@ -176,7 +176,7 @@ def test_transparent_target_keeps_transparency(tmp_path):
 
 @pytest.mark.parametrize("case", ["missing target", "target not an image", "svg does not parse",
                                   "svg missing", "mismatched sizes", "nothing to optimise",
-                                  "output over input"])
+                                  "output over input", "target too small"])
 def test_bad_input_is_a_clear_error_and_leaves_no_files(case, tmp_path):
     target = disc_image(tmp_path / "t.png")
     svg = circle_svg(tmp_path / "c.svg")
@@ -200,6 +200,10 @@ def test_bad_input_is_a_clear_error_and_leaves_no_files(case, tmp_path):
     elif case == "output over input":
         args += ["-o", svg]
         expect = "would overwrite the input"
+    elif case == "target too small":  # SSIM's window is 11 x 11
+        args[0] = disc_image(tmp_path / "tiny.png", cx=4, cy=3, r=2, size=(10, 8))
+        args[1] = circle_svg(tmp_path / "tiny.svg", cx=5, cy=4, r=2, size=(10, 8))
+        expect = "too small (10x8 pixels"
     before = sorted(os.listdir(tmp_path))
     r = run("refine", *args, "--iterations", 2, "-q")
     assert r.exit_code == 1, r.output
@@ -228,6 +232,17 @@ def test_bad_config_is_a_usage_error(tmp_path):
     r = run("refine", target, svg, "--background", "chartreuse-ish")
     assert r.exit_code == 2 and "background" in r.output
     assert sorted(os.listdir(tmp_path)) == ["c.svg", "c.toml", "t.png"]
+
+
+def test_bad_values_in_a_command_config_are_usage_errors(tmp_path):
+    target = disc_image(tmp_path / "t.png")
+    cfg = tmp_path / "p.toml"
+    cfg.write_text("[paint]\nmin_width = 6.0\nmax_width = 2.0\n")
+    r = run("paint", target, "--config", cfg)
+    assert r.exit_code == 2 and "min_width <= max_width" in r.output
+    cfg.write_text("[trace]\ntolerance = -1.0\n")
+    r = run("trace", target, "--config", cfg)
+    assert r.exit_code == 2 and "tolerance" in r.output
 
 
 def test_config_resolution_order(tmp_path):

@@ -9,6 +9,7 @@ naming the file and the key rather than a setting silently ignored.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import tomllib
 from pathlib import Path
 
@@ -97,7 +98,36 @@ def resolve(command: str, *, preset: str | None = None, config_file=None,
         settings = merge(settings, read_toml(config_file), schema, str(config_file))
     if overrides:
         settings = merge(settings, _drop_none(overrides), schema, "command line")
+    validate(settings)
     return settings
+
+
+def validate(settings: dict) -> None:
+    """Checks the values, not just the keys and types: a bad background, loss, rate, trace
+    or paint setting is refused here, before any work starts (VecfitError)."""
+    from .colors import parse_background
+    from .optimize import Settings
+
+    if settings["optimize"]["background"].strip().lower() != "auto":
+        parse_background(settings["optimize"]["background"])
+    Settings.from_config(settings["optimize"])
+    seed = settings["optimize"]["seed"]
+    if "trace" in settings:
+        from .trace import TraceSettings
+        from .trace.settings import check_settings
+        check_settings(settings_of(TraceSettings, settings["trace"], seed=seed))
+    if "paint" in settings:
+        from .painterly import PaintSettings
+        settings_of(PaintSettings, settings["paint"], seed=seed).check()
+
+
+def settings_of(cls, table: dict, **fixed):
+    """A settings dataclass from a config table (plus ``fixed`` values, e.g. the seed)."""
+    known = {f.name for f in dataclasses.fields(cls)}
+    unknown = sorted(set(table) - known)
+    if unknown:
+        raise VecfitError(f"unknown {cls.__name__} fields: {', '.join(unknown)}")
+    return cls(**{**table, **fixed})
 
 
 def _drop_none(d: dict) -> dict:

@@ -8,7 +8,9 @@ from pathlib import Path
 
 import numpy as np
 import torch
-from PIL import Image
+from PIL import Image, UnidentifiedImageError
+
+from .errors import VecfitError
 
 
 def to_uint8(image: torch.Tensor | np.ndarray) -> np.ndarray:
@@ -42,6 +44,19 @@ def save_png(image, path: str | os.PathLike) -> None:
 
 
 def load_rgba(path: str | os.PathLike) -> np.ndarray:
-    """An image file as float RGBA in [0, 1], [H, W, 4]."""
-    with Image.open(path) as im:
-        return np.asarray(im.convert("RGBA"), dtype=np.float32) / 255.0
+    """An image file as float32 straight RGBA in [0, 1], [H, W, 4]; VecfitError naming
+    the file and the reason when it cannot be read."""
+    path = Path(path)
+    if not path.exists():
+        raise VecfitError(f"{path}: no such file")
+    if path.is_dir():
+        raise VecfitError(f"{path}: is a folder, not an image")
+    try:
+        with Image.open(path) as im:
+            im.load()
+            rgba = im.convert("RGBA")
+    except UnidentifiedImageError:
+        raise VecfitError(f"{path}: not an image file (or a format that cannot be read)") from None
+    except (OSError, ValueError, Image.DecompressionBombError) as e:
+        raise VecfitError(f"{path}: cannot read the image ({e})") from None
+    return np.asarray(rgba, dtype=np.float32) / 255.0

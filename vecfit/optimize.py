@@ -11,10 +11,9 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Callable, Optional
 
-import numpy as np
 import torch
 
 from . import losses
@@ -46,9 +45,10 @@ class Settings:
 
     @classmethod
     def from_config(cls, table: dict) -> "Settings":
-        s = cls(**{k: table[k] for k in ("iterations", "loss", "mode", "samples", "boundary_samples",
-                                         "seed", "threads", "lr_decay", "lr_warmup", "fixed_alpha")
-                                         if k in table},
+        """From the [optimize] table; its other keys (max_size, background, ...) belong
+        to the job around the loop."""
+        names = {f.name for f in fields(cls)}
+        s = cls(**{k: v for k, v in table.items() if k in names and k != "lr"},
                 lr=dict(table.get("lr", {})))
         s.check()
         return s

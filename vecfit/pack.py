@@ -8,7 +8,6 @@ Layout of every table: see csrc/scene.h.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np

@@ -2,25 +2,14 @@
 loop of `vecfit refine`, with re-seeding and optional frames."""
 from __future__ import annotations
 
-import dataclasses
 import tempfile
 import warnings
 from pathlib import Path
 
-from .errors import VecfitError
+from .config import settings_of
 from .painterly import FrameSaver, PaintSettings, Reseeder, initial_svg
 from .refine import Outputs, fit, load_target
 from .svg.read import load_svg
-
-
-def paint_settings(table: dict, seed: int) -> PaintSettings:
-    known = {f.name for f in dataclasses.fields(PaintSettings)}
-    unknown = sorted(set(table) - known)
-    if unknown:
-        raise VecfitError(f"unknown paint settings: {', '.join(unknown)}")
-    settings = PaintSettings(**{**table, "seed": seed})
-    settings.check()
-    return settings
 
 
 def paint(target_path, config: dict, outputs: Outputs, progress=None, frames=None) -> dict:
@@ -28,7 +17,7 @@ def paint(target_path, config: dict, outputs: Outputs, progress=None, frames=Non
     target_path = Path(target_path)
     outputs.check_against(target_path)
     target = load_target(target_path)
-    settings = paint_settings(config["paint"], config["optimize"]["seed"])
+    settings = settings_of(PaintSettings, config["paint"], seed=config["optimize"]["seed"])
     reseeder = Reseeder(settings, config["optimize"]["iterations"])
     hooks = [reseeder]
     saver = None
@@ -41,14 +30,12 @@ def paint(target_path, config: dict, outputs: Outputs, progress=None, frames=Non
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             scene = load_svg(source)
-        gif = {}
 
-        def frames_entry():
+        def frames_entry():  # called when the report is made, after the last frame
             if saver is None:
                 return None
-            gif["path"] = saver.finish()
-            return {"folder": str(frames), "count": len(saver.files),
-                    "gif": str(gif["path"]) if gif["path"] else None}
+            gif = saver.finish()
+            return {"folder": str(frames), "count": len(saver.files), "gif": str(gif) if gif else None}
 
         return fit(scene, source, target, config, outputs, progress, hooks=hooks,
                    inputs={"command": "paint", "target": str(target_path),

@@ -23,6 +23,7 @@ from PIL import Image
 
 from .errors import VecfitError
 from .imageio import atomic_write, to_uint8
+from .metrics import to_rgb
 from .scene import Path as PathGeometry
 
 KINDS = ("strokes", "shapes")
@@ -205,10 +206,7 @@ class FrameSaver:
         if step.iteration % self.every:
             return
         bg = step.target.background
-        img = step.image.numpy()
-        a = img[..., 3:]
-        base = np.asarray(bg[:3] if bg is not None else (1.0, 1.0, 1.0), dtype=np.float32)
-        rgb = to_uint8(img[..., :3] * a + base * (1 - a))
+        rgb = to_uint8(to_rgb(step.image.numpy(), bg[:3] if bg is not None else (1.0, 1.0, 1.0)))
         path = self.folder / f"frame_{step.iteration:05d}.png"
         atomic_write(path, lambda tmp: Image.fromarray(rgb, "RGB").save(tmp, format="PNG"))
         self.files.append(path)

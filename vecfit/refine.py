@@ -12,14 +12,14 @@ from pathlib import Path
 import cv2
 import numpy as np
 import torch
-from PIL import Image, UnidentifiedImageError
 
 from . import __version__
 from .colors import parse_background
 from .errors import VecfitError
+from .imageio import load_rgba
 from .metrics import compare, to_rgb
-from .optimize import Progress, Settings, Target, optimize
-from .render import output_size, render
+from .optimize import Settings, Target, optimize
+from .render import render
 from .report import save_comparison, save_report
 from .scene import Scene
 from .svg.read import load_svg
@@ -27,6 +27,7 @@ from .svg.write import write_svg
 
 OPAQUE = 0.999  # a target whose every alpha is at least this is treated as opaque
 ASPECT_TOLERANCE = 0.01
+MIN_SIDE = 11
 
 
 @dataclass
@@ -50,13 +51,14 @@ class Outputs:
         paths = [self.svg, self.report, self.comparison]
         for out in paths:
             for src in inputs:
-                if src is not None and _same_file(out, Path(src)):
+                if src is not None and same_path(out, Path(src)):
                     raise VecfitError(f"{out}: output would overwrite the input {src}; choose another name")
         if len({p.resolve() for p in paths}) < len(paths):
             raise VecfitError("the SVG, report and comparison outputs must be different files")
 
 
-def _same_file(a: Path, b: Path) -> bool:
+def same_path(a: Path, b: Path) -> bool:
+    """Whether two paths name the same file or folder (False when one cannot be resolved)."""
     try:
         return a.resolve() == b.resolve()
     except OSError:
@@ -66,23 +68,12 @@ def _same_file(a: Path, b: Path) -> bool:
 # ------------------------------------------------------------------------- target
 
 def load_target(path) -> np.ndarray:
-    """An image file as float32 straight RGBA [H, W, 4] in [0, 1]."""
-    path = Path(path)
-    if not path.exists():
-        raise VecfitError(f"{path}: no such file")
-    if path.is_dir():
-        raise VecfitError(f"{path}: is a folder, not an image")
-    try:
-        with Image.open(path) as im:
-            im.load()
-            rgba = im.convert("RGBA")
-    except UnidentifiedImageError:
-        raise VecfitError(f"{path}: not an image file (or a format that cannot be read)") from None
-    except (OSError, ValueError, Image.DecompressionBombError) as e:
-        raise VecfitError(f"{path}: cannot read the image ({e})") from None
-    a = np.asarray(rgba, dtype=np.float32) / 255.0
-    if a.shape[0] < 2 or a.shape[1] < 2:
-        raise VecfitError(f"{path}: the image is too small ({a.shape[1]}x{a.shape[0]} pixels)")
+    """The target image (vecfit.imageio.load_rgba), big enough to be measured: SSIM's
+    Gaussian window is 11 x 11 pixels."""
+    a = load_rgba(path)
+    if min(a.shape[:2]) < MIN_SIDE:
+        raise VecfitError(f"{path}: the image is too small ({a.shape[1]}x{a.shape[0]} pixels; "
+                          f"at least {MIN_SIDE}x{MIN_SIDE})")
     return a
 
 
@@ -128,15 +119,11 @@ def check_sizes(scene: Scene, target: np.ndarray, svg_path, target_path) -> None
 
 # --------------------------------------------------------------------------- run
 
-def _rgb(image: torch.Tensor, background) -> np.ndarray:
-    """A render as RGB for metrics and pictures: over its background, else over white."""
-    return to_rgb(image.numpy(), background[:3] if background is not None else (1.0, 1.0, 1.0))
-
-
-def _render_full(scene, w, h, background, config) -> torch.Tensor:
+def _render_full(scene, w, h, config) -> torch.Tensor:
+    """The scene at the target's size, without background (straight RGBA)."""
     with torch.no_grad():
-        return render(scene, w, h, samples=config["eval_samples"], background=background,
-                      seed=config["seed"], threads=config["threads"])
+        return render(scene, w, h, samples=config["eval_samples"], seed=config["seed"],
+                      threads=config["threads"])
 
 
 def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Outputs,
@@ -157,27 +144,27 @@ def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Out
     small = downscaled(target, opt["max_size"])
     sh, sw = small.shape[:2]
     goal = Target(torch.from_numpy(small), background)
-    target_rgb = to_rgb(target, background[:3] if background is not None else (1.0, 1.0, 1.0))
+    under = background[:3] if background is not None else (1.0, 1.0, 1.0)  # metrics: over white
+    target_rgb = to_rgb(target, under)
 
-    initial_image = _render_full(scene, w, h, background, opt)
-    initial = compare(_rgb(initial_image, background), target_rgb)
+    # Rendered bare and composited here (the same arithmetic as the core's background):
+    # the alpha then also says whether the shapes cover the canvas.
+    initial_image = _render_full(scene, w, h, opt)
+    initial_rgb = to_rgb(initial_image.numpy(), under)
+    initial = compare(initial_rgb, target_rgb)
     result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
-    final_image = _render_full(scene, w, h, background, opt)
-    final = compare(_rgb(final_image, background), target_rgb)
+    final_image = initial_image if result.iterations == 0 else _render_full(scene, w, h, opt)
+    final_rgb = to_rgb(final_image.numpy(), under)
+    final = compare(final_rgb, target_rgb)
     if not all(math.isfinite(final[k]) or (k == "psnr" and final["mse"] == 0) for k in final):
         raise VecfitError(f"the optimised image has non-finite values ({final}); nothing written")
 
     # The SVG must look like what was optimised: where the shapes leave the canvas
     # uncovered, the background is written in as a first rect.
-    svg_background = None
-    if background is not None and background[3] > 0:
-        with torch.no_grad():
-            bare = render(scene, w, h, samples=1, threads=opt["threads"])
-        if float(bare[..., 3].min()) < OPAQUE:
-            svg_background = background
+    covered = float(final_image[..., 3].min()) >= OPAQUE
+    svg_background = background if background is not None and background[3] > 0 and not covered else None
     write_svg(scene, source_svg, outputs.svg, background=svg_background)
-    save_comparison(outputs.comparison, target_rgb, _rgb(initial_image, background),
-                    _rgb(final_image, background))
+    save_comparison(outputs.comparison, target_rgb, initial_rgb, final_rgb)
     seconds = time.perf_counter() - started
     report = {
         "vecfit": __version__,

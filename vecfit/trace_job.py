@@ -2,24 +2,16 @@
 it with the same loop as `vecfit refine` (vecfit.refine.fit)."""
 from __future__ import annotations
 
-import dataclasses
 import tempfile
 import warnings
 from pathlib import Path
 
+from .config import settings_of
 from .errors import VecfitError
 from .refine import Outputs, fit, load_target
 from .scene import Rect, Solid
 from .svg.read import load_svg
 from .trace import TraceSettings, trace_image
-
-
-def trace_settings(table: dict, seed: int) -> TraceSettings:
-    known = {f.name for f in dataclasses.fields(TraceSettings)}
-    unknown = sorted(set(table) - known)
-    if unknown:
-        raise VecfitError(f"unknown trace settings: {', '.join(unknown)}")
-    return TraceSettings(**{**table, "seed": seed})
 
 
 def trace(target_path, config: dict, outputs: Outputs, progress=None, refine: bool = True,
@@ -29,7 +21,7 @@ def trace(target_path, config: dict, outputs: Outputs, progress=None, refine: bo
     target_path = Path(target_path)
     outputs.check_against(target_path)
     target = load_target(target_path)
-    settings = trace_settings(config["trace"], config["optimize"]["seed"])
+    settings = settings_of(TraceSettings, config["trace"], seed=config["optimize"]["seed"])
     if status is not None:
         status(f"tracing {target_path} ({target.shape[1]}x{target.shape[0]})")
     traced = trace_image(target, settings)

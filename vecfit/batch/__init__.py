@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import VecfitError
+from ..refine import same_path
 from .plan import (DONE, FAILED, INTERRUPTED, JOBS, MODES, NOT_RUN, SKIPPED, STATUSES,
                    UNPAIRED, Plan, Task, find_images, finished_report, make_plan, result_row)
 from .summary import SUMMARY_FILES, THUMBS, count, write_all
@@ -51,27 +52,14 @@ def available_cores() -> int:
 
 
 def resolve_config(mode: str, preset: str | None = None, config_file=None) -> dict:
-    """The command's settings (see vecfit.config.resolve), checked like the single-image
-    commands check them; BatchUsageError when they are bad."""
-    from ..colors import parse_background
+    """The command's settings (vecfit.config.resolve, which also checks the values);
+    BatchUsageError when they are bad."""
     from ..config import resolve
-    from ..optimize import Settings
 
     try:
-        config = resolve(mode, preset=preset, config_file=config_file)
-        if config["optimize"]["background"].strip().lower() != "auto":
-            parse_background(config["optimize"]["background"])
-        Settings.from_config(config["optimize"])
+        return resolve(mode, preset=preset, config_file=config_file)
     except VecfitError as e:
         raise BatchUsageError(str(e)) from None
-    return config
-
-
-def _same_dir(a: Path, b: Path) -> bool:
-    try:
-        return a.resolve() == b.resolve()
-    except OSError:
-        return False
 
 
 _TMP = re.compile(r"^\.(?P<name>.+)\.[A-Za-z0-9_]{8}\.tmp$")
@@ -162,7 +150,7 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
         if not init_dir.is_dir():
             raise BatchUsageError(f"{init_dir}: no such folder")
     for d in (in_dir, init_dir):
-        if d is not None and _same_dir(out_dir, d):
+        if d is not None and same_path(out_dir, d):
             raise BatchUsageError(f"the output folder must differ from {d} (the outputs would be "
                                   "taken for inputs)")
     if jobs < 0 or (threads is not None and threads < 1):

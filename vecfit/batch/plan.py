@@ -15,7 +15,7 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..refine import Outputs
+from ..refine import Outputs, same_path
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp")
 SVG_SUFFIXES = (".svg", ".svgz")
@@ -129,7 +129,7 @@ def finished_report(task: Task) -> dict | None:
     inputs = [Path(task.image)]
     if task.init_svg is not None:
         recorded = report.get("init")
-        if recorded is None or not _same(Path(recorded), Path(task.init_svg)):
+        if recorded is None or not same_path(Path(recorded), Path(task.init_svg)):
             return None
         inputs.append(Path(task.init_svg))
     try:
@@ -138,13 +138,6 @@ def finished_report(task: Task) -> dict | None:
     except OSError:
         return None
     return report
-
-
-def _same(a: Path, b: Path) -> bool:
-    try:
-        return a.resolve() == b.resolve()
-    except OSError:
-        return False
 
 
 def _previous_seconds(out_dir: Path) -> dict:

@@ -30,7 +30,7 @@ import torch
 from ..errors import VecfitError
 from ..imageio import atomic_write
 from ..scene import Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect, Scene, Solid
-from .dom import is_svg, local_name, read_root
+from .dom import local_name, read_root
 from .paint import GRADIENTS
 from .skips import VecfitWarning
 from .style import INHERITED

@@ -1,18 +1,12 @@
 """SVG text of the traced shapes."""
 from __future__ import annotations
 
-import numpy as np
+from ..svg.write import fmt
 
 
 def number(v: float) -> str:
     """Compact decimal with at most 2 decimals: 12.5, 3, -0.25 (never -0)."""
-    s = f"{v:.2f}".rstrip("0").rstrip(".")
-    return "0" if s in ("-0", "") else s
-
-
-def hex_color(rgb) -> str:
-    r, g, b = (int(round(float(np.clip(c, 0, 1)) * 255)) for c in rgb)
-    return f"#{r:02x}{g:02x}{b:02x}"
+    return fmt(v, 2)
 
 
 def path_data(subpaths) -> str:

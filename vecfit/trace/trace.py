@@ -18,7 +18,8 @@ from .quantize import OPAQUE, prefilter, quantize
 from .regions import build_regions, palette_colors
 from .settings import TraceResult, TraceSettings, check_settings
 from .subpixel import refine_outlines
-from .svgtext import hex_color, path_data, path_element, rect_element, svg_document
+from ..svg.write import hex_color
+from .svgtext import path_data, path_element, rect_element, svg_document
 
 
 def check_image(image) -> np.ndarray:
