@@ -14,8 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-CORPUS = ROOT.parent / "shared" / "conformance"
+from shared_data import CONFORMANCE as CORPUS, ROOT
 FAILURES = ROOT / "tests" / "failures" / "conformance"
 PASS_DB = 35.0
 

@@ -11,7 +11,12 @@ _SESSION_START = time.time()
 
 
 def pytest_terminal_summary(terminalreporter):
-    """Show the conformance table when this run wrote it."""
+    """Show the conformance table when this run wrote it; say loudly when the shared data
+    was missing (its tests skipped: conformance, Fig. 9, the real traces)."""
+    from shared_data import SHARED
+    if not SHARED.is_dir():
+        terminalreporter.write_sep("!", f"shared test data not found at {SHARED}: its tests were "
+                                        "skipped (set VECFIT_SHARED to its folder)")
     table = Path(__file__).resolve().parent / "failures" / "conformance-table.txt"
     if table.exists() and table.stat().st_mtime >= _SESSION_START:
         terminalreporter.write_sep("-", "conformance pass rate per tag")

@@ -11,7 +11,6 @@ mcseem2 2.3% and 7.5%.
 from __future__ import annotations
 
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,7 +18,7 @@ import torch
 
 import vecfit
 
-SCENES = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "scenes"
+from shared_data import SCENES
 if not SCENES.exists():
     pytest.skip("the shared data folder is not present", allow_module_level=True)
 

@@ -23,7 +23,7 @@ from vecfit.metrics import compare
 from vecfit.optimize import Settings, Target, optimize
 from vecfit.scene import Circle, LinearGradient, Scene, Shape, Solid
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
+from shared_data import SHARED
 PEPPERS = SHARED / "data" / "photos" / "peppers.png"
 PEPPERS_SVG = SHARED / "data" / "photos" / "peppers.svg"
 

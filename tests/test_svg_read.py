@@ -20,7 +20,7 @@ from vecfit.svg import VecfitWarning, load_svg
 from vecfit.svg.color import parse_color
 from vecfit.svg.pathdata import PathDataError, parse_path_data
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
+from shared_data import SHARED
 CORPUS = SHARED / "conformance"
 DATA = SHARED / "data"
 SVG_HEAD = ('<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" '

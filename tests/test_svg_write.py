@@ -20,7 +20,7 @@ from vecfit.scene import (Circle, Ellipse, LinearGradient, Path as PathGeometry,
 from vecfit.svg import VecfitWarning, load_svg
 from vecfit.svg.write import fmt, path_data, write_svg
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
+from shared_data import SHARED
 CONFORMANCE = SHARED / "conformance"
 KITTY = SHARED / "data" / "photos" / "kitty.svg"
 TIGER = SHARED / "data" / "scenes" / "tiger.svg"
