@@ -14,6 +14,10 @@ EXIT_FAILURE = 1
 EXIT_USAGE = 2
 EXIT_INTERRUPTED = 130  # as a shell reports a process stopped by Ctrl-C
 
+DEVICE_OPTION = dict(metavar="auto|cpu|cuda[:N]",
+                     help="Where pixels are shaded: auto (a GPU when vecfit was built with CUDA and "
+                          "one is present), cpu, or cuda (GPU N with cuda:N).")
+
 
 def _echo_err(message: str) -> None:
     click.echo(message, err=True)
@@ -49,11 +53,13 @@ def main():
               help="none, white, black or #rrggbb[aa].")
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed of the samples.")
 @click.option("--threads", type=click.IntRange(min=0), default=0, help="Threads (0: all cores).")
+@click.option("--device", default="auto", show_default=True, **DEVICE_OPTION)
 def render(inputs, output, out_dir, width, height, samples, mode, filter_, filter_radius,
-           background, seed, threads):
+           background, seed, threads, device):
     """Render SVG files to PNG (8-bit RGBA)."""
     import vecfit
     from vecfit.colors import parse_background
+    from vecfit.device import resolve as resolve_device
     from vecfit.errors import VecfitError
     from vecfit.imageio import save_png
 
@@ -65,6 +71,10 @@ def render(inputs, output, out_dir, width, height, samples, mode, filter_, filte
         bg = parse_background(background)
     except VecfitError as e:
         raise click.BadParameter(str(e), param_hint="--background")
+    try:
+        resolve_device(device)
+    except VecfitError as e:
+        raise click.BadParameter(str(e), param_hint="--device")
     failed = 0
     for i, src in enumerate(inputs):
         dst = Path(output) if output else Path(out_dir) / (Path(src).stem + ".png")
@@ -75,7 +85,7 @@ def render(inputs, output, out_dir, width, height, samples, mode, filter_, filte
                 scene = vecfit.load_svg(src)
             image = vecfit.render(scene, width, height, samples=samples, mode=mode, filter=filter_,
                                   filter_radius=filter_radius, seed=seed, background=bg,
-                                  threads=threads)
+                                  threads=threads, device=device)
             save_png(image, dst)
         except VecfitError as e:
             failed += 1
@@ -89,13 +99,22 @@ def render(inputs, output, out_dir, width, height, samples, mode, filter_, filte
 
 
 @main.command()
-@click.argument("svg", type=click.Path(dir_okay=False))
-def info(svg):
-    """List the shapes, segments and paints of an SVG, and what was skipped."""
+@click.argument("svg", required=False, type=click.Path(dir_okay=False))
+@click.option("--build", is_flag=True, help="Say how this vecfit was built (compiler, CUDA, devices).")
+def info(svg, build):
+    """List the shapes, segments and paints of an SVG, and what was skipped; or, with
+    --build, what the compiled core has."""
     import vecfit
     from vecfit.describe import describe
     from vecfit.errors import VecfitError
 
+    if build:
+        from vecfit.device import build_summary
+        click.echo(build_summary())
+    if svg is None:
+        if not build:
+            raise click.UsageError("give an SVG file, or --build")
+        return
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -104,7 +123,6 @@ def info(svg):
         _echo_err(f"error: {e}")
         sys.exit(EXIT_FAILURE)
     click.echo(describe(scene))
-
 
 
 # ------------------------------------------------------------------ optimising commands
@@ -132,6 +150,7 @@ def optimize_options(f):
                      help="Learning rate of a parameter kind, e.g. --lr points=1 (repeatable)."),
         click.option("--seed", type=int, help="Random seed."),
         click.option("--threads", type=click.IntRange(min=0), help="Threads (0: all cores)."),
+        click.option("--device", **DEVICE_OPTION),
         click.option("-q", "--quiet", is_flag=True, help="No progress bar."),
     ]
     for option in reversed(options):
@@ -161,7 +180,8 @@ def _resolve_config(command, preset, config_file, options, extra=None):
         "iterations": options["iterations"], "loss": options["loss"], "mode": options["mode"],
         "samples": options["samples"], "max_size": options["max_size"],
         "background": options["background"], "seed": options["seed"],
-        "threads": options["threads"], "lr": _parse_learning_rates(options["learning_rates"]),
+        "threads": options["threads"], "device": options["device"],
+        "lr": _parse_learning_rates(options["learning_rates"]),
     }, **(extra or {})}
     try:
         return resolve(command, preset=preset, config_file=config_file, overrides=overrides)

@@ -47,13 +47,13 @@ struct LocalList {
     int operator[](int i) const { return li[i].item; }
 };
 
-int tile_of(const TileBins& bins, Vec2 p) {
+int tile_of(const TileView& bins, Vec2 p) {
     int tx = std::clamp((int)std::floor(p.x / TILE), 0, bins.nx - 1);
     int ty = std::clamp((int)std::floor(p.y / TILE), 0, bins.ny - 1);
     return ty * bins.nx + tx;
 }
 
-bool covers(const PreparedScene& sc, const TileBins& bins, const TileEntry& e, const Box& region, Vec2 p) {
+bool covers(const SceneView& sc, const TileView& bins, const TileEntry& e, const Box& region, Vec2 p) {
     const PreparedDraw& d = sc.draws[e.draw];
     if (p.x < d.box.x0 || p.x > d.box.x1 || p.y < d.box.y0 || p.y > d.box.y1) return false;
     if (d.kind == DRAW_STROKE) {
@@ -70,7 +70,7 @@ bool covers(const PreparedScene& sc, const TileBins& bins, const TileEntry& e, c
 }
 
 // Does draw `draw` cover p? (p inside the tile grid's reach.)
-bool draw_covers_at(const PreparedScene& sc, const TileBins& bins, int draw, Vec2 p) {
+bool draw_covers_at(const SceneView& sc, const TileView& bins, int draw, Vec2 p) {
     int tile = tile_of(bins, p);
     Box region = bins.region(tile);
     if (p.x < region.x0 || p.x > region.x1 || p.y < region.y0 || p.y > region.y1) return false;
@@ -87,7 +87,7 @@ bool draw_covers_at(const PreparedScene& sc, const TileBins& bins, int draw, Vec
 
 // Draws covering p, front to back, with their premultiplied colours; `forced` (if >= 0)
 // counts as covering. Returns the count.
-int collect_hits(const PreparedScene& sc, const TileBins& bins, Vec2 p, int forced, std::vector<Hit>& hits) {
+int collect_hits(const SceneView& sc, const TileView& bins, Vec2 p, int forced, std::vector<Hit>& hits) {
     hits.clear();
     int tile = tile_of(bins, p);
     Box region = bins.region(tile);
@@ -133,7 +133,7 @@ inline double kernel(double d) {
 inline double kernel_slope(double d) { return std::fabs(d) < 1 ? 0.75 * (d * d - 1) : 0.0; }
 
 // Analytical prefilter: the draws reaching p, front to back, with fractional coverage.
-void collect_hits_analytic(const PreparedScene& sc, const TileBins& bins, Vec2 p, double r, std::vector<Hit>& hits) {
+void collect_hits_analytic(const SceneView& sc, const TileView& bins, Vec2 p, double r, std::vector<Hit>& hits) {
     hits.clear();
     int tile = tile_of(bins, p);
     Box region = bins.region(tile);
@@ -168,7 +168,7 @@ void collect_hits_analytic(const PreparedScene& sc, const TileBins& bins, Vec2 p
 // the transmittance of what lies in front of the draw and B the composite behind it, so
 // delta = T (c_d - a_d B). One front-to-back pass that stops as soon as T is 0 (the
 // draw is hidden) or B is opaque.
-void jump_without_layers(const PreparedScene& sc, const TileBins& bins, Vec2 p, int forced, double delta[4]) {
+void jump_without_layers(const SceneView& sc, const TileView& bins, Vec2 p, int forced, double delta[4]) {
     for (int i = 0; i < 4; ++i) delta[i] = 0;
     int tile = tile_of(bins, p);
     Box region = bins.region(tile);
@@ -209,7 +209,7 @@ struct Tape {
     std::vector<Op> ops;
 };
 
-void composite(const PreparedScene& sc, const std::vector<Hit>& hits, Tape* tape, double out[4]) {
+void composite(const SceneView& sc, const std::vector<Hit>& hits, Tape* tape, double out[4]) {
     struct Frame {
         int layer;
         double c[4];
@@ -257,8 +257,8 @@ void composite(const PreparedScene& sc, const std::vector<Hit>& hits, Tape* tape
 
 // Reverse of composite: g is dL/d(result); adds dL/d(hit colour) into g_hits and
 // dL/d(layer opacity) into grads.
-void composite_backward(const PreparedScene& sc, const std::vector<Hit>& hits, const Tape& tape, const double g[4],
-                        std::vector<std::array<double, 4>>& g_hits, SceneGrads& grads) {
+void composite_backward(const SceneView& sc, const std::vector<Hit>& hits, const Tape& tape, const double g[4],
+                        std::vector<std::array<double, 4>>& g_hits, const GradView& grads) {
     g_hits.assign(hits.size(), {0, 0, 0, 0});
     double adj[MAX_LAYER_DEPTH][4];
     int top = 0;
@@ -324,8 +324,7 @@ void pixel_adjoints(const RenderOptions& o, const float* image, const float* d_i
 // One boundary sample: a point, its outward normal (pixel space), its length weight, and
 // how the point moves along the normal per unit change of each parameter it depends on.
 struct Velocity {
-    std::vector<double>* target;
-    size_t index;
+    GradRef target;
     double value;
 };
 
@@ -335,8 +334,8 @@ struct BoundarySample {
     int draw = -1;
     Velocity v[32];
     int nv = 0;
-    void add(std::vector<double>* t, size_t i, double value) {
-        if (nv < 32 && value != 0) v[nv++] = {t, i, value};
+    VF_HD void add(GradPtr t, size_t i, double value) {
+        if (nv < 32 && value != 0) v[nv++] = {t[i], value};
     }
 };
 
@@ -369,10 +368,10 @@ double bernstein_deriv(int n, int i, double t) {
 
 // Per-point widths: whether point k's width takes gradients. A negative input is clamped
 // to 0 (no gradient, as the clamp has none); 0 itself does, so a width can grow from 0.
-bool width_free(const PreparedScene& sc, int32_t k) { return k >= 0 && (size_t)k < sc.point_hw.size() && sc.point_hw[k] >= 0; }
+bool width_free(const SceneView& sc, int32_t k) { return k >= 0 && (size_t)k < sc.point_hw.size() && sc.point_hw[k] >= 0; }
 
 // Pixel-space control-point indices of a stroke item (its straightened form uses the ends).
-void stroke_item_indices(const PreparedScene& sc, const StrokeSegment& s, int32_t idx[4]) {
+void stroke_item_indices(const SceneView& sc, const StrokeSegment& s, int32_t idx[4]) {
     const PreparedSegment& src = sc.segments[s.source];
     for (int i = 0; i < 4; ++i) idx[i] = -1;
     if (s.seg.degree == src.seg.degree) {
@@ -384,7 +383,7 @@ void stroke_item_indices(const PreparedScene& sc, const StrokeSegment& s, int32_
 }
 
 // The whole stroke-space segment a stroke item is a piece of (as preparation made it).
-Segment whole_segment(const PreparedScene& sc, const PreparedDraw& d, const StrokeSegment& s) {
+Segment whole_segment(const SceneView& sc, const PreparedDraw& d, const StrokeSegment& s) {
     Segment w = sc.segments[s.source].seg;
     if (!d.metric_identity) w = transformed(w, d.metric);
     return straightened(w, d.varying);
@@ -421,7 +420,7 @@ EndFrame end_frame(const Segment& s, bool end) {
 
 class BoundaryPass {
 public:
-    BoundaryPass(const PreparedScene& sc, const RenderOptions& o, double density)
+    BoundaryPass(const SceneView& sc, const RenderOptions& o, double density)
         : sc_(sc), o_(o), density_(density) {}
 
     std::vector<Piece> pieces() const {
@@ -464,7 +463,7 @@ public:
     }
 
     // Fills bs for sample j of the piece; false if the sample does not exist.
-    bool sample(const Piece& pc, int j, uint64_t key, SceneGrads& g, BoundarySample& bs) const {
+    bool sample(const Piece& pc, int j, uint64_t key, const GradView& g, BoundarySample& bs) const {
         double u, unused;
         sample_uniform2(o_.seed ^ 0xb0b0b0b0ull, key, (uint64_t)j, u, unused);
         double t = (j + u) / pc.count;
@@ -480,7 +479,7 @@ public:
     }
 
 private:
-    const PreparedScene& sc_;
+    const SceneView& sc_;
     const RenderOptions& o_;
     double density_;
 
@@ -500,35 +499,35 @@ private:
     }
     // Pixel-space velocity coefficients of a stroke-space point displacement along n_q,
     // for the pixel point with index idx: (M^T n_q) / |M^T n_q| scaled by w.
-    void add_point(SceneGrads& g, BoundarySample& bs, int32_t idx, Vec2 n_pixel, double w) const {
+    void add_point(const GradView& g, BoundarySample& bs, int32_t idx, Vec2 n_pixel, double w) const {
         if (idx < 0) return;
-        bs.add(&g.points, 2 * (size_t)idx, w * n_pixel.x);
-        bs.add(&g.points, 2 * (size_t)idx + 1, w * n_pixel.y);
+        bs.add(g.points, 2 * (size_t)idx, w * n_pixel.x);
+        bs.add(g.points, 2 * (size_t)idx + 1, w * n_pixel.y);
     }
     // Same for a stroke-space direction vector e (not the normal): w * (M^T e).n_q / |M^T n_q|
-    void add_point_dir(const PreparedDraw& d, SceneGrads& g, BoundarySample& bs, int32_t idx, Vec2 e,
+    void add_point_dir(const PreparedDraw& d, const GradView& g, BoundarySample& bs, int32_t idx, Vec2 e,
                        double factor, double w) const {
         if (idx < 0) return;
         Vec2 m = d.metric_identity ? e : Vec2{d.metric.a * e.x + d.metric.c * e.y, d.metric.b * e.x + d.metric.d * e.y};
-        bs.add(&g.points, 2 * (size_t)idx, w * factor * m.x);
-        bs.add(&g.points, 2 * (size_t)idx + 1, w * factor * m.y);
+        bs.add(g.points, 2 * (size_t)idx, w * factor * m.x);
+        bs.add(g.points, 2 * (size_t)idx + 1, w * factor * m.y);
     }
 
     // Normal velocity per entry of the stroke metric M (stroke space = M pixel space): the
     // point is p = M^-1 q with q built from M times pixel geometry, and normal changes are
     // tangential, so dv/dM_rc = factor n_q[r] (anchor - p)[c], where anchor is the pixel
     // point the piece is built around (the curve point, or the vertex).
-    void add_metric(const PreparedDraw& d, int draw, SceneGrads& g, BoundarySample& bs, Vec2 n_q, double factor,
+    void add_metric(const PreparedDraw& d, int draw, const GradView& g, BoundarySample& bs, Vec2 n_q, double factor,
                     Vec2 anchor_minus_p) const {
         if (d.metric_identity) return;
         size_t base = DRAW_FCOLS * (size_t)draw + 2;
-        bs.add(&g.draw_params, base + 0, factor * n_q.x * anchor_minus_p.x);
-        bs.add(&g.draw_params, base + 1, factor * n_q.x * anchor_minus_p.y);
-        bs.add(&g.draw_params, base + 2, factor * n_q.y * anchor_minus_p.x);
-        bs.add(&g.draw_params, base + 3, factor * n_q.y * anchor_minus_p.y);
+        bs.add(g.draw_params, base + 0, factor * n_q.x * anchor_minus_p.x);
+        bs.add(g.draw_params, base + 1, factor * n_q.x * anchor_minus_p.y);
+        bs.add(g.draw_params, base + 2, factor * n_q.y * anchor_minus_p.x);
+        bs.add(g.draw_params, base + 3, factor * n_q.y * anchor_minus_p.y);
     }
 
-    bool fill_sample(const PreparedSegment& s, double t, int count, SceneGrads& g, BoundarySample& bs) const {
+    bool fill_sample(const PreparedSegment& s, double t, int count, const GradView& g, BoundarySample& bs) const {
         Vec2 dp = seg_deriv(s.seg, t);
         double speed = length(dp);
         if (speed <= 0) return false;
@@ -541,7 +540,7 @@ private:
 
     // Ellipse q = c + A (cos, sin) from its pixel-space row; a stroke offsets it by
     // side * hw along the normal in stroke space (q_s = M q).
-    bool ellipse_sample(const Piece& pc, const PreparedDraw& d, double t, SceneGrads& g, BoundarySample& bs) const {
+    bool ellipse_sample(const Piece& pc, const PreparedDraw& d, double t, const GradView& g, BoundarySample& bs) const {
         double phi = 2 * M_PI * t;
         Vec2 u{std::cos(phi), std::sin(phi)}, du{-std::sin(phi), std::cos(phi)};
         Mat2 M = d.kind == DRAW_STROKE ? d.metric : Mat2{};
@@ -565,20 +564,20 @@ private:
         // d q_s / d c = M, d q_s / d A[r][k] = M e_r u_k; normal changes are tangential.
         size_t row = ELLIPSE_COLS * (size_t)d.ellipse_row;
         Vec2 mt{M.a * n_side.x + M.c * n_side.y, M.b * n_side.x + M.d * n_side.y};  // M^T n
-        bs.add(&g.ellipses, row + 0, factor * mt.x);
-        bs.add(&g.ellipses, row + 1, factor * mt.y);
-        bs.add(&g.ellipses, row + 2, factor * mt.x * u.x);
-        bs.add(&g.ellipses, row + 3, factor * mt.x * u.y);
-        bs.add(&g.ellipses, row + 4, factor * mt.y * u.x);
-        bs.add(&g.ellipses, row + 5, factor * mt.y * u.y);
+        bs.add(g.ellipses, row + 0, factor * mt.x);
+        bs.add(g.ellipses, row + 1, factor * mt.y);
+        bs.add(g.ellipses, row + 2, factor * mt.x * u.x);
+        bs.add(g.ellipses, row + 3, factor * mt.x * u.y);
+        bs.add(g.ellipses, row + 4, factor * mt.y * u.x);
+        bs.add(g.ellipses, row + 5, factor * mt.y * u.y);
         if (d.kind == DRAW_STROKE) {
-            bs.add(&g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * factor);
+            bs.add(g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * factor);
             add_metric(d, pc.draw, g, bs, n_side, factor, (c + A * u) - bs.p);
         }
         return true;
     }
 
-    bool offset_sample(const Piece& pc, const PreparedDraw& d, double t, SceneGrads& g, BoundarySample& bs) const {
+    bool offset_sample(const Piece& pc, const PreparedDraw& d, double t, const GradView& g, BoundarySample& bs) const {
         const StrokeSegment& s = sc_.stroke_items[d.first_item + pc.item];
         if (d.varying) return offset_sample_varying(pc, d, s, t, g, bs);
         Vec2 b1 = seg_deriv(s.seg, t);
@@ -600,7 +599,7 @@ private:
         stroke_item_indices(sc_, s, idx);
         for (int i = 0; i <= s.seg.degree; ++i)
             add_point_dir(d, g, bs, idx[i], n_q, factor, bernstein(s.seg.degree, i, whole_t(s, t)));
-        bs.add(&g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * factor);
+        bs.add(g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * factor);
         add_metric(d, pc.draw, g, bs, n_q, factor, to_pixel(d, seg_eval(s.seg, t)) - bs.p);
         return true;
     }
@@ -614,7 +613,7 @@ private:
     // are the whole segment's (the piece's parameter maps to it linearly, and only
     // b_i' / |B'| enters).
     bool offset_sample_varying(const Piece& pc, const PreparedDraw& d, const StrokeSegment& s, double t,
-                               SceneGrads& g, BoundarySample& bs) const {
+                               const GradView& g, BoundarySample& bs) const {
         const Segment& ps = s.seg;
         Vec2 b1 = seg_deriv(ps, t);
         double sp = length(b1);
@@ -646,7 +645,7 @@ private:
             double bi = bernstein(n, i, T_whole), dbi = bernstein_deriv(n, i, T_whole);
             add_point_dir(d, g, bs, idx[i], bi * n_q - (tilt * dbi) * N, factor, 1.0);
             if (width_free(sc_, idx[i]))
-                bs.add(&g.point_widths, (size_t)idx[i], 0.5 * side * bi * dot(N, n_q) * factor);
+                bs.add(g.point_widths, (size_t)idx[i], 0.5 * side * bi * dot(N, n_q) * factor);
         }
         // Metric: sum_i c_i (x) P_i(pixel) - n_q (x) p, with sum b_i P_i = B and sum b_i' P_i = B'.
         add_metric(d, pc.draw, g, bs, n_q, factor, to_pixel(d, seg_eval(W, T_whole)) - bs.p);
@@ -734,7 +733,7 @@ private:
         return 0;
     }
 
-    bool end_sample(const Piece& pc, const PreparedDraw& d, double t, SceneGrads& g, BoundarySample& bs) const {
+    bool end_sample(const Piece& pc, const PreparedDraw& d, double t, const GradView& g, BoundarySample& bs) const {
         const StrokeSegment& s = sc_.stroke_items[d.first_item + pc.item];
         EndGeometry eg = end_geometry(d, s, pc.side);
         if (!eg.valid) return false;
@@ -786,9 +785,9 @@ private:
         // (one-sided where the width is about 0: a join of negative width does not exist)
         double rate_w = hw > dw ? normal_rate(eg.in.t, t_out, eg.in.t, t_out, hw + dw, hw - dw, dw)
                                 : 2 * normal_rate(eg.in.t, t_out, eg.in.t, t_out, hw + dw, hw, dw);
-        if (!d.varying) bs.add(&g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * rate_w * factor);
+        if (!d.varying) bs.add(g.draw_params, DRAW_FCOLS * (size_t)pc.draw, 0.5 * rate_w * factor);
         else if (width_free(sc_, stored.width_index))
-            bs.add(&g.point_widths, (size_t)stored.width_index, 0.5 * rate_w * factor);
+            bs.add(g.point_widths, (size_t)stored.width_index, 0.5 * rate_w * factor);
         return true;
     }
 };
@@ -801,7 +800,7 @@ private:
 // function theorem): d|B(t*) - p| / dP_i = basis_i(t*) (B(t*) - p) / |B(t*) - p|.
 // Joins, caps and butt ends: central differences of their construction in the vertex,
 // the tangents' angles and the width.
-void sdf_backward(const PreparedScene& sc, const Hit& h, Vec2 p, double g_sd, SceneGrads& g) {
+void sdf_backward(const SceneView& sc, const Hit& h, Vec2 p, double g_sd, const GradView& g) {
     const PreparedDraw& d = sc.draws[h.draw];
     const SdfArg& arg = h.arg;
     auto add_pixel_point = [&](int32_t idx, Vec2 v) {  // v: d sd / d(pixel point)
@@ -823,7 +822,7 @@ void sdf_backward(const PreparedScene& sc, const Hit& h, Vec2 p, double g_sd, Sc
                 add_pixel_point(seg.point_index[i], (g_sd * sign * bernstein(seg.seg.degree, i, arg.t)) * dir);
         } else if (arg.kind == SdfArg::ELLIPSE) {
             Vec2 u = inverse(d.ellipse_axes) * (arg.closest - d.ellipse_center);
-            double* ge = g.ellipses.data() + ELLIPSE_COLS * (size_t)d.ellipse_row;
+            GradPtr ge = g.ellipses + ELLIPSE_COLS * (size_t)d.ellipse_row;
             double k = g_sd * sign;
             ge[0] += k * dir.x; ge[1] += k * dir.y;
             ge[2] += k * dir.x * u.x; ge[3] += k * dir.x * u.y;
@@ -835,7 +834,7 @@ void sdf_backward(const PreparedScene& sc, const Hit& h, Vec2 p, double g_sd, Sc
     double gs = g_sd * d.metric_scale;
     Vec2 q = d.metric_identity ? p : d.metric * p;
     double hw = d.half_width;
-    double* gw = g.draw_params.data() + DRAW_FCOLS * (size_t)h.draw;  // width = 2 hw
+    GradPtr gw = g.draw_params + DRAW_FCOLS * (size_t)h.draw;  // width = 2 hw
     // The stroke metric M: stroke-space geometry is M times pixel geometry, q = M p, and
     // metric_scale = |det M|^-1/2. d sd_s / d M[r][c] = v[r] (anchor - p)[c] for a piece
     // built around `anchor` whose stroke-space gradient is v.
@@ -895,7 +894,7 @@ void sdf_backward(const PreparedScene& sc, const Hit& h, Vec2 p, double g_sd, Sc
             Vec2 local = anchor;
             Vec2 u = inverse(d.ellipse_axes) * (local - d.ellipse_center);
             Vec2 m = mt(dir);
-            double* ge = g.ellipses.data() + ELLIPSE_COLS * (size_t)d.ellipse_row;
+            GradPtr ge = g.ellipses + ELLIPSE_COLS * (size_t)d.ellipse_row;
             ge[0] += gs * m.x; ge[1] += gs * m.y;
             ge[2] += gs * m.x * u.x; ge[3] += gs * m.x * u.y;
             ge[4] += gs * m.y * u.x; ge[5] += gs * m.y * u.y;
@@ -970,12 +969,14 @@ void sdf_backward(const PreparedScene& sc, const Hit& h, Vec2 p, double g_sd, Sc
 
 }  // namespace
 
-void render_backward(const PreparedScene& sc, const SceneArrays& a, const RenderOptions& o, const float* image,
+void render_backward(const PreparedScene& prepared, const SceneArrays& a, const RenderOptions& o, const float* image,
                      const float* d_image, double boundary_density, SceneGrads& out) {
+    const SceneView sc = prepared.view();
     const int W = o.width, H = o.height, N = std::max(1, o.samples);
     const double R = o.filter == FILTER_BOX ? 0.5 : std::max(0.5, o.filter_radius);
     // Boundary samples reach pixels within R of them, so tiles must see that far out.
-    TileBins bins = bin_draws(sc, W, H, (o.mode == MODE_ANALYTIC ? 2 * R : R) + 4 * EPS_NORMAL, false);
+    TileBins tile_bins = bin_draws(prepared, W, H, (o.mode == MODE_ANALYTIC ? 2 * R : R) + 4 * EPS_NORMAL, false);
+    const TileView bins = tile_bins.view();
     std::vector<double> gpix;
     pixel_adjoints(o, image, d_image, gpix);
     int lanes = std::max(1, o.threads > 0 ? o.threads : ThreadPool::hardware_threads());
@@ -987,7 +988,7 @@ void render_backward(const PreparedScene& sc, const SceneArrays& a, const Render
     // function of the geometry there, so there is no boundary term).
     const bool analytic = o.mode == MODE_ANALYTIC;
     ThreadPool::instance().parallel_for(lanes, lanes, [&](int lane, int) {
-        SceneGrads& g = grads[lane];
+        const GradView g = grads[lane].view();
         std::vector<Hit> hits;
         Tape tape;
         std::vector<std::array<double, 4>> g_hits;
@@ -1053,7 +1054,7 @@ void render_backward(const PreparedScene& sc, const SceneArrays& a, const Render
         filter_integral = one * one;
     } else filter_integral = 4 * R * R;
     ThreadPool::instance().parallel_for(lanes, lanes, [&](int lane, int) {
-        SceneGrads& g = grads[lane];
+        const GradView g = grads[lane].view();
         std::vector<Hit> hits;
         BoundarySample bs;
         for (size_t k = lane; k < pieces.size(); k += lanes) {
@@ -1101,7 +1102,7 @@ void render_backward(const PreparedScene& sc, const SceneArrays& a, const Render
                     }
                 total *= bs.weight;
                 if (total == 0) continue;
-                for (int i = 0; i < bs.nv; ++i) (*bs.v[i].target)[bs.v[i].index] += total * bs.v[i].value;
+                for (int i = 0; i < bs.nv; ++i) bs.v[i].target += total * bs.v[i].value;
             }
         }
     });

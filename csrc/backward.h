@@ -2,6 +2,7 @@
 // loss's gradient with respect to the rendered (straight RGBA) image.
 #pragma once
 
+#include "grads.h"
 #include "paint.h"
 #include "render.h"
 #include "scene.h"

@@ -8,6 +8,7 @@
 
 #include "backward.h"
 #include "coverage.h"
+#include "gpu.h"
 #include "render.h"
 #include "scene.h"
 #include "thread_pool.h"
@@ -118,7 +119,7 @@ RenderOptions render_options(int width, int height, int samples, const std::stri
 
 py::array_t<float> render(const py::dict& scene, int width, int height, int samples, const std::string& mode,
                           const std::string& filter, double filter_radius, uint64_t seed, int threads,
-                          py::object background, bool brute_force) {
+                          py::object background, bool brute_force, int device) {
     SceneInput in = scene_input(scene);
     SceneArrays a = in.arrays();
     RenderOptions o = render_options(width, height, samples, mode, filter, filter_radius, seed, threads, background);
@@ -128,7 +129,8 @@ py::array_t<float> render(const py::dict& scene, int width, int height, int samp
     {
         py::gil_scoped_release release;
         PreparedScene prepared = prepare_scene(a);
-        render_forward(prepared, o, out);
+        if (device >= 0) gpu::render_forward(prepared, o, device, out);
+        else render_forward(prepared, o, out);
     }
     return image;
 }
@@ -181,14 +183,30 @@ PYBIND11_MODULE(_core, m) {
     m.def("render", &render, "Render the scene arrays (a dict, see vecfit/pack.py) into [H, W, 4] straight RGBA",
           py::arg("scene"), py::arg("width"), py::arg("height"), py::arg("samples"), py::arg("mode"),
           py::arg("filter"), py::arg("filter_radius"), py::arg("seed"), py::arg("threads"), py::arg("background"),
-          py::arg("brute_force") = false);
+          py::arg("brute_force") = false, py::arg("device") = -1);
     m.def("render_grad", &render_grad,
           "Gradients of the scene arrays given the forward image and dL/d(image)",
           py::arg("scene"), py::arg("image"), py::arg("d_image"), py::arg("width"), py::arg("height"),
           py::arg("samples"), py::arg("mode"), py::arg("filter"), py::arg("filter_radius"), py::arg("seed"),
           py::arg("threads"), py::arg("background"), py::arg("boundary_density"));
     m.def("hardware_threads", &ThreadPool::hardware_threads);
-    m.def("has_cuda", [] { return false; });
+    m.def("has_cuda", &gpu::compiled, "Whether this build has the CUDA kernels");
+    m.def("cuda_device_count", &gpu::device_count, "CUDA devices usable now (0 without a CUDA build)");
+    m.def("build_info", [] {
+        py::dict info;
+        info["compiler"] = std::string(
+#if defined(__clang__)
+            "clang " __clang_version__
+#elif defined(__GNUC__)
+            "gcc " __VERSION__
+#else
+            "unknown"
+#endif
+        );
+        info["cuda"] = gpu::build_info();
+        info["hardware_threads"] = ThreadPool::hardware_threads();
+        return info;
+    });
 
     m.def("polynomial_roots", [](std::vector<double> coeffs, double lo, double hi) {
         if (coeffs.empty() || coeffs.size() > 6) throw std::invalid_argument("degree must be 0..5");

@@ -62,7 +62,7 @@ struct SdfArg {
 // Signed crossings of the ray from p towards +x, up to and including x_max, with the
 // segment; each y-monotone piece counts on the half-open range [y_low, y_high) so that
 // pieces meeting at a vertex are counted once. +1 where the curve moves towards +y.
-inline int ray_crossings(const PreparedSegment& s, Vec2 p, double x_max = 1e300) {
+VF_HD int ray_crossings(const PreparedSegment& s, Vec2 p, double x_max = 1e300) {
     if (p.y < s.box.y0 || p.y > s.box.y1 || s.box.x1 <= p.x || s.box.x0 > x_max) return 0;
     int w = 0;
     for (int k = 0; k + 1 < s.n_split; ++k) {
@@ -83,20 +83,20 @@ inline int ray_crossings(const PreparedSegment& s, Vec2 p, double x_max = 1e300)
     return w;
 }
 
-inline bool winding_inside(int winding, int rule) {
+VF_HD bool winding_inside(int winding, int rule) {
     return rule == EVENODD ? (winding & 1) != 0 : winding != 0;
 }
 
 // ----------------------------------------------------------------------- strokes
 
-inline double point_line_segment_distance(Vec2 p, Vec2 a, Vec2 b) {
+VF_HD double point_line_segment_distance(Vec2 p, Vec2 a, Vec2 b) {
     Vec2 d = b - a;
     double l2 = dot(d, d);
-    double t = l2 > 0 ? std::clamp(dot(p - a, d) / l2, 0.0, 1.0) : 0.0;
+    double t = l2 > 0 ? vclamp(dot(p - a, d) / l2, 0.0, 1.0) : 0.0;
     return distance(a + t * d, p);
 }
 
-inline bool convex_contains(const Vec2* v, int n, Vec2 q) {
+VF_HD bool convex_contains(const Vec2* v, int n, Vec2 q) {
     bool pos = false, neg = false;
     for (int i = 0; i < n; ++i) {
         double c = cross(v[(i + 1) % n] - v[i], q - v[i]);
@@ -108,34 +108,34 @@ inline bool convex_contains(const Vec2* v, int n, Vec2 q) {
 
 // A join polygon (vertex first, then its outer points): its two sides from the vertex are
 // seams with the sweeps, so depth inside counts only the outer edges.
-inline double join_polygon_sdf(const Vec2* v, int n, Vec2 q) {
+VF_HD double join_polygon_sdf(const Vec2* v, int n, Vec2 q) {
     double outer = 1e300, all = 1e300;
     for (int i = 0; i < n; ++i) {
         double d = point_line_segment_distance(q, v[i], v[(i + 1) % n]);
-        all = std::min(all, d);
-        if (i != 0 && i != n - 1) outer = std::min(outer, d);
+        all = vmin(all, d);
+        if (i != 0 && i != n - 1) outer = vmin(outer, d);
     }
     return convex_contains(v, n, q) ? -outer : all;
 }
 
 // Local frame of a square cap: s along the outward tangent from the end point, u across.
-inline void cap_frame(const StrokeEnd& e, Vec2 q, double& s, double& u) {
+VF_HD void cap_frame(const StrokeEnd& e, Vec2 q, double& s, double& u) {
     Vec2 r = q - e.center;
     s = dot(r, e.axis);
     u = cross(e.axis, r);
 }
 
 // Half square s in [0, hw], |u| <= hw; its back edge (s = 0) is a seam with the sweep.
-inline double square_sdf(const StrokeEnd& e, Vec2 q, double hw) {
+VF_HD double square_sdf(const StrokeEnd& e, Vec2 q, double hw) {
     double s, u;
     cap_frame(e, q, s, u);
     double au = std::fabs(u);
-    if (s >= 0 && s <= hw && au <= hw) return -std::min(hw - s, hw - au);
-    double ds = s < 0 ? -s : std::max(s - hw, 0.0), du = std::max(au - hw, 0.0);
+    if (s >= 0 && s <= hw && au <= hw) return -vmin(hw - s, hw - au);
+    double ds = s < 0 ? -s : vmax(s - hw, 0.0), du = vmax(au - hw, 0.0);
     return std::sqrt(ds * ds + du * du);
 }
 
-inline bool end_contains(const StrokeEnd& e, Vec2 q) {
+VF_HD bool end_contains(const StrokeEnd& e, Vec2 q) {
     double hw = e.hw;
     switch (e.kind) {
         case StrokeEnd::DISK: return dot(q - e.center, q - e.center) <= hw * hw;
@@ -149,7 +149,7 @@ inline bool end_contains(const StrokeEnd& e, Vec2 q) {
     }
 }
 
-inline double end_sdf(const StrokeEnd& e, Vec2 q) {
+VF_HD double end_sdf(const StrokeEnd& e, Vec2 q) {
     double hw = e.hw;
     switch (e.kind) {
         case StrokeEnd::DISK: return distance(q, e.center) - hw;
@@ -163,11 +163,11 @@ inline double end_sdf(const StrokeEnd& e, Vec2 q) {
 // control point on the end point) every q is "critical", which would put a disk there,
 // a round cap or join the style did not ask for. The limit tangent decides there, and
 // its normal line has no area. (An interior cusp keeps its disk, as Skia's stroker does.)
-inline int sweep_critical_points(const Segment& s, Vec2 q, double* ts) {
+VF_HD int sweep_critical_points(const Segment& s, Vec2 q, double* ts) {
     int n = seg_critical_points(s, q, ts);
     if (n == 0 || (ts[0] > 0 && ts[n - 1] < 1)) return n;
     double size2 = 0;
-    for (int i = 1; i <= s.degree; ++i) size2 = std::max(size2, dot(s.p[i] - s.p[0], s.p[i] - s.p[0]));
+    for (int i = 1; i <= s.degree; ++i) size2 = vmax(size2, dot(s.p[i] - s.p[0], s.p[i] - s.p[0]));
     int m = 0;
     for (int i = 0; i < n; ++i) {
         bool end = ts[i] <= 0 || ts[i] >= 1;
@@ -180,7 +180,7 @@ inline int sweep_critical_points(const Segment& s, Vec2 q, double* ts) {
 
 // The critical point of a gently curved piece (StrokeSegment::simple): g(t) = (B - q).B'
 // is increasing there, so a root exists iff g(0) <= 0 <= g(1); safeguarded Newton.
-inline int simple_critical_point(const Segment& s, Vec2 q, double* ts) {
+VF_HD int simple_critical_point(const Segment& s, Vec2 q, double* ts) {
     Vec2 a[4];  // B(t) - q = sum a[k] t^k
     seg_power_basis(s, q, a);
     int n = s.degree;
@@ -217,13 +217,13 @@ inline int simple_critical_point(const Segment& s, Vec2 q, double* ts) {
     return 1;
 }
 
-inline int stroke_critical_points(const StrokeSegment& ss, Vec2 q, double* ts) {
+VF_HD int stroke_critical_points(const StrokeSegment& ss, Vec2 q, double* ts) {
     return ss.simple ? simple_critical_point(ss.seg, q, ts) : sweep_critical_points(ss.seg, q, ts);
 }
 
 // Signed distance to the sweep's boundary from its critical points alone (offset curves):
 // min over critical points of (|B(t*) - q| - w/2); +huge when there are none.
-inline double sweep_sdf(const StrokeSegment& ss, Vec2 q, double hw, double* t_best = nullptr) {
+VF_HD double sweep_sdf(const StrokeSegment& ss, Vec2 q, double hw, double* t_best = nullptr) {
     const Segment& s = ss.seg;
     double ts[5];
     int n = stroke_critical_points(ss, q, ts);
@@ -239,13 +239,13 @@ inline double sweep_sdf(const StrokeSegment& ss, Vec2 q, double hw, double* t_be
 }
 
 // Whether q is within `reach` of the segment's control-point hull's chord-frame box.
-inline bool near_segment(const StrokeSegment& ss, Vec2 q, double reach) {
+VF_HD bool near_segment(const StrokeSegment& ss, Vec2 q, double reach) {
     Vec2 r = q - ss.seg.p[0];
     double s = dot(r, ss.frame_u), n = cross(ss.frame_u, r);
     return s >= ss.s_min - reach && s <= ss.s_max + reach && n >= ss.n_min - reach && n <= ss.n_max + reach;
 }
 
-inline bool sweep_contains(const StrokeSegment& ss, Vec2 q, double hw) {
+VF_HD bool sweep_contains(const StrokeSegment& ss, Vec2 q, double hw) {
     const Segment& s = ss.seg;
     if (s.degree == 1) {  // the rectangle around the line
         Vec2 d = s.p[1] - s.p[0];
@@ -261,16 +261,16 @@ inline bool sweep_contains(const StrokeSegment& ss, Vec2 q, double hw) {
     return false;
 }
 
-inline bool stroke_item_contains(const StrokeSegment& s, Vec2 q, double hw) {
+VF_HD bool stroke_item_contains(const StrokeSegment& s, Vec2 q, double hw) {
     return end_contains(s.end, q) || end_contains(s.start, q) ||
            (near_segment(s, q, hw) && sweep_contains(s, q, hw));
 }
 
 // Per-point widths: the half width along the piece.
-inline double item_hw(const StrokeSegment& s, double t) { return bez_scalar(s.hw, s.seg.degree, t); }
+VF_HD double item_hw(const StrokeSegment& s, double t) { return bez_scalar(s.hw, s.seg.degree, t); }
 
 // The sweep of normals of half length hw(t) (per-point widths; see the top comment).
-inline bool sweep_contains_varying(const StrokeSegment& ss, Vec2 q) {
+VF_HD bool sweep_contains_varying(const StrokeSegment& ss, Vec2 q) {
     const Segment& s = ss.seg;
     if (s.degree == 1) {  // the trapezoid around the line: the normal through q is at t
         Vec2 d = s.p[1] - s.p[0];
@@ -290,7 +290,7 @@ inline bool sweep_contains_varying(const StrokeSegment& ss, Vec2 q) {
 }
 
 // min over critical points of |B(t*) - q| - hw(t*); +huge when there are none.
-inline double sweep_sdf_varying(const StrokeSegment& ss, Vec2 q, double* t_best = nullptr) {
+VF_HD double sweep_sdf_varying(const StrokeSegment& ss, Vec2 q, double* t_best = nullptr) {
     double ts[5];
     int n = stroke_critical_points(ss, q, ts);
     double best = 1e300;
@@ -304,7 +304,7 @@ inline double sweep_sdf_varying(const StrokeSegment& ss, Vec2 q, double* t_best 
     return best;
 }
 
-inline bool stroke_item_contains_varying(const StrokeSegment& s, Vec2 q) {
+VF_HD bool stroke_item_contains_varying(const StrokeSegment& s, Vec2 q) {
     return end_contains(s.end, q) || end_contains(s.start, q) ||
            (near_segment(s, q, s.hw_max) && sweep_contains_varying(s, q));
 }
@@ -312,7 +312,7 @@ inline bool stroke_item_contains_varying(const StrokeSegment& s, Vec2 q) {
 // Signed distance (stroke space) to this item's pieces. The butt end lines of free ends
 // bound the sweep; other end normals are interior seams covered by a join or cap.
 // varying: per-point widths (the item's own hw profile; hw is then unused).
-inline double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double hw, double limit, SdfArg* arg = nullptr,
+VF_HD double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double hw, double limit, SdfArg* arg = nullptr,
                               bool varying = false) {
     // Farther than hw + limit from the hull: the sweep cannot bring the distance under limit.
     double t = 0;
@@ -331,7 +331,7 @@ inline double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double hw, double 
             double v = point_line_segment_distance(q, at - h * n, at + h * n);
             if (v < dl) { dl = v; dl_side = k; }
         }
-        double combined = sd <= 0 ? std::max(sd, -dl) : std::min(sd, dl);
+        double combined = sd <= 0 ? vmax(sd, -dl) : vmin(sd, dl);
         if (combined != sd) { kind = SdfArg::BUTT; side = dl_side; }
         sd = combined;
     }
@@ -353,15 +353,15 @@ inline double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double hw, double 
 
 struct AllItems {
     int n;
-    int size() const { return n; }
-    int operator[](int i) const { return i; }
+    VF_HD int size() const { return n; }
+    VF_HD int operator[](int i) const { return i; }
 };
 
-inline Vec2 to_stroke_space(const PreparedDraw& d, Vec2 p) {
+VF_HD Vec2 to_stroke_space(const PreparedDraw& d, Vec2 p) {
     return d.metric_identity ? p : d.metric * p;
 }
 
-inline int draw_winding_all(const PreparedScene& sc, const PreparedDraw& d, Vec2 p) {
+VF_HD int draw_winding_all(const SceneView& sc, const PreparedDraw& d, Vec2 p) {
     int w = 0;
     const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
     for (int i = 0; i < d.n_items; ++i) w += ray_crossings(segs[i], p);
@@ -370,7 +370,7 @@ inline int draw_winding_all(const PreparedScene& sc, const PreparedDraw& d, Vec2
 
 // Distance from p to the closest fill segment among items, or `limit` if none is closer.
 template <class Items>
-double fill_distance(const PreparedScene& sc, const PreparedDraw& d, const Items& items, Vec2 p, double limit,
+VF_HD double fill_distance(const SceneView& sc, const PreparedDraw& d, const Items& items, Vec2 p, double limit,
                      SdfArg* arg = nullptr) {
     const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
     double best = limit;
@@ -381,7 +381,7 @@ double fill_distance(const PreparedScene& sc, const PreparedDraw& d, const Items
         if (s.seg.degree == 1) {
             Vec2 a = s.seg.p[0], e = s.seg.p[1] - a;
             double l2 = dot(e, e);
-            c.t = l2 > 0 ? std::clamp(dot(p - a, e) / l2, 0.0, 1.0) : 0.0;
+            c.t = l2 > 0 ? vclamp(dot(p - a, e) / l2, 0.0, 1.0) : 0.0;
             c.dist = distance(a + c.t * e, p);
         } else {
             c = seg_closest(s.seg, p);
@@ -400,7 +400,7 @@ double fill_distance(const PreparedScene& sc, const PreparedDraw& d, const Items
 }
 
 template <class Items>
-bool stroke_contains(const PreparedScene& sc, const PreparedDraw& d, const Items& items, Vec2 p) {
+VF_HD bool stroke_contains(const SceneView& sc, const PreparedDraw& d, const Items& items, Vec2 p) {
     Vec2 q = to_stroke_space(d, p);
     double hw = d.half_width;
     if (d.is_ellipse) {
@@ -418,7 +418,7 @@ bool stroke_contains(const PreparedScene& sc, const PreparedDraw& d, const Items
 
 // Signed distance in pixels to the stroke (negative inside), clamped to [-limit, limit].
 template <class Items>
-double stroke_sdf(const PreparedScene& sc, const PreparedDraw& d, const Items& items, Vec2 p, double limit,
+VF_HD double stroke_sdf(const SceneView& sc, const PreparedDraw& d, const Items& items, Vec2 p, double limit,
                   SdfArg* arg = nullptr) {
     Vec2 q = to_stroke_space(d, p);
     double hw = d.half_width;
@@ -447,12 +447,12 @@ double stroke_sdf(const PreparedScene& sc, const PreparedDraw& d, const Items& i
             }
         }
     }
-    return std::clamp(sd * d.metric_scale, -limit, limit);
+    return vclamp(sd * d.metric_scale, -limit, limit);
 }
 
-inline double ellipse_fill_sdf(const PreparedDraw& d, Vec2 p, double limit, SdfArg* arg = nullptr) {
+VF_HD double ellipse_fill_sdf(const PreparedDraw& d, Vec2 p, double limit, SdfArg* arg = nullptr) {
     Vec2 c;
-    double dist = std::min(ellipse_closest(d.ellipse, p, c), limit);
+    double dist = vmin(ellipse_closest(d.ellipse, p, c), limit);
     if (arg) {
         arg->kind = SdfArg::ELLIPSE;
         arg->closest = c;

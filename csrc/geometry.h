@@ -3,12 +3,9 @@
 // same functions for the device.
 #pragma once
 
-#include <algorithm>
 #include <cmath>
 
-#ifndef VF_HD
-#define VF_HD inline
-#endif
+#include "device.h"
 
 namespace vf {
 
@@ -54,10 +51,10 @@ struct Box {
     double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
 };
 VF_HD void expand(Box& b, Vec2 p) {
-    b.x0 = std::min(b.x0, p.x);
-    b.y0 = std::min(b.y0, p.y);
-    b.x1 = std::max(b.x1, p.x);
-    b.y1 = std::max(b.y1, p.y);
+    b.x0 = vmin(b.x0, p.x);
+    b.y0 = vmin(b.y0, p.y);
+    b.x1 = vmax(b.x1, p.x);
+    b.y1 = vmax(b.y1, p.y);
 }
 VF_HD Box grown(Box b, double m) { return {b.x0 - m, b.y0 - m, b.x1 + m, b.y1 + m}; }
 VF_HD bool overlaps(const Box& a, const Box& b) {
@@ -66,8 +63,8 @@ VF_HD bool overlaps(const Box& a, const Box& b) {
 VF_HD bool valid(const Box& b) { return b.x0 <= b.x1 && b.y0 <= b.y1; }
 // Squared distance from p to the box (0 inside).
 VF_HD double distance2(const Box& b, Vec2 p) {
-    double dx = std::max(std::max(b.x0 - p.x, 0.0), p.x - b.x1);
-    double dy = std::max(std::max(b.y0 - p.y, 0.0), p.y - b.y1);
+    double dx = vmax(vmax(b.x0 - p.x, 0.0), p.x - b.x1);
+    double dy = vmax(vmax(b.y0 - p.y, 0.0), p.y - b.y1);
     return dx * dx + dy * dy;
 }
 
@@ -115,7 +112,7 @@ namespace detail {
 struct RootSink {
     double* roots;
     int count;
-    void push(double t) {
+    VF_HD void push(double t) {
         // a double root can come back as two roots a rounding error apart
         if (count == 0 || t - roots[count - 1] > 1e-7 * (1 + std::fabs(t))) roots[count++] = t;
     }
@@ -205,7 +202,7 @@ VF_HD int poly_roots(const double* coeffs, int degree, double lo, double hi, dou
     double scale = 0;
     for (int i = 0; i <= degree; ++i) {
         c[i] = coeffs[i];
-        scale = std::max(scale, std::fabs(c[i]));
+        scale = vmax(scale, std::fabs(c[i]));
     }
     if (scale == 0 || !(hi >= lo)) return 0;
     int n = degree;
@@ -228,7 +225,7 @@ VF_HD int poly_roots(const double* coeffs, int degree, double lo, double hi, dou
         }
         double q = -0.5 * (c[1] + std::copysign(std::sqrt(disc), c[1]));
         double r0 = q / c[2], r1 = q != 0 ? c[0] / q : r0;
-        if (r0 > r1) std::swap(r0, r1);
+        if (r0 > r1) vswap(r0, r1);
         int count = 0;
         if (r0 >= lo && r0 <= hi) roots[count++] = r0;
         if (r1 >= lo && r1 <= hi && (count == 0 || r1 - roots[0] > 1e-7 * (1 + std::fabs(r1)))) roots[count++] = r1;
@@ -251,7 +248,7 @@ VF_HD int poly_roots(const double* coeffs, int degree, double lo, double hi, dou
     for (int k = 0; k <= n; ++k) {
         b[k] = 0;
         for (int i = 0; i <= k; ++i) b[k] += binom[k][i] / binom[n][i] * a[i];
-        bscale = std::max(bscale, std::fabs(b[k]));
+        bscale = vmax(bscale, std::fabs(b[k]));
     }
     double eps = 1e-14 * bscale;
     detail::RootSink sink{roots, 0};
@@ -517,7 +514,7 @@ VF_HD double ellipse_closest_quadrant(double e0, double e1, double y0, double y1
     if (numer0 < denom0) {
         double xde0 = numer0 / denom0;
         x0 = e0 * xde0;
-        x1 = e1 * std::sqrt(std::max(0.0, 1 - xde0 * xde0));
+        x1 = e1 * std::sqrt(vmax(0.0, 1 - xde0 * xde0));
         return std::hypot(x0 - y0, x1);
     }
     x0 = e0;
@@ -542,8 +539,8 @@ VF_HD EllipseFrame ellipse_frame(Vec2 c, const Mat2& A) {
     f.c = c;
     f.cs = std::cos(theta);
     f.sn = std::sin(theta);
-    f.r0 = std::sqrt(std::max(0.0, mid + rad));
-    f.r1 = std::sqrt(std::max(0.0, mid - rad));
+    f.r0 = std::sqrt(vmax(0.0, mid + rad));
+    f.r1 = std::sqrt(vmax(0.0, mid - rad));
     return f;
 }
 
@@ -553,7 +550,7 @@ VF_HD double ellipse_closest(const EllipseFrame& f, Vec2 p, Vec2& closest) {
     double u = f.cs * d.x + f.sn * d.y, v = -f.sn * d.x + f.cs * d.y;
     double e0 = f.r0, e1 = f.r1;
     if (e1 <= 0) {  // degenerate: a line segment of half-length e0 along the first axis
-        double x = std::clamp(u, -e0, e0);
+        double x = vclamp(u, -e0, e0);
         closest = f.c + Vec2{f.cs * x, f.sn * x};
         return std::hypot(u - x, v);
     }

@@ -3,12 +3,13 @@
 #pragma once
 
 #include "geometry.h"
+#include "grads.h"
 #include "scene.h"
 
 namespace vf {
 
 // Colour of the stops at t (straight RGBA interpolated, as SVG does), premultiplied.
-inline void stop_color(const PreparedScene& sc, const PreparedPaint& p, double t, double out[4]) {
+VF_HD void stop_color(const SceneView& sc, const PreparedPaint& p, double t, double out[4]) {
     const double* off = sc.stop_offsets.data() + p.first_stop;
     const double* col = sc.stop_colors.data() + 4 * p.first_stop;
     int n = p.n_stops;
@@ -24,8 +25,8 @@ inline void stop_color(const PreparedScene& sc, const PreparedPaint& p, double t
         double u = span > 0 ? (t - off[k]) / span : 1.0;
         for (int i = 0; i < 4; ++i) c[i] = (1 - u) * col[4 * k + i] + u * col[4 * (k + 1) + i];
     }
-    double a = std::clamp(c[3], 0.0, 1.0);
-    for (int i = 0; i < 3; ++i) out[i] = std::clamp(c[i], 0.0, 1.0) * a;
+    double a = vclamp(c[3], 0.0, 1.0);
+    for (int i = 0; i < 3; ++i) out[i] = vclamp(c[i], 0.0, 1.0) * a;
     out[3] = a;
 }
 
@@ -34,7 +35,7 @@ inline void stop_color(const PreparedScene& sc, const PreparedPaint& p, double t
 // largest t with t r >= 0 for which q lies on the circle of centre f + t (c - f) and
 // radius t r. Returns false where no such t exists: outside the cone, when the focal
 // point lies outside the circle; that area is not painted.
-inline bool radial_t(Vec2 q, Vec2 c, double r, Vec2 f, double& t) {
+VF_HD bool radial_t(Vec2 q, Vec2 c, double r, Vec2 f, double& t) {
     Vec2 d = c - f, e = q - f;
     double a = dot(d, d) - r * r, b = dot(e, d), cc = dot(e, e);
     if (std::fabs(a) <= 1e-9 * r * r) {  // focal point on the circle: a linear equation
@@ -48,10 +49,10 @@ inline bool radial_t(Vec2 q, Vec2 c, double r, Vec2 f, double& t) {
     return t >= 0;
 }
 
-inline void paint_color(const PreparedScene& sc, const PreparedPaint& p, Vec2 pixel, double out[4]) {
+VF_HD void paint_color(const SceneView& sc, const PreparedPaint& p, Vec2 pixel, double out[4]) {
     if (p.kind == PAINT_SOLID) {
-        double a = std::clamp(p.rgba[3], 0.0, 1.0);
-        for (int i = 0; i < 3; ++i) out[i] = std::clamp(p.rgba[i], 0.0, 1.0) * a;
+        double a = vclamp(p.rgba[3], 0.0, 1.0);
+        for (int i = 0; i < 3; ++i) out[i] = vclamp(p.rgba[i], 0.0, 1.0) * a;
         out[3] = a;
         return;
     }
@@ -76,48 +77,23 @@ inline void paint_color(const PreparedScene& sc, const PreparedPaint& p, Vec2 pi
 
 namespace vf {
 
-// Gradients of the core's float inputs, laid out like SceneArrays (doubles, so that
-// accumulation over many samples keeps its precision).
-struct SceneGrads {
-    std::vector<double> points, point_widths, ellipses, draw_params, paint_params, stop_offsets, stop_colors,
-        layer_opacity;
-    void resize_like(const SceneArrays& a) {
-        points.assign(2 * a.n_points, 0);
-        point_widths.assign(a.n_point_widths, 0);
-        ellipses.assign(ELLIPSE_COLS * a.n_ellipses, 0);
-        draw_params.assign(DRAW_FCOLS * a.n_draws, 0);
-        paint_params.assign(PAINT_FCOLS * a.n_paints, 0);
-        stop_offsets.assign(a.n_stops, 0);
-        stop_colors.assign(4 * a.n_stops, 0);
-        layer_opacity.assign(a.n_layers, 0);
-    }
-    void add(const SceneGrads& o) {
-        auto acc = [](std::vector<double>& x, const std::vector<double>& y) {
-            for (size_t i = 0; i < x.size(); ++i) x[i] += y[i];
-        };
-        acc(points, o.points); acc(point_widths, o.point_widths); acc(ellipses, o.ellipses); acc(draw_params, o.draw_params);
-        acc(paint_params, o.paint_params); acc(stop_offsets, o.stop_offsets);
-        acc(stop_colors, o.stop_colors); acc(layer_opacity, o.layer_opacity);
-    }
-};
-
 // d(premultiplied colour)/d(straight colour c) applied to g: the adjoint of c.
 // Values are clamped to [0, 1]; the gradient passes where a value lies in [0, 1], ends
 // included, so that an opaque alpha or a zero channel can still move inwards.
-inline void premultiply_backward(const double c[4], const double g[4], double gc[4]) {
-    double a = std::clamp(c[3], 0.0, 1.0);
+VF_HD void premultiply_backward(const double c[4], const double g[4], double gc[4]) {
+    double a = vclamp(c[3], 0.0, 1.0);
     for (int i = 0; i < 3; ++i) gc[i] = (c[i] >= 0 && c[i] <= 1) ? g[i] * a : 0.0;
     double ga = g[3];
-    for (int i = 0; i < 3; ++i) ga += g[i] * std::clamp(c[i], 0.0, 1.0);
+    for (int i = 0; i < 3; ++i) ga += g[i] * vclamp(c[i], 0.0, 1.0);
     gc[3] = (c[3] >= 0 && c[3] <= 1) ? ga : 0.0;
 }
 
 // Adjoint of paint_color: g is dL/d(premultiplied colour at `pixel`); adds dL/d(paint
 // parameters, stop offsets, stop colours) into grads.
-inline void paint_color_backward(const PreparedScene& sc, int paint_index, Vec2 pixel, const double g[4],
-                                 SceneGrads& grads) {
+VF_HD void paint_color_backward(const SceneView& sc, int paint_index, Vec2 pixel, const double g[4],
+                                const GradView& grads) {
     const PreparedPaint& p = sc.paints[paint_index];
-    double* gp = grads.paint_params.data() + PAINT_FCOLS * paint_index;
+    GradPtr gp = grads.paint_params + PAINT_FCOLS * paint_index;
     if (p.kind == PAINT_SOLID) {
         double gc[4];
         premultiply_backward(p.rgba, g, gc);
@@ -160,8 +136,8 @@ inline void paint_color_backward(const PreparedScene& sc, int paint_index, Vec2 
     // Stops: straight colour c = (1-u) C_k + u C_{k+1}, u = (t - o_k) / (o_{k+1} - o_k).
     const double* off = sc.stop_offsets.data() + p.first_stop;
     const double* col = sc.stop_colors.data() + 4 * p.first_stop;
-    double* g_off = grads.stop_offsets.data() + p.first_stop;
-    double* g_col = grads.stop_colors.data() + 4 * p.first_stop;
+    GradPtr g_off = grads.stop_offsets + p.first_stop;
+    GradPtr g_col = grads.stop_colors + 4 * p.first_stop;
     int n = p.n_stops;
     double c[4], gc[4];
     if (!(t > off[0]) || t >= off[n - 1]) {  // padded: a constant colour, no t dependence

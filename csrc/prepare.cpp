@@ -1,5 +1,6 @@
 // Builds the PreparedScene from the flat arrays: control points per segment, bounds,
 // y-monotone pieces for ray crossings, stroke pieces (joins and caps), paints, layers.
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 

@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "scene.h"
+#include "tiles.h"
 
 namespace vf {
 
@@ -21,6 +22,15 @@ struct RenderOptions {
     bool has_background = false;
     double background[4] = {0, 0, 0, 0};  // straight RGBA
 };
+
+// What the per-pixel work needs besides the scene: the options with the filter radius
+// settled, the tiles, and the premultiplied background.
+struct ForwardPlan {
+    RenderOptions options;
+    TileBins bins;
+    double background[4] = {0, 0, 0, 0};
+};
+ForwardPlan plan_forward(const PreparedScene& scene, const RenderOptions& options);
 
 // out: height x width x 4 floats, straight (not premultiplied) RGBA.
 void render_forward(const PreparedScene& scene, const RenderOptions& options, float* out);

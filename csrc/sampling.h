@@ -7,7 +7,7 @@
 
 namespace vf {
 
-inline uint64_t mix64(uint64_t z) {  // splitmix64 finaliser
+VF_HD uint64_t mix64(uint64_t z) {  // splitmix64 finaliser
     z += 0x9e3779b97f4a7c15ull;
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
@@ -15,7 +15,7 @@ inline uint64_t mix64(uint64_t z) {  // splitmix64 finaliser
 }
 
 // Two uniform numbers in [0, 1) for one sample.
-inline void sample_uniform2(uint64_t seed, uint64_t pixel, uint64_t sample, double& u, double& v) {
+VF_HD void sample_uniform2(uint64_t seed, uint64_t pixel, uint64_t sample, double& u, double& v) {
     uint64_t h = mix64(seed * 0x100000001b3ull ^ mix64(pixel * 0x9e3779b97f4a7c15ull + sample));
     u = (h >> 11) * (1.0 / 9007199254740992.0);
     h = mix64(h);
@@ -27,7 +27,7 @@ inline void sample_uniform2(uint64_t seed, uint64_t pixel, uint64_t sample, doub
 // the n^2 samples also fall in distinct columns and rows of the fine n^2 x n^2 grid, which
 // estimates edge coverage with less noise than plain jittered strata. The two
 // permutations are shared by the pixel's rows / columns ("correlated") and drawn per pixel.
-inline uint32_t permute_index(uint32_t i, uint32_t n, uint64_t key) {
+VF_HD uint32_t permute_index(uint32_t i, uint32_t n, uint64_t key) {
     // i-th element of a random permutation of 0..n-1 (n <= 64): rank by hashed keys.
     uint64_t ki = mix64(key ^ (i * 0x9e3779b97f4a7c15ull));
     uint32_t rank = 0;
@@ -38,7 +38,7 @@ inline uint32_t permute_index(uint32_t i, uint32_t n, uint64_t key) {
     return rank;
 }
 
-inline void sample_position(uint64_t seed, uint64_t pixel, int s, int n, double& x, double& y) {
+VF_HD void sample_position(uint64_t seed, uint64_t pixel, int s, int n, double& x, double& y) {
     double u, v;
     sample_uniform2(seed, pixel, (uint64_t)s, u, v);
     int sx = s % n, sy = s / n;
@@ -51,9 +51,9 @@ inline void sample_position(uint64_t seed, uint64_t pixel, int s, int n, double&
 enum FilterKind : int { FILTER_BOX = 0, FILTER_TENT = 1, FILTER_GAUSSIAN = 2 };
 
 // Unnormalised filter weight at offset (dx, dy) from the pixel centre, support radius r.
-inline double filter_weight(int kind, double r, double dx, double dy) {
+VF_HD double filter_weight(int kind, double r, double dx, double dy) {
     switch (kind) {
-        case FILTER_TENT: return std::max(0.0, 1 - std::fabs(dx) / r) * std::max(0.0, 1 - std::fabs(dy) / r);
+        case FILTER_TENT: return vmax(0.0, 1 - std::fabs(dx) / r) * vmax(0.0, 1 - std::fabs(dy) / r);
         case FILTER_GAUSSIAN: {
             double s = r / 2;  // truncated at two standard deviations
             return std::exp(-(dx * dx + dy * dy) / (2 * s * s));

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "device.h"
 #include "geometry.h"
 
 namespace vf {
@@ -135,7 +136,29 @@ struct PreparedScene {
     std::vector<int32_t> layer_parent;
     std::vector<double> layer_opacity;
     std::vector<int32_t> layer_depth;
+    struct SceneView view() const;
 };
+
+// The prepared scene as the per-sample code reads it: views of its arrays, in host memory
+// (PreparedScene::view) or in device memory (a CUDA build's copy).
+struct SceneView {
+    Span<PreparedSegment> segments;
+    Span<double> point_hw;
+    Span<PreparedSegment> fill_items;
+    Span<StrokeSegment> stroke_items;
+    Span<PreparedDraw> draws;
+    Span<PreparedPaint> paints;
+    Span<double> stop_offsets, stop_colors;
+    Span<int32_t> layer_parent;
+    Span<double> layer_opacity;
+    Span<int32_t> layer_depth;
+};
+
+inline SceneView PreparedScene::view() const {
+    return {span_of(segments),     span_of(point_hw),     span_of(fill_items),   span_of(stroke_items),
+            span_of(draws),        span_of(paints),       span_of(stop_offsets), span_of(stop_colors),
+            span_of(layer_parent), span_of(layer_opacity), span_of(layer_depth)};
+}
 
 // A segment with its bounds and y-monotone pieces; idx: its control points' indices or null.
 PreparedSegment prepare_segment(const Segment& s, const int32_t* idx);

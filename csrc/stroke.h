@@ -9,7 +9,7 @@
 namespace vf {
 
 // The join at vertex v between a segment leaving along t_in and one leaving along t_out.
-inline StrokeEnd make_join(Vec2 v, Vec2 t_in, Vec2 t_out, int join, double hw, double miter_limit) {
+VF_HD StrokeEnd make_join(Vec2 v, Vec2 t_in, Vec2 t_out, int join, double hw, double miter_limit) {
     StrokeEnd e;
     e.hw = hw;
     double c = cross(t_in, t_out), d = dot(t_in, t_out);
@@ -26,7 +26,7 @@ inline StrokeEnd make_join(Vec2 v, Vec2 t_in, Vec2 t_out, int join, double hw, d
     double s = c >= 0 ? 1.0 : -1.0;
     Vec2 n_in = -s * perp(t_in), n_out = -s * perp(t_out);
     e.kind = StrokeEnd::POLYGON;
-    double cos_half = std::sqrt(std::max(0.0, 0.5 * (1 + d)));  // cos of half the turn
+    double cos_half = std::sqrt(vmax(0.0, 0.5 * (1 + d)));  // cos of half the turn
     // Miter length / stroke width = 1 / sin(interior angle / 2) = 1 / cos(turn / 2).
     if (join == JOIN_MITER && cos_half > 1e-12 && 1.0 / cos_half <= miter_limit) {
         Vec2 dir = normalized(n_in + n_out);
@@ -44,7 +44,7 @@ inline StrokeEnd make_join(Vec2 v, Vec2 t_in, Vec2 t_out, int join, double hw, d
     return e;
 }
 
-inline StrokeEnd make_cap(Vec2 at, Vec2 outward, int cap, double hw) {
+VF_HD StrokeEnd make_cap(Vec2 at, Vec2 outward, int cap, double hw) {
     StrokeEnd e;
     e.hw = hw;
     if (cap == CAP_ROUND) {
@@ -58,7 +58,7 @@ inline StrokeEnd make_cap(Vec2 at, Vec2 outward, int cap, double hw) {
     return e;
 }
 
-inline Segment transformed(const Segment& s, const Mat2& m) {
+VF_HD Segment transformed(const Segment& s, const Mat2& m) {
     Segment out = s;
     for (int i = 0; i <= s.degree; ++i) out.p[i] = m * s.p[i];
     return out;
@@ -68,7 +68,7 @@ inline Segment transformed(const Segment& s, const Mat2& m) {
 // is stroked as that straight line, as Skia and resvg do: the direction at the end of
 // such a curve is decided by sub-pixel control-point offsets, and stroking it exactly
 // grows visible fins and rounds that those renderers (and users) do not expect.
-inline bool nearly_straight(const Segment& s) {
+VF_HD bool nearly_straight(const Segment& s) {
     if (s.degree == 1) return false;
     Vec2 a = s.p[0], b = seg_end(s), d = b - a;
     double l2 = dot(d, d);
@@ -85,7 +85,7 @@ inline bool nearly_straight(const Segment& s) {
 // own parameter, so the straight line keeps the curve's degree and parametrisation: the
 // inner control points are projected onto the chord (the same line, the same end
 // directions, and the widths of the inner points still count).
-inline Segment straightened(const Segment& s, bool keep_degree = false) {
+VF_HD Segment straightened(const Segment& s, bool keep_degree = false) {
     if (!nearly_straight(s)) return s;
     Vec2 a = s.p[0], b = seg_end(s), d = b - a;
     if (keep_degree) {

@@ -180,18 +180,4 @@ TileBins bin_draws(const PreparedScene& sc, int width, int height, double margin
     return bins;
 }
 
-int tile_winding(const PreparedScene& sc, const TileBins& bins, const TileEntry& e, const Box& region, Vec2 p) {
-    const PreparedDraw& d = sc.draws[e.draw];
-    const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
-    const LocalItem* items = bins.items.data() + e.first;
-    int w = e.winding;
-    for (int i = 0; i < e.count; ++i) {
-        const LocalItem& li = items[i];
-        w += ray_crossings(segs[li.item], p, region.x1);
-        for (int c = 0; c < li.n_cross; ++c)
-            if (li.cross_y[c] <= p.y) w += li.cross_dir[c];  // heights are already > region.y0
-    }
-    return w;
-}
-
 }  // namespace vf

@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "coverage.h"
 #include "scene.h"
 
 namespace vf {
@@ -38,19 +39,30 @@ struct TileEntry {
     int32_t first = 0, count = 0; // local items
 };
 
+// The bins as the per-sample code reads them (host or device memory).
+struct TileView {
+    int nx = 0, ny = 0;
+    double margin = 0;
+    Span<int> start;
+    Span<TileEntry> entries;
+    Span<LocalItem> items;
+    VF_HD const TileEntry* begin(int tile) const { return entries.data() + start[tile]; }
+    VF_HD int count(int tile) const { return start[tile + 1] - start[tile]; }
+    VF_HD Box region(int tile) const {  // pixel-space area the tile's samples and prefilter reach
+        int tx = tile % nx, ty = tile / nx;
+        return {tx * (double)TILE - margin, ty * (double)TILE - margin, (tx + 1) * (double)TILE + margin,
+                (ty + 1) * (double)TILE + margin};
+    }
+};
+
 struct TileBins {
     int nx = 0, ny = 0;
     double margin = 0;
     std::vector<int> start;       // [nx * ny + 1] offsets into entries
     std::vector<TileEntry> entries;
     std::vector<LocalItem> items;
-    const TileEntry* begin(int tile) const { return entries.data() + start[tile]; }
-    int count(int tile) const { return start[tile + 1] - start[tile]; }
-    Box region(int tile) const {  // pixel-space area the tile's samples and prefilter reach
-        int tx = tile % nx, ty = tile / nx;
-        return {tx * (double)TILE - margin, ty * (double)TILE - margin, (tx + 1) * (double)TILE + margin,
-                (ty + 1) * (double)TILE + margin};
-    }
+    TileView view() const { return {nx, ny, margin, span_of(start), span_of(entries), span_of(items)}; }
+    Box region(int tile) const { return view().region(tile); }
 };
 
 // margin: how far (pixels) outside a tile its samples and their prefilter reach.
@@ -59,6 +71,18 @@ struct TileBins {
 TileBins bin_draws(const PreparedScene& scene, int width, int height, double margin, bool every_tile = false);
 
 // Winding number of a fill draw at p in the tile, from its entry (see above).
-int tile_winding(const PreparedScene& scene, const TileBins& bins, const TileEntry& e, const Box& region, Vec2 p);
+VF_HD int tile_winding(const SceneView& sc, const TileView& bins, const TileEntry& e, const Box& region, Vec2 p) {
+    const PreparedDraw& d = sc.draws[e.draw];
+    const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
+    const LocalItem* items = bins.items.data() + e.first;
+    int w = e.winding;
+    for (int i = 0; i < e.count; ++i) {
+        const LocalItem& li = items[i];
+        w += ray_crossings(segs[li.item], p, region.x1);
+        for (int c = 0; c < li.n_cross; ++c)
+            if (li.cross_y[c] <= p.y) w += li.cross_dir[c];  // heights are already > region.y0
+    }
+    return w;
+}
 
 }  // namespace vf

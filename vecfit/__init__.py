@@ -1,4 +1,5 @@
 """vecfit: vectorize raster images and refine vector graphics against them."""
+from .device import cuda_device_count, has_cuda
 from .errors import SvgError, VecfitError
 from .render import render
 from .scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient, Rect,
@@ -11,9 +12,3 @@ def load_svg(path) -> Scene:
     """Read an SVG file into a Scene (see vecfit.svg.read)."""
     from .svg.read import load_svg as _load
     return _load(path)
-
-
-def has_cuda() -> bool:
-    """Whether this build of the core has the CUDA kernels."""
-    from . import _core
-    return bool(_core.has_cuda())

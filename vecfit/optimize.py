@@ -16,6 +16,7 @@ from typing import Callable, Optional
 
 import torch
 
+from . import device as devices
 from . import losses
 from .errors import VecfitError
 from .pack import local_bbox_size, shape_pixel_scales
@@ -38,6 +39,7 @@ class Settings:
     boundary_samples: float = 2.0
     seed: int = 0
     threads: int = 0
+    device: str = "auto"
     lr_decay: float = 0.1
     lr_warmup: int = 0
     fixed_alpha: bool = False
@@ -65,6 +67,7 @@ class Settings:
             raise VecfitError("lr_decay must be in (0, 1]")
         if self.lr_warmup < 0:
             raise VecfitError("lr_warmup must be 0 or more")
+        devices.resolve(self.device)
         for kind, value in self.lr.items():
             if kind not in KINDS:
                 raise VecfitError(f"unknown parameter kind {kind!r} (known: {', '.join(KINDS)})")
@@ -286,7 +289,8 @@ def optimize(scene: Scene, target: Target, settings: Settings,
         with torch.set_grad_enabled(grad):
             image = render(scene, width, height, samples=settings.samples, mode=settings.mode,
                            seed=settings.seed + iteration, background=target.background,
-                           threads=settings.threads, boundary_samples=settings.boundary_samples)
+                           threads=settings.threads, boundary_samples=settings.boundary_samples,
+                           device=settings.device)
             frame["image"] = image.detach()
             return loss_fn(target.compared(image), goal)
 

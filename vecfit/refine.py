@@ -123,7 +123,7 @@ def _render_full(scene, w, h, config) -> torch.Tensor:
     """The scene at the target's size, without background (straight RGBA)."""
     with torch.no_grad():
         return render(scene, w, h, samples=config["eval_samples"], seed=config["seed"],
-                      threads=config["threads"])
+                      threads=config["threads"], device=config["device"])
 
 
 def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Outputs,

@@ -10,6 +10,7 @@ import math
 import torch
 
 from . import _core
+from . import device as devices
 from .errors import VecfitError
 from .pack import pack_scene
 from .scene import Scene
@@ -44,6 +45,8 @@ def _core_render(settings: dict, structure: dict, floats, brute_force: bool = Fa
         return scene, _core.render(scene, **settings, brute_force=brute_force)
     except ValueError as e:  # the core refused the scene (e.g. layers nested too deeply)
         raise VecfitError(str(e)) from None
+    except RuntimeError as e:  # the GPU failed (out of memory, driver)
+        raise VecfitError(f"rendering on {devices.describe(settings['device'])} failed: {e}") from None
 
 
 class _Render(torch.autograd.Function):
@@ -55,23 +58,26 @@ class _Render(torch.autograd.Function):
         ctx.scene, ctx.image = _core_render(settings, structure, floats)
         ctx.settings, ctx.boundary_density = settings, boundary_density
         ctx.shapes = [t.shape for t in floats]
-        return torch.from_numpy(ctx.image)
+        ctx.tensor_device = floats[0].device
+        return torch.from_numpy(ctx.image).to(ctx.tensor_device)
 
     @staticmethod
     def backward(ctx, grad_image):
+        # (On the CPU for now, also after a GPU forward pass: the CUDA backward is to come.)
         s = ctx.settings
         grads = _core.render_grad(ctx.scene, ctx.image, grad_image.detach().cpu().contiguous().numpy(),
                                   s["width"], s["height"], s["samples"], s["mode"], s["filter"],
                                   s["filter_radius"], s["seed"], s["threads"], s["background"],
                                   ctx.boundary_density)
-        out = [torch.from_numpy(grads[name]).reshape(shape) for name, shape in zip(FLOAT_INPUTS, ctx.shapes)]
+        out = [torch.from_numpy(grads[name]).reshape(shape).to(ctx.tensor_device)
+               for name, shape in zip(FLOAT_INPUTS, ctx.shapes)]
         return (None, None, None, *out)
 
 
 def render(scene: Scene, width: int | None = None, height: int | None = None, *,
            samples: int = 2, mode: str = "mc", filter: str = "box", filter_radius: float = 0.5,
            seed: int = 0, background=None, threads: int | None = None, boundary_samples: float = 2.0,
-           _brute_force: bool = False) -> torch.Tensor:
+           device=None, _brute_force: bool = False) -> torch.Tensor:
     """Render ``scene`` into an [H, W, 4] float tensor of straight RGBA.
 
     samples: N means N x N stratified samples per pixel (jittered in "mc" mode, at the
@@ -82,6 +88,12 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     The result is differentiable with respect to every tensor of the scene. In "mc" mode
     the backward pass samples the boundaries (``boundary_samples`` points per pixel of
     boundary length, same seed); in "analytic" mode it differentiates the prefilter.
+
+    device: where the pixels are shaded: None (a GPU if the scene's tensors are on one,
+    else the CPU), "auto", "cpu", "cuda" or "cuda:N" (needs a core built with
+    VECFIT_CUDA=1; see vecfit.has_cuda()). The same seed gives the same image on either.
+    The result lies on the device of the scene's tensors. Gradients are computed on the
+    CPU for now.
     """
     if mode not in MODES:
         raise VecfitError(f"mode must be one of {', '.join(MODES)}, not {mode!r}")
@@ -110,7 +122,8 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     structure = {k: v for k, v in arrays.items() if k not in FLOAT_INPUTS}
     settings = dict(width=width, height=height, samples=int(samples), mode=mode, filter=filter,
                     filter_radius=float(filter_radius), seed=int(seed), threads=int(threads or 0),
-                    background=background)
+                    background=background, device=devices.resolve(device, floats))
     if torch.is_grad_enabled() and any(t.requires_grad for t in floats) and not _brute_force:
         return _Render.apply(settings, float(boundary_samples), structure, *floats)
-    return torch.from_numpy(_core_render(settings, structure, floats, brute_force=_brute_force)[1])
+    image = _core_render(settings, structure, floats, brute_force=_brute_force)[1]
+    return torch.from_numpy(image).to(floats[0].device)

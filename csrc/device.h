@@ -1,0 +1,47 @@
+// What lets one source serve the CPU and a CUDA build: VF_HD marks the per-sample
+// functions (scene evaluation, coverage, boundary sampling, their derivatives) for both
+// the host and the device, and Span is the read-only view of an array they index, which
+// on the host points into a std::vector and on the device into device memory.
+#pragma once
+
+#include <cstddef>
+
+#ifdef __CUDACC__
+#define VF_HD __host__ __device__ inline
+#else
+#define VF_HD inline
+#endif
+
+namespace vf {
+
+template <class T>
+struct Span {
+    const T* ptr = nullptr;
+    size_t n = 0;
+    VF_HD const T& operator[](size_t i) const { return ptr[i]; }
+    VF_HD const T* data() const { return ptr; }
+    VF_HD size_t size() const { return n; }
+    VF_HD bool empty() const { return n == 0; }
+};
+
+template <class Vector>
+Span<typename Vector::value_type> span_of(const Vector& v) {
+    return {v.data(), v.size()};
+}
+
+// min / max / clamp / swap for device code too (std::swap is not constexpr before C++20,
+// and std::min / max / clamp need nvcc's relaxed-constexpr mode on the device).
+template <class T>
+VF_HD T vmin(T a, T b) { return b < a ? b : a; }
+template <class T>
+VF_HD T vmax(T a, T b) { return a < b ? b : a; }
+template <class T>
+VF_HD T vclamp(T v, T lo, T hi) { return v < lo ? lo : (hi < v ? hi : v); }
+template <class T>
+VF_HD void vswap(T& a, T& b) {
+    T t = a;
+    a = b;
+    b = t;
+}
+
+}  // namespace vf

@@ -1,0 +1,23 @@
+// The CUDA build's entry points, declared for every build: a CPU-only build defines them
+// in gpu_absent.cpp (they report that CUDA was not compiled in), a CUDA build in
+// csrc/cuda/. Nothing here needs CUDA's headers, so the bindings stay plain C++.
+#pragma once
+
+#include <string>
+
+#include "render.h"
+#include "scene.h"
+
+namespace vf {
+namespace gpu {
+
+bool compiled();            // was this build made with VECFIT_CUDA
+int device_count();         // CUDA devices this process can use (0 without CUDA)
+std::string build_info();   // architectures and CUDA versions, for `vecfit info --build`
+
+// As render_forward, on CUDA device `device`: the scene is prepared and binned on the
+// host, uploaded, and every pixel shaded by the same shade_pixel as on the CPU.
+void render_forward(const PreparedScene& scene, const RenderOptions& options, int device, float* out);
+
+}  // namespace gpu
+}  // namespace vf

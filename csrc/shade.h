@@ -1,0 +1,162 @@
+// The forward pass's per-pixel work, shared by the CPU loop (forward.cpp) and the CUDA
+// kernel: composite the draws that cover each sample front to back (stopping once it is
+// opaque), with nested layers for group opacity, and filter the samples into a pixel.
+#pragma once
+
+#include "coverage.h"
+#include "layers.h"
+#include "paint.h"
+#include "render.h"
+#include "sampling.h"
+#include "tiles.h"
+
+namespace vf {
+
+// Parabolic prefilter kernel: coverage of a half-plane at signed distance d (in units of
+// the kernel radius, positive outside): 1/2 + (d^3 - 3d)/4 on [-1, 1].
+VF_HD double kernel_coverage(double d) {
+    if (d <= -1) return 1;
+    if (d >= 1) return 0;
+    return 0.5 + (d * d * d - 3 * d) * 0.25;
+}
+
+// Front-to-back compositing with a stack of open layers. Each frame accumulates the
+// premultiplied colour of its layer; closing a layer scales it by the layer's opacity
+// and puts it under what its parent has so far.
+struct Compositor {
+    const SceneView& sc;
+    struct Frame {
+        int layer;
+        double c[4];
+    } stack[MAX_LAYER_DEPTH];
+    int top = 0;
+
+    VF_HD explicit Compositor(const SceneView& s) : sc(s) {
+        stack[0].layer = 0;
+        for (int i = 0; i < 4; ++i) stack[0].c[i] = 0;
+    }
+
+    VF_HD void pop() {
+        Frame& child = stack[top--];
+        Frame& parent = stack[top];
+        double k = (1 - parent.c[3]) * sc.layer_opacity[child.layer];
+        for (int i = 0; i < 4; ++i) parent.c[i] += k * child.c[i];
+    }
+
+    VF_HD void enter(int layer) {
+        if (stack[top].layer == layer) return;
+        while (!layer_contains(sc, stack[top].layer, layer)) pop();
+        int chain[MAX_LAYER_DEPTH];
+        int n = layers_between(sc, stack[top].layer, layer, chain);
+        for (int i = 0; i < n; ++i) {
+            Frame& f = stack[++top];
+            f.layer = chain[i];
+            for (int j = 0; j < 4; ++j) f.c[j] = 0;
+        }
+    }
+
+    // Adds a premultiplied colour under what the current layer has.
+    VF_HD void under(const double c[4], double coverage) {
+        Frame& f = stack[top];
+        double k = (1 - f.c[3]) * coverage;
+        for (int i = 0; i < 4; ++i) f.c[i] += k * c[i];
+    }
+
+    VF_HD bool opaque() const { return top == 0 && stack[0].c[3] >= 1 - 1e-12; }
+
+    VF_HD void finish(double out[4]) {
+        while (top > 0) pop();
+        for (int i = 0; i < 4; ++i) out[i] = stack[0].c[i];
+    }
+};
+
+struct LocalItems {
+    const LocalItem* li;
+    int n;
+    VF_HD int size() const { return n; }
+    VF_HD int operator[](int i) const { return li[i].item; }
+};
+
+// Coverage of one draw at p in [0, 1]: a step (Monte Carlo) or the prefiltered kernel.
+VF_HD double entry_coverage(const SceneView& sc, const TileView& bins, const TileEntry& e, const Box& region,
+                            Vec2 p, const RenderOptions& o) {
+    const PreparedDraw& d = sc.draws[e.draw];
+    const bool analytic = o.mode == MODE_ANALYTIC;
+    const double r = o.filter_radius;
+    const bool brute = o.brute_force;
+    LocalItems local{bins.items.data() + e.first, e.count};
+    AllItems all{d.n_items};
+    if (d.kind == DRAW_STROKE) {
+        if (analytic) {
+            double sd = brute ? stroke_sdf(sc, d, all, p, r) : stroke_sdf(sc, d, local, p, r);
+            return kernel_coverage(sd / r);
+        }
+        return (brute ? stroke_contains(sc, d, all, p) : stroke_contains(sc, d, local, p)) ? 1.0 : 0.0;
+    }
+    if (d.is_ellipse) {
+        if (analytic) return kernel_coverage(ellipse_fill_sdf(d, p, r) / r);
+        return ellipse_contains(d.ellipse, p) ? 1.0 : 0.0;
+    }
+    int w = brute ? draw_winding_all(sc, d, p) : tile_winding(sc, bins, e, region, p);
+    bool inside = winding_inside(w, d.fill_rule);
+    if (!analytic) return inside ? 1.0 : 0.0;
+    double dist = brute ? fill_distance(sc, d, all, p, r) : fill_distance(sc, d, local, p, r);
+    return kernel_coverage((inside ? -dist : dist) / r);
+}
+
+// Premultiplied colour of the scene at pixel-space point p, from the tile's entries.
+VF_HD void eval_point(const SceneView& sc, const TileView& bins, int tile, Vec2 p, const RenderOptions& o,
+                      double out[4]) {
+    Compositor comp(sc);
+    const TileEntry* entries = bins.begin(tile);
+    Box region = bins.region(tile);
+    for (int k = bins.count(tile) - 1; k >= 0; --k) {
+        const TileEntry& e = entries[k];
+        const PreparedDraw& d = sc.draws[e.draw];
+        if (p.x < d.box.x0 - o.filter_radius || p.x > d.box.x1 + o.filter_radius ||
+            p.y < d.box.y0 - o.filter_radius || p.y > d.box.y1 + o.filter_radius)
+            continue;
+        double coverage = entry_coverage(sc, bins, e, region, p, o);
+        if (coverage <= 0) continue;
+        double c[4];
+        paint_color(sc, sc.paints[d.paint], p, c);
+        if (c[3] <= 0) continue;
+        comp.enter(d.layer);
+        comp.under(c, coverage);
+        if (comp.opaque()) break;
+    }
+    comp.finish(out);
+}
+
+// One output pixel: its samples filtered, the background under them, as straight RGBA.
+// o is the plan's options (filter radius settled); bg the premultiplied background.
+VF_HD void shade_pixel(const SceneView& sc, const TileView& bins, const RenderOptions& o, const double bg[4], int x,
+                       int y, float* px) {
+    const int N = o.samples;
+    const double R = o.filter_radius;
+    int tile = (y / TILE) * bins.nx + x / TILE;
+    bool any = bins.count(tile) > 0;
+    double acc[4] = {0, 0, 0, 0}, wsum = 0;
+    uint64_t pixel = (uint64_t)y * o.width + x;
+    for (int s = 0; s < N * N; ++s) {
+        double fx = ((s % N) + 0.5) / N, fy = ((s / N) + 0.5) / N;  // strata centres
+        if (o.mode == MODE_MC) sample_position(o.seed, pixel, s, N, fx, fy);
+        double dx = R * (2 * fx - 1), dy = R * (2 * fy - 1);
+        double w = filter_weight(o.filter, R, dx, dy);
+        if (w <= 0) continue;
+        double c[4] = {0, 0, 0, 0};
+        if (any) eval_point(sc, bins, tile, {x + 0.5 + dx, y + 0.5 + dy}, o, c);
+        for (int i = 0; i < 4; ++i) acc[i] += w * c[i];
+        wsum += w;
+    }
+    // Filtered premultiplied colour, the background under it, then straight RGBA.
+    double k = wsum > 0 ? 1 / wsum : 0, c[4];
+    for (int i = 0; i < 4; ++i) c[i] = acc[i] * k;
+    double rest = 1 - c[3];
+    for (int i = 0; i < 4; ++i) c[i] += rest * bg[i];
+    double a = c[3];
+    for (int i = 0; i < 3; ++i) px[i] = a > 0 ? (float)vclamp(c[i] / a, 0.0, 1.0) : 0.0f;
+    px[3] = (float)vclamp(a, 0.0, 1.0);
+}
+
+}  // namespace vf

@@ -1,0 +1,127 @@
+"""The CUDA build: its sources compile (with nvcc, wherever it is installed, GPU or not),
+a build without CUDA says so clearly, and, where a CUDA build meets a GPU, the GPU's
+images agree with the CPU's on the conformance corpus."""
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+from click.testing import CliRunner
+
+import vecfit
+from cli.main import main
+from vecfit.errors import VecfitError
+
+ROOT = Path(__file__).resolve().parents[1]
+CUDA_SOURCES = sorted((ROOT / "csrc" / "cuda").glob("*.cu"))
+GPU = vecfit.has_cuda() and vecfit.cuda_device_count() > 0
+
+
+def find_nvcc() -> str | None:
+    for candidate in (os.environ.get("CUDACXX"), shutil.which("nvcc"), "/usr/local/cuda/bin/nvcc"):
+        if candidate and Path(candidate).is_file():
+            return candidate
+    return None
+
+
+@pytest.mark.skipif(find_nvcc() is None, reason="nvcc is not installed")
+@pytest.mark.parametrize("source", CUDA_SOURCES, ids=[s.name for s in CUDA_SOURCES])
+def test_cuda_source_compiles(source, tmp_path):
+    # One architecture is enough to catch what breaks the build: host-only code reached
+    # from device code (an error here, as in CMakeLists.txt), and syntax nvcc rejects.
+    cmd = [find_nvcc(), "-std=c++17", "-arch=sm_80", "--Werror=cross-execution-space-call",
+           "-DVECFIT_WITH_CUDA=1", '-DVECFIT_CUDA_ARCHS="sm_80"', f"-I{ROOT / 'csrc'}",
+           "-c", str(source), "-o", str(tmp_path / "out.o")]
+    run = subprocess.run(cmd, capture_output=True, text=True)
+    assert run.returncode == 0, f"nvcc failed on {source.name}:\n{run.stderr[-4000:]}"
+    assert (tmp_path / "out.o").stat().st_size > 0
+
+
+def test_cuda_sources_exist():
+    assert CUDA_SOURCES, "csrc/cuda/ has no .cu files"
+
+
+def small_scene():
+    return vecfit.Scene(width=16, height=12, shapes=[vecfit.Shape(
+        geometry=vecfit.Circle(center=torch.tensor([8.0, 6.0]), radius=torch.tensor(4.0)),
+        fill=vecfit.Solid(torch.tensor([1.0, 0.0, 0.0, 1.0])))])
+
+
+@pytest.mark.skipif(vecfit.has_cuda(), reason="this build has CUDA")
+class TestWithoutCuda:
+    def test_render_on_cuda_is_a_clear_error(self):
+        with pytest.raises(VecfitError, match="built without CUDA"):
+            vecfit.render(small_scene(), device="cuda")
+
+    def test_auto_and_cpu_render_the_same(self):
+        a = vecfit.render(small_scene(), device="auto")
+        b = vecfit.render(small_scene(), device="cpu")
+        assert torch.equal(a, b) and a[6, 8, 0] == 1.0
+
+    def test_bad_device_name(self):
+        with pytest.raises(VecfitError, match="device must be"):
+            vecfit.render(small_scene(), device="gpu")
+
+    def test_info_build(self):
+        run = CliRunner().invoke(main, ["info", "--build"])
+        assert run.exit_code == 0, run.output
+        assert "CUDA: not compiled" in run.output and "device auto resolves to: cpu" in run.output
+
+    def test_cli_device_cuda_is_a_usage_error(self, tmp_path):
+        svg = tmp_path / "a.svg"
+        svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="8" height="8">'
+                       '<rect width="4" height="4"/></svg>')
+        run = CliRunner().invoke(main, ["render", str(svg), "-o", str(tmp_path / "a.png"), "--device", "cuda"])
+        assert run.exit_code == 2 and "without CUDA" in run.output
+        assert not (tmp_path / "a.png").exists()
+
+
+def test_info_needs_svg_or_build():
+    run = CliRunner().invoke(main, ["info"])
+    assert run.exit_code == 2
+
+
+# ------------------------------------------------------- with a GPU (the `device` tool)
+
+@pytest.mark.skipif(not GPU, reason="needs a CUDA build and a GPU")
+def test_gpu_matches_cpu_on_conformance_corpus():
+    import conformance as conf
+    if not (conf.CORPUS / "manifest.tsv").exists():
+        pytest.skip("the shared conformance corpus is not present")
+    worst = 0.0
+    for case in conf.load_manifest():
+        try:
+            scene = vecfit.load_svg(case.svg)
+        except VecfitError:
+            continue
+        for mode in ("mc", "analytic"):
+            cpu = vecfit.render(scene, case.width, case.height, samples=4 if mode == "mc" else 1, mode=mode,
+                                device="cpu")
+            gpu = vecfit.render(scene, case.width, case.height, samples=4 if mode == "mc" else 1, mode=mode,
+                                device="cuda")
+            diff = float((cpu - gpu).abs().max())
+            worst = max(worst, diff)
+            assert diff <= 1e-4, f"{case.name} ({mode}): CPU and GPU differ by {diff:.2e}"
+    print(f"largest CPU-GPU difference over the corpus: {worst:.2e}")
+
+
+@pytest.mark.skipif(not GPU, reason="needs a CUDA build and a GPU")
+def test_gpu_gradients_match_cpu():
+    torch.manual_seed(0)
+    scene = small_scene()
+    params = [t for ts in scene.parameters().values() for t in ts]
+    grads = {}
+    for device in ("cpu", "cuda"):
+        for t in params:
+            t.requires_grad_(True)
+            t.grad = None
+        img = vecfit.render(scene, samples=4, device=device)
+        (img ** 2).sum().backward()
+        grads[device] = [t.grad.clone() for t in params]
+    for a, b in zip(grads["cpu"], grads["cuda"]):
+        np.testing.assert_allclose(a.numpy(), b.numpy(), rtol=1e-3, atol=1e-4)
