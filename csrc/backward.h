@@ -2,10 +2,13 @@
 // loss's gradient with respect to the rendered (straight RGBA) image.
 #pragma once
 
+#include <vector>
+
+#include "backward_sample.h"
 #include "grads.h"
-#include "paint.h"
 #include "render.h"
 #include "scene.h"
+#include "tiles.h"
 
 namespace vf {
 
@@ -14,5 +17,18 @@ namespace vf {
 // analytical prefilter has no boundary term).
 void render_backward(const PreparedScene& scene, const SceneArrays& arrays, const RenderOptions& options,
                      const float* image, const float* d_image, double boundary_density, SceneGrads& out);
+
+// What the per-sample work needs besides the scene, made on the host for the CPU lanes
+// and the CUDA kernels alike.
+struct BackwardPlan {
+    RenderOptions options;          // filter radius settled, samples >= 1
+    TileBins bins;
+    std::vector<double> gpix;       // dL/d(premultiplied colour) of each pixel
+    std::vector<Piece> pieces;      // Monte Carlo: the boundary pieces, with their sample counts
+    BoundaryContext boundary;       // (its gpix points into this plan's)
+    int max_hits = 1, max_ops = 1;  // list sizes no sample can exceed
+};
+BackwardPlan plan_backward(const PreparedScene& scene, const RenderOptions& options, const float* image,
+                           const float* d_image, double boundary_density);
 
 }  // namespace vf

@@ -137,7 +137,7 @@ py::array_t<float> render(const py::dict& scene, int width, int height, int samp
 
 py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_image, int width, int height,
                      int samples, const std::string& mode, const std::string& filter, double filter_radius,
-                     uint64_t seed, int threads, py::object background, double boundary_density) {
+                     uint64_t seed, int threads, py::object background, double boundary_density, int device) {
     SceneInput in = scene_input(scene);
     SceneArrays a = in.arrays();
     RenderOptions o = render_options(width, height, samples, mode, filter, filter_radius, seed, threads, background);
@@ -147,7 +147,10 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
     {
         py::gil_scoped_release release;
         PreparedScene prepared = prepare_scene(a);
-        render_backward(prepared, a, o, image.data(), d_image.data(), boundary_density, g);
+        // (on the GPU when asked, unless a sample there needs longer lists than a thread holds)
+        bool done = device >= 0 &&
+                    gpu::render_backward(prepared, a, o, image.data(), d_image.data(), boundary_density, device, g);
+        if (!done) render_backward(prepared, a, o, image.data(), d_image.data(), boundary_density, g);
     }
     auto out = [](const std::vector<double>& v, py::ssize_t cols) {
         py::array_t<float> arr({(py::ssize_t)(cols > 0 ? v.size() / cols : v.size()), cols});
@@ -188,7 +191,7 @@ PYBIND11_MODULE(_core, m) {
           "Gradients of the scene arrays given the forward image and dL/d(image)",
           py::arg("scene"), py::arg("image"), py::arg("d_image"), py::arg("width"), py::arg("height"),
           py::arg("samples"), py::arg("mode"), py::arg("filter"), py::arg("filter_radius"), py::arg("seed"),
-          py::arg("threads"), py::arg("background"), py::arg("boundary_density"));
+          py::arg("threads"), py::arg("background"), py::arg("boundary_density"), py::arg("device") = -1);
     m.def("hardware_threads", &ThreadPool::hardware_threads);
     m.def("has_cuda", &gpu::compiled, "Whether this build has the CUDA kernels");
     m.def("cuda_device_count", &gpu::device_count, "CUDA devices usable now (0 without a CUDA build)");

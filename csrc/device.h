@@ -29,6 +29,26 @@ Span<typename Vector::value_type> span_of(const Vector& v) {
     return {v.data(), v.size()};
 }
 
+// A list in storage someone else owns, with a fixed capacity: per-thread arrays on a
+// GPU, vectors sized to the scene's worst case on the CPU. A push past the capacity is
+// dropped and flagged, so that the caller can redo the work where there is room.
+template <class T>
+struct Buffer {
+    T* items = nullptr;
+    int capacity = 0;
+    int n = 0;
+    bool overflow = false;
+    VF_HD void clear() { n = 0; }
+    VF_HD void push_back(const T& t) {
+        if (n < capacity) items[n++] = t;
+        else overflow = true;
+    }
+    VF_HD int size() const { return n; }
+    VF_HD bool empty() const { return n == 0; }
+    VF_HD T& operator[](int i) { return items[i]; }
+    VF_HD const T& operator[](int i) const { return items[i]; }
+};
+
 // min / max / clamp / swap for device code too (std::swap is not constexpr before C++20,
 // and std::min / max / clamp need nvcc's relaxed-constexpr mode on the device).
 template <class T>

@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "grads.h"
 #include "render.h"
 #include "scene.h"
 
@@ -18,6 +19,13 @@ std::string build_info();   // architectures and CUDA versions, for `vecfit info
 // As render_forward, on CUDA device `device`: the scene is prepared and binned on the
 // host, uploaded, and every pixel shaded by the same shade_pixel as on the CPU.
 void render_forward(const PreparedScene& scene, const RenderOptions& options, int device, float* out);
+
+// As render_backward (backward.h), on CUDA device `device`. Returns false, with `out`
+// unset, when a sample needed longer lists than a GPU thread holds: the caller redoes the
+// pass on the CPU.
+bool render_backward(const PreparedScene& scene, const SceneArrays& arrays, const RenderOptions& options,
+                     const float* image, const float* d_image, double boundary_density, int device,
+                     SceneGrads& out);
 
 }  // namespace gpu
 }  // namespace vf

@@ -15,6 +15,11 @@ void render_forward(const PreparedScene&, const RenderOptions&, int, float*) {
     throw std::runtime_error("this vecfit was built without CUDA (rebuild with VECFIT_CUDA=1)");
 }
 
+bool render_backward(const PreparedScene&, const SceneArrays&, const RenderOptions&, const float*, const float*,
+                     double, int, SceneGrads&) {
+    throw std::runtime_error("this vecfit was built without CUDA (rebuild with VECFIT_CUDA=1)");
+}
+
 }  // namespace gpu
 }  // namespace vf
 #endif

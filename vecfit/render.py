@@ -63,12 +63,14 @@ class _Render(torch.autograd.Function):
 
     @staticmethod
     def backward(ctx, grad_image):
-        # (On the CPU for now, also after a GPU forward pass: the CUDA backward is to come.)
         s = ctx.settings
-        grads = _core.render_grad(ctx.scene, ctx.image, grad_image.detach().cpu().contiguous().numpy(),
-                                  s["width"], s["height"], s["samples"], s["mode"], s["filter"],
-                                  s["filter_radius"], s["seed"], s["threads"], s["background"],
-                                  ctx.boundary_density)
+        try:
+            grads = _core.render_grad(ctx.scene, ctx.image, grad_image.detach().cpu().contiguous().numpy(),
+                                      s["width"], s["height"], s["samples"], s["mode"], s["filter"],
+                                      s["filter_radius"], s["seed"], s["threads"], s["background"],
+                                      ctx.boundary_density, s["device"])
+        except RuntimeError as e:  # the GPU failed (out of memory, driver)
+            raise VecfitError(f"gradients on {devices.describe(s['device'])} failed: {e}") from None
         out = [torch.from_numpy(grads[name]).reshape(shape).to(ctx.tensor_device)
                for name, shape in zip(FLOAT_INPUTS, ctx.shapes)]
         return (None, None, None, *out)
@@ -92,8 +94,8 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     device: where the pixels are shaded: None (a GPU if the scene's tensors are on one,
     else the CPU), "auto", "cpu", "cuda" or "cuda:N" (needs a core built with
     VECFIT_CUDA=1; see vecfit.has_cuda()). The same seed gives the same image on either.
-    The result lies on the device of the scene's tensors. Gradients are computed on the
-    CPU for now.
+    The result lies on the device of the scene's tensors; gradients are computed where
+    the image was.
     """
     if mode not in MODES:
         raise VecfitError(f"mode must be one of {', '.join(MODES)}, not {mode!r}")

@@ -9,66 +9,11 @@
 
 #include "../gpu.h"
 #include "../shade.h"
+#include "device_memory.cuh"
 
 namespace vf {
 namespace gpu {
 namespace {
-
-void check(cudaError_t status, const char* what) {
-    if (status != cudaSuccess) throw std::runtime_error(std::string("CUDA error in ") + what + ": " + cudaGetErrorString(status));
-}
-
-// Device memory that frees itself.
-class DeviceBuffer {
-public:
-    explicit DeviceBuffer(size_t bytes) { check(cudaMalloc(&ptr_, bytes ? bytes : 1), "cudaMalloc"); }
-    DeviceBuffer(const DeviceBuffer&) = delete;
-    DeviceBuffer& operator=(const DeviceBuffer&) = delete;
-    ~DeviceBuffer() { cudaFree(ptr_); }
-    void* get() const { return ptr_; }
-
-private:
-    void* ptr_ = nullptr;
-};
-
-// Device copies of host arrays, kept alive together.
-class Uploads {
-public:
-    template <class T>
-    Span<T> put(const std::vector<T>& v) {
-        if (v.empty()) return {nullptr, 0};
-        buffers_.emplace_back(new DeviceBuffer(v.size() * sizeof(T)));
-        void* p = buffers_.back()->get();
-        check(cudaMemcpy(p, v.data(), v.size() * sizeof(T), cudaMemcpyHostToDevice), "cudaMemcpy (upload)");
-        return {static_cast<const T*>(p), v.size()};
-    }
-    ~Uploads() {
-        for (DeviceBuffer* b : buffers_) delete b;
-    }
-
-private:
-    std::vector<DeviceBuffer*> buffers_;
-};
-
-SceneView upload_scene(Uploads& up, const PreparedScene& sc) {
-    SceneView v;
-    v.segments = up.put(sc.segments);
-    v.point_hw = up.put(sc.point_hw);
-    v.fill_items = up.put(sc.fill_items);
-    v.stroke_items = up.put(sc.stroke_items);
-    v.draws = up.put(sc.draws);
-    v.paints = up.put(sc.paints);
-    v.stop_offsets = up.put(sc.stop_offsets);
-    v.stop_colors = up.put(sc.stop_colors);
-    v.layer_parent = up.put(sc.layer_parent);
-    v.layer_opacity = up.put(sc.layer_opacity);
-    v.layer_depth = up.put(sc.layer_depth);
-    return v;
-}
-
-TileView upload_bins(Uploads& up, const TileBins& b) {
-    return {b.nx, b.ny, b.margin, up.put(b.start), up.put(b.entries), up.put(b.items)};
-}
 
 struct Background {
     double c[4];
@@ -114,11 +59,7 @@ std::string build_info() {
 }
 
 void render_forward(const PreparedScene& scene, const RenderOptions& options, int device, float* out) {
-    if (device < 0 || device >= device_count())
-        throw std::runtime_error("no CUDA device " + std::to_string(device) + " (found " +
-                                 std::to_string(device_count()) + ")");
-    check(cudaSetDevice(device), "cudaSetDevice");
-    check(cudaDeviceSetLimit(cudaLimitStackSize, STACK_BYTES), "cudaDeviceSetLimit");
+    use_device(device, STACK_BYTES);
     ForwardPlan plan = plan_forward(scene, options);
     Uploads up;
     SceneView sc = upload_scene(up, scene);

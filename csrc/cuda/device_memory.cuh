@@ -1,0 +1,87 @@
+// Device memory for the CUDA passes: buffers that free themselves, and device copies of
+// the prepared scene and the tiles, seen through the same views as on the host.
+#pragma once
+
+#include <cuda_runtime.h>
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "../scene.h"
+#include "../tiles.h"
+
+namespace vf {
+namespace gpu {
+
+inline void check(cudaError_t status, const char* what) {
+    if (status != cudaSuccess) throw std::runtime_error(std::string("CUDA error in ") + what + ": " + cudaGetErrorString(status));
+}
+
+// Device memory that frees itself.
+class DeviceBuffer {
+public:
+    explicit DeviceBuffer(size_t bytes) { check(cudaMalloc(&ptr_, bytes ? bytes : 1), "cudaMalloc"); }
+    DeviceBuffer(const DeviceBuffer&) = delete;
+    DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+    ~DeviceBuffer() { cudaFree(ptr_); }
+    void* get() const { return ptr_; }
+
+private:
+    void* ptr_ = nullptr;
+};
+
+// Device copies of host arrays, kept alive together.
+class Uploads {
+public:
+    template <class T>
+    Span<T> put(const std::vector<T>& v) {
+        if (v.empty()) return {nullptr, 0};
+        buffers_.emplace_back(new DeviceBuffer(v.size() * sizeof(T)));
+        void* p = buffers_.back()->get();
+        check(cudaMemcpy(p, v.data(), v.size() * sizeof(T), cudaMemcpyHostToDevice), "cudaMemcpy (upload)");
+        return {static_cast<const T*>(p), v.size()};
+    }
+
+private:
+    std::vector<std::unique_ptr<DeviceBuffer>> buffers_;
+};
+
+inline SceneView upload_scene(Uploads& up, const PreparedScene& sc) {
+    SceneView v;
+    v.segments = up.put(sc.segments);
+    v.point_hw = up.put(sc.point_hw);
+    v.fill_items = up.put(sc.fill_items);
+    v.stroke_items = up.put(sc.stroke_items);
+    v.draws = up.put(sc.draws);
+    v.paints = up.put(sc.paints);
+    v.stop_offsets = up.put(sc.stop_offsets);
+    v.stop_colors = up.put(sc.stop_colors);
+    v.layer_parent = up.put(sc.layer_parent);
+    v.layer_opacity = up.put(sc.layer_opacity);
+    v.layer_depth = up.put(sc.layer_depth);
+    return v;
+}
+
+inline TileView upload_bins(Uploads& up, const TileBins& b) {
+    return {b.nx, b.ny, b.margin, up.put(b.start), up.put(b.entries), up.put(b.items)};
+}
+
+// Makes `device` current, with room on each thread's stack for the per-sample lists.
+inline void use_device(int device, size_t stack_bytes) {
+    int count = 0;
+    if (cudaGetDeviceCount(&count) != cudaSuccess) {
+        cudaGetLastError();
+        count = 0;
+    }
+    if (device < 0 || device >= count)
+        throw std::runtime_error("no CUDA device " + std::to_string(device) + " (found " + std::to_string(count) + ")");
+    check(cudaSetDevice(device), "cudaSetDevice");
+    size_t current = 0;
+    check(cudaDeviceGetLimit(&current, cudaLimitStackSize), "cudaDeviceGetLimit");
+    if (current < stack_bytes) check(cudaDeviceSetLimit(cudaLimitStackSize, stack_bytes), "cudaDeviceSetLimit");
+}
+
+}  // namespace gpu
+}  // namespace vf
