@@ -328,9 +328,10 @@ def paint(target, paths, kind, preset, frames, output, report, comparison, confi
 @click.option("--scheduler", metavar="ADDRESS",
               help="Run the images on this Dask distributed scheduler (needs the "
                    "'distributed' package; paths must be the same on the workers).")
+@click.option("--device", **DEVICE_OPTION)
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar or per-image lines.")
 def batch(in_dir, out_dir, mode, config_file, preset, init_dir, jobs, threads, resume, scheduler,
-          quiet):
+          device, quiet):
     """Run refine, trace or paint on every image in IN_DIR (*.png, *.jpg, *.jpeg, *.bmp,
     *.tif, *.tiff, *.webp; not recursive), writing NAME.svg, NAME.report.json and
     NAME.compare.png per image, and summary.csv, summary.json and index.html (with
@@ -354,7 +355,7 @@ def batch(in_dir, out_dir, mode, config_file, preset, init_dir, jobs, threads, r
         try:
             result = run_batch(in_dir, out_dir, mode, config_file=config_file, preset=preset,
                                jobs=jobs, threads=threads, resume=resume, init_dir=init_dir,
-                               scheduler=scheduler, reporter=reporter)
+                               scheduler=scheduler, reporter=reporter, device=device)
         except BatchUsageError as e:
             _echo_err(f"error: {e}")
             sys.exit(EXIT_USAGE)

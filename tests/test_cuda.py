@@ -81,6 +81,31 @@ class TestWithoutCuda:
         assert not (tmp_path / "a.png").exists()
 
 
+    def test_optimising_commands_refuse_cuda(self, tmp_path):
+        import numpy as np
+        from vecfit.imageio import save_png
+        save_png(torch.from_numpy(np.full((16, 16, 4), 0.5, np.float32)), tmp_path / "in" / "a.png")
+        for args in (["trace", str(tmp_path / "in" / "a.png"), "-o", str(tmp_path / "a.svg")],
+                     ["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--mode", "trace"]):
+            run = CliRunner().invoke(main, args + ["--device", "cuda"])
+            assert run.exit_code == 2 and "without CUDA" in run.output, run.output
+        assert not (tmp_path / "a.svg").exists() and not (tmp_path / "out").exists()
+
+
+def test_bad_device_in_a_config_is_a_usage_error(tmp_path):
+    cfg = tmp_path / "c.toml"
+    cfg.write_text('[optimize]\ndevice = "gpu"\n')
+    run = CliRunner().invoke(main, ["refine", "a.png", "a.svg", "--config", str(cfg)])
+    assert run.exit_code == 2 and "device must be" in run.output, run.output
+
+
+def test_device_does_not_change_a_batch_settings_key():
+    from vecfit.batch.plan import comparable
+    a = {"optimize": {"device": "cpu", "threads": 2, "iterations": 5}}
+    b = {"optimize": {"device": "cuda", "threads": 1, "iterations": 5}}
+    assert comparable(a) == comparable(b) == {"optimize": {"iterations": 5}}
+
+
 def test_info_needs_svg_or_build():
     run = CliRunner().invoke(main, ["info"])
     assert run.exit_code == 2

@@ -14,6 +14,7 @@ import numpy as np
 import torch
 
 from . import __version__
+from . import device as devices
 from .colors import parse_background
 from .errors import VecfitError
 from .imageio import load_rgba
@@ -190,6 +191,7 @@ def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Out
         "loss": settings.loss,
         "loss_curve": result.losses,
         "seed": opt["seed"],
+        "device": devices.describe(devices.resolve(opt["device"])),  # what "auto" came to
         "config": config,
     }
     save_report(outputs.report, report)

@@ -121,7 +121,7 @@ class _Silent:
 def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | None = None,
               jobs: int = 1, threads: int | None = None, resume: bool = True, init_dir=None,
               scheduler: str | None = None, client=None, job: str | None = None,
-              reporter=None) -> BatchResult:
+              reporter=None, device: str | None = None) -> BatchResult:
     """Runs ``mode`` (refine, trace, paint) on every image directly in ``in_dir``, writing
     NAME.svg, NAME.report.json and NAME.compare.png per image and the summary into
     ``out_dir``.
@@ -133,6 +133,7 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
     address (or give a connected ``client``). job: "module:function" in place of the
     mode's job function (same signature; for tests and extensions). reporter: an object
     with start(total), row(row) and finish() (see vecfit.batch.progress.Progress).
+    device: where pixels are shaded (auto, cpu, cuda[:N]; default: the config's).
 
     Raises BatchUsageError before any work when the run cannot start."""
     started = time.time()
@@ -156,6 +157,13 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
     if jobs < 0 or (threads is not None and threads < 1):
         raise BatchUsageError("jobs must be >= 0 and threads >= 1")
     config = resolve_config(mode, preset, config_file)
+    if device is not None:
+        from ..device import resolve as resolve_device
+        try:
+            resolve_device(device)
+        except VecfitError as e:
+            raise BatchUsageError(str(e)) from None
+        config["optimize"]["device"] = device
     if scheduler is not None and client is None:
         from .execute import connect
         try:

@@ -99,9 +99,11 @@ def metrics_into(row: dict, report: dict) -> dict:
 
 
 def comparable(config: dict) -> dict:
-    """The settings as a report records them (JSON), less optimize.threads."""
+    """The settings as a report records them (JSON), less optimize.threads and
+    optimize.device (neither changes the result beyond rounding)."""
     c = json.loads(json.dumps(config))
     c.get("optimize", {}).pop("threads", None)
+    c.get("optimize", {}).pop("device", None)
     return c
 
 
