@@ -6,7 +6,7 @@ STAMP := $(VENV)/.vecfit-installed
 # A CPU build of torch: an unpinned torch would pull gigabytes of CUDA packages.
 TORCH := torch==2.13.0
 
-.PHONY: install demo test bench clean
+.PHONY: install demo test bench gpu-carry clean
 
 install: $(STAMP)
 
@@ -29,6 +29,16 @@ bench: install
 	$(PY) benchmarks/refine.py
 	$(PY) benchmarks/trace.py
 	$(PY) benchmarks/paint.py
+
+# A GPU session (the `device` tool): the device machine reaches no registry and does not
+# see ../shared, so what it needs travels in .gpu/ (carry [".gpu"]); there, run
+# benchmarks/gpu_session.sh.
+SHARED ?= ../shared
+gpu-carry: install
+	rm -rf .gpu && mkdir -p .gpu/wheels .gpu/shared/data
+	$(PY) -m pip download -q --no-deps -d .gpu/wheels svgelements
+	cp -r $(SHARED)/conformance .gpu/shared/
+	cp -r $(SHARED)/data/scenes .gpu/shared/data/
 
 clean:
 	rm -rf build out tests/failures

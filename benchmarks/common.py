@@ -1,12 +1,15 @@
 """Shared helpers for the benchmark scripts: data paths and robust timing."""
 from __future__ import annotations
 
+import os
 import statistics
 import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-SCENES = ROOT.parent / "shared" / "data" / "scenes"
+# ../shared beside the repository, or where VECFIT_SHARED points (as for the tests)
+SHARED = Path(os.environ.get("VECFIT_SHARED") or ROOT.parent / "shared")
+SCENES = SHARED / "data" / "scenes"
 
 
 def median_time(fn, repeats: int = 5, warmup: int = 1) -> float:

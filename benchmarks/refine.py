@@ -15,13 +15,13 @@ from pathlib import Path
 
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import ROOT, resvg_rgb  # noqa: E402
+from common import ROOT, SHARED, resvg_rgb  # noqa: E402
 
 from vecfit.config import resolve  # noqa: E402
 from vecfit.metrics import compare, to_rgb  # noqa: E402
 from vecfit.refine import Outputs, load_target, refine  # noqa: E402
 
-PHOTOS = ROOT.parent / "shared" / "data" / "photos"
+PHOTOS = SHARED / "data" / "photos"
 TARGETS = {"kitty": "kitty.jpg", "peppers": "peppers.png"}
 
 

@@ -136,17 +136,24 @@ def test_gpu_matches_cpu_on_conformance_corpus():
 
 
 @pytest.mark.skipif(not GPU, reason="needs a CUDA build and a GPU")
-def test_gpu_gradients_match_cpu():
-    torch.manual_seed(0)
-    scene = small_scene()
+@pytest.mark.parametrize("mode", ["mc", "analytic"])
+def test_gpu_gradients_match_cpu(mode):
+    # The tiger: fills and strokes, many overlaps, group transforms. Same seed, so the
+    # same pixel and boundary samples on both devices; only the order of the sums differs.
+    with __import__("warnings").catch_warnings():
+        __import__("warnings").simplefilter("ignore")
+        scene = vecfit.load_svg(ROOT / "examples" / "tiger.svg")
     params = [t for ts in scene.parameters().values() for t in ts]
     grads = {}
     for device in ("cpu", "cuda"):
         for t in params:
             t.requires_grad_(True)
             t.grad = None
-        img = vecfit.render(scene, samples=4, device=device)
+        img = vecfit.render(scene, 160, 160, samples=2, mode=mode, device=device)
         (img ** 2).sum().backward()
-        grads[device] = [t.grad.clone() for t in params]
-    for a, b in zip(grads["cpu"], grads["cuda"]):
-        np.testing.assert_allclose(a.numpy(), b.numpy(), rtol=1e-3, atol=1e-4)
+        grads[device] = torch.cat([t.grad.flatten() for t in params if t.grad is not None])
+    cpu, gpu = grads["cpu"], grads["cuda"]
+    assert cpu.abs().max() > 0
+    scale = float(cpu.abs().max())
+    worst = float((cpu - gpu).abs().max())
+    assert worst <= 1e-4 * scale, f"gradients differ by {worst:.3e} (largest {scale:.3e})"
