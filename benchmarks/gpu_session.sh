@@ -10,7 +10,7 @@ python3 -m pip install -q --no-index --find-links .gpu/wheels svgelements
 VECFIT_CUDA=1 python3 -m pip install -q --no-build-isolation --no-deps \
     -C cmake.define.CMAKE_CUDA_ARCHITECTURES=90-real -e .
 export VECFIT_SHARED="$PWD/.gpu/shared"
-nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv
+nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv || echo "(no nvidia-smi)"
 python3 -c "from vecfit.device import build_summary; print(build_summary())"
 # GPU against CPU: images over the conformance corpus, gradients on the tiger.
 python3 -m pytest -q -p no:cacheprovider tests/test_cuda.py -rs

@@ -106,6 +106,15 @@ def test_device_does_not_change_a_batch_settings_key():
     assert comparable(a) == comparable(b) == {"optimize": {"iterations": 5}}
 
 
+@pytest.mark.skipif(not vecfit.has_cuda(), reason="this build has no CUDA")
+def test_cuda_build_names_a_missing_device():
+    n = vecfit.cuda_device_count()
+    with pytest.raises(VecfitError, match=f"no CUDA device {n}: this machine has {n}"):
+        vecfit.render(small_scene(), device=f"cuda:{n}")
+    run = CliRunner().invoke(main, ["info", "--build"])
+    assert run.exit_code == 0 and "CUDA: compiled for" in run.output
+
+
 def test_info_needs_svg_or_build():
     run = CliRunner().invoke(main, ["info"])
     assert run.exit_code == 2
