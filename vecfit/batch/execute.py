@@ -135,8 +135,8 @@ def _stop(executor, stop_event, futures, finished, on_row) -> None:
 def run_processes(tasks: list[Task], workers: int, threads: int, on_row) -> bool:
     """Worker processes ("spawn": torch and fork do not mix), ``threads`` each. A worker
     that dies (a crash in native code, the OOM killer) breaks the pool: the tasks that
-    were in flight then run one at a time in a pool of their own, which finds the one that
-    kills its worker (recorded as failed), and the rest go on in parallel."""
+    were in flight then run one at a time, each in a pool of its own, which finds the one
+    that kills its worker (recorded as failed), and the rest go on in parallel."""
     pending = list(tasks)
     try:
         while pending:
@@ -147,12 +147,13 @@ def run_processes(tasks: list[Task], workers: int, threads: int, on_row) -> bool
             # Tasks start in submission order, so the ones in flight when the pool broke
             # are among the first n + 1 unfinished (n running, one queued).
             suspects, pending = unfinished[:n + 1], unfinished[n + 1:]
-            while suspects:
-                unfinished, broken = _round(suspects, 1, threads, on_row)
-                if not broken:
-                    break
-                culprit, suspects = unfinished[0], unfinished[1:]
-                on_row(result_row(culprit, FAILED, CRASHED))
+            # Each suspect alone in a pool of its own, so that a pool that breaks names its
+            # task. (Queued behind another in one pool, it would not: the executor can
+            # report a result that a worker sent just before dying as broken too.)
+            for task in suspects:
+                _, broken = _round([task], 1, threads, on_row)
+                if broken:
+                    on_row(result_row(task, FAILED, CRASHED))
     except _Interrupted:
         return True
     return False
