@@ -235,8 +235,9 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
             result.exit_code = EXIT_INTERRUPTED
         elif counts[FAILED] or counts[UNPAIRED]:
             result.exit_code = EXIT_FAILED
-        if interrupted:
-            remove_stale_temporaries(out_dir)
+        # Workers stopped by Ctrl-C, or killed by the executor when another one crashed,
+        # leave their temporaries; all are finished now, so whatever is left is stale.
+        remove_stale_temporaries(out_dir)
         from .. import __version__
         meta = {
             "vecfit": __version__, "mode": mode, "in_dir": str(in_dir.resolve()),
