@@ -122,14 +122,6 @@ VF_HD int collect_hits(const SceneView& sc, const TileView& bins, Vec2 p, int fo
     return (int)hits.size();
 }
 
-VF_HD double kernel(double d) {
-    if (d <= -1) return 1;
-    if (d >= 1) return 0;
-    return 0.5 + (d * d * d - 3 * d) * 0.25;
-}
-
-VF_HD double kernel_slope(double d) { return std::fabs(d) < 1 ? 0.75 * (d * d - 1) : 0.0; }
-
 // Analytical prefilter: the draws reaching p, front to back, with fractional coverage.
 VF_HD void collect_hits_analytic(const SceneView& sc, const TileView& bins, Vec2 p, double r, Buffer<Hit>& hits) {
     hits.clear();
@@ -153,7 +145,7 @@ VF_HD void collect_hits_analytic(const SceneView& sc, const TileView& bins, Vec2
             bool inside = winding_inside(tile_winding(sc, bins, e, region, p), d.fill_rule);
             h.sd = inside ? -dist : dist;
         }
-        h.cov = kernel(h.sd / r);
+        h.cov = kernel_coverage(h.sd / r);
         if (h.cov <= 0) continue;
         paint_color(sc, sc.paints[d.paint], p, h.paint);
         for (int i = 0; i < 4; ++i) h.c[i] = h.cov * h.paint[i];
@@ -217,17 +209,14 @@ struct Quad {
 };
 
 VF_HD void composite(const SceneView& sc, const Buffer<Hit>& hits, Tape* tape, double out[4]) {
-    struct Frame {
-        int layer;
-        double c[4];
-    } stack[MAX_LAYER_DEPTH];
+    LayerFrame stack[MAX_LAYER_DEPTH];
     int top = 0;
     stack[0].layer = 0;
     for (int i = 0; i < 4; ++i) stack[0].c[i] = 0;
     if (tape) tape->ops.clear();
     auto pop = [&] {
-        Frame& child = stack[top];
-        Frame& parent = stack[top - 1];
+        LayerFrame& child = stack[top];
+        LayerFrame& parent = stack[top - 1];
         double op = sc.layer_opacity[child.layer];
         if (tape) {
             Tape::Op o{Tape::POP, child.layer, {}, {}};
@@ -239,17 +228,10 @@ VF_HD void composite(const SceneView& sc, const Buffer<Hit>& hits, Tape* tape, d
         --top;
     };
     for (int h = (int)hits.size() - 1; h >= 0; --h) {
-        int layer = sc.draws[hits[h].draw].layer;
-        while (!layer_contains(sc, stack[top].layer, layer)) pop();
-        int chain[MAX_LAYER_DEPTH];
-        int n = layers_between(sc, stack[top].layer, layer, chain);
-        for (int i = 0; i < n; ++i) {
-            Frame& f = stack[++top];
-            f.layer = chain[i];
-            for (int j = 0; j < 4; ++j) f.c[j] = 0;
-            if (tape) tape->ops.push_back({Tape::PUSH, f.layer, {}, {}});
-        }
-        Frame& f = stack[top];
+        enter_layer(sc, stack, top, sc.draws[hits[h].draw].layer, pop, [&](int opened) {
+            if (tape) tape->ops.push_back({Tape::PUSH, opened, {}, {}});
+        });
+        LayerFrame& f = stack[top];
         if (tape) {
             Tape::Op o{Tape::OVER, h, {}, {}};
             for (int i = 0; i < 4; ++i) o.prev[i] = f.c[i];

@@ -83,6 +83,16 @@ VF_HD int ray_crossings(const PreparedSegment& s, Vec2 p, double x_max = 1e300) 
     return w;
 }
 
+// Parabolic prefilter kernel: coverage of a half-plane at signed distance d (in units of
+// the kernel radius, positive outside): 1/2 + (d^3 - 3d)/4 on [-1, 1]; and its slope.
+VF_HD double kernel_coverage(double d) {
+    if (d <= -1) return 1;
+    if (d >= 1) return 0;
+    return 0.5 + (d * d * d - 3 * d) * 0.25;
+}
+
+VF_HD double kernel_slope(double d) { return std::fabs(d) < 1 ? 0.75 * (d * d - 1) : 0.0; }
+
 VF_HD bool winding_inside(int winding, int rule) {
     return rule == EVENODD ? (winding & 1) != 0 : winding != 0;
 }

@@ -12,23 +12,12 @@
 
 namespace vf {
 
-// Parabolic prefilter kernel: coverage of a half-plane at signed distance d (in units of
-// the kernel radius, positive outside): 1/2 + (d^3 - 3d)/4 on [-1, 1].
-VF_HD double kernel_coverage(double d) {
-    if (d <= -1) return 1;
-    if (d >= 1) return 0;
-    return 0.5 + (d * d * d - 3 * d) * 0.25;
-}
-
 // Front-to-back compositing with a stack of open layers. Each frame accumulates the
 // premultiplied colour of its layer; closing a layer scales it by the layer's opacity
 // and puts it under what its parent has so far.
 struct Compositor {
     const SceneView& sc;
-    struct Frame {
-        int layer;
-        double c[4];
-    } stack[MAX_LAYER_DEPTH];
+    LayerFrame stack[MAX_LAYER_DEPTH];
     int top = 0;
 
     VF_HD explicit Compositor(const SceneView& s) : sc(s) {
@@ -37,27 +26,19 @@ struct Compositor {
     }
 
     VF_HD void pop() {
-        Frame& child = stack[top--];
-        Frame& parent = stack[top];
+        LayerFrame& child = stack[top--];
+        LayerFrame& parent = stack[top];
         double k = (1 - parent.c[3]) * sc.layer_opacity[child.layer];
         for (int i = 0; i < 4; ++i) parent.c[i] += k * child.c[i];
     }
 
     VF_HD void enter(int layer) {
-        if (stack[top].layer == layer) return;
-        while (!layer_contains(sc, stack[top].layer, layer)) pop();
-        int chain[MAX_LAYER_DEPTH];
-        int n = layers_between(sc, stack[top].layer, layer, chain);
-        for (int i = 0; i < n; ++i) {
-            Frame& f = stack[++top];
-            f.layer = chain[i];
-            for (int j = 0; j < 4; ++j) f.c[j] = 0;
-        }
+        enter_layer(sc, stack, top, layer, [&] { pop(); }, [](int) {});
     }
 
     // Adds a premultiplied colour under what the current layer has.
     VF_HD void under(const double c[4], double coverage) {
-        Frame& f = stack[top];
+        LayerFrame& f = stack[top];
         double k = (1 - f.c[3]) * coverage;
         for (int i = 0; i < 4; ++i) f.c[i] += k * c[i];
     }
