@@ -16,12 +16,8 @@ namespace {
 void pixel_adjoints(const RenderOptions& o, const float* image, const float* d_image, std::vector<double>& g) {
     int n = o.width * o.height;
     g.assign(4 * (size_t)n, 0);
-    double bg[4] = {0, 0, 0, 0};
-    if (o.has_background) {
-        double a = std::clamp(o.background[3], 0.0, 1.0);
-        for (int i = 0; i < 3; ++i) bg[i] = std::clamp(o.background[i], 0.0, 1.0) * a;
-        bg[3] = a;
-    }
+    double bg[4];
+    premultiplied_background(o, bg);
     for (int p = 0; p < n; ++p) {
         const float* s = image + 4 * p;
         const float* ds = d_image + 4 * p;
@@ -88,10 +84,8 @@ std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_) {
 BackwardPlan plan_backward(const PreparedScene& prepared, const RenderOptions& o, const float* image,
                            const float* d_image, double boundary_density) {
     BackwardPlan plan;
-    plan.options = o;
-    plan.options.samples = std::max(1, o.samples);
-    const double R = o.filter == FILTER_BOX ? 0.5 : std::max(0.5, o.filter_radius);
-    plan.options.filter_radius = R;
+    plan.options = settled(o);
+    const double R = plan.options.filter_radius;
     // Boundary samples reach pixels within R of them, so tiles must see that far out.
     plan.bins = bin_draws(prepared, o.width, o.height, (o.mode == MODE_ANALYTIC ? 2 * R : R) + 4 * EPS_NORMAL, false);
     pixel_adjoints(o, image, d_image, plan.gpix);

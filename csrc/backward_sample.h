@@ -43,13 +43,6 @@ struct Hit {
     SdfArg arg;
 };
 
-struct LocalList {
-    const LocalItem* li;
-    int n;
-    VF_HD int size() const { return n; }
-    VF_HD int operator[](int i) const { return li[i].item; }
-};
-
 VF_HD int tile_of(const TileView& bins, Vec2 p) {
     int tx = vclamp((int)std::floor(p.x / TILE), 0, bins.nx - 1);
     int ty = vclamp((int)std::floor(p.y / TILE), 0, bins.ny - 1);
@@ -57,14 +50,8 @@ VF_HD int tile_of(const TileView& bins, Vec2 p) {
 }
 
 VF_HD bool covers(const SceneView& sc, const TileView& bins, const TileEntry& e, const Box& region, Vec2 p) {
-    const PreparedDraw& d = sc.draws[e.draw];
-    if (p.x < d.box.x0 || p.x > d.box.x1 || p.y < d.box.y0 || p.y > d.box.y1) return false;
-    if (d.kind == DRAW_STROKE) {
-        LocalList local{bins.items.data() + e.first, e.count};
-        return stroke_contains(sc, d, local, p);
-    }
-    if (d.is_ellipse) return ellipse_contains(d.ellipse, p);
-    return winding_inside(tile_winding(sc, bins, e, region, p), d.fill_rule);
+    const Box& b = sc.draws[e.draw].box;
+    return p.x >= b.x0 && p.x <= b.x1 && p.y >= b.y0 && p.y <= b.y1 && entry_covers(sc, bins, e, region, p);
 }
 
 // Does draw `draw` cover p? (p inside the tile grid's reach.)
@@ -133,7 +120,7 @@ VF_HD void collect_hits_analytic(const SceneView& sc, const TileView& bins, Vec2
         const PreparedDraw& d = sc.draws[e.draw];
         Box near = grown(d.box, r);
         if (p.x < near.x0 || p.x > near.x1 || p.y < near.y0 || p.y > near.y1) continue;
-        LocalList local{bins.items.data() + e.first, e.count};
+        LocalItems local(bins, e);
         Hit h;
         h.draw = e.draw;
         if (d.kind == DRAW_STROKE) {

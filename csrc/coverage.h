@@ -231,15 +231,24 @@ VF_HD int stroke_critical_points(const StrokeSegment& ss, Vec2 q, double* ts) {
     return ss.simple ? simple_critical_point(ss.seg, q, ts) : sweep_critical_points(ss.seg, q, ts);
 }
 
+// Whether q is within `reach` of the segment's control-point hull's chord-frame box.
+VF_HD bool near_segment(const StrokeSegment& ss, Vec2 q, double reach) {
+    Vec2 r = q - ss.seg.p[0];
+    double s = dot(r, ss.frame_u), n = cross(ss.frame_u, r);
+    return s >= ss.s_min - reach && s <= ss.s_max + reach && n >= ss.n_min - reach && n <= ss.n_max + reach;
+}
+
+// The half width along the piece: its profile hw(t) (all equal without per-point widths).
+VF_HD double item_hw(const StrokeSegment& s, double t) { return bez_scalar(s.hw, s.seg.degree, t); }
+
 // Signed distance to the sweep's boundary from its critical points alone (offset curves):
-// min over critical points of (|B(t*) - q| - w/2); +huge when there are none.
-VF_HD double sweep_sdf(const StrokeSegment& ss, Vec2 q, double hw, double* t_best = nullptr) {
-    const Segment& s = ss.seg;
+// min over critical points of |B(t*) - q| - hw(t*); +huge when there are none.
+VF_HD double sweep_sdf(const StrokeSegment& ss, Vec2 q, double* t_best = nullptr) {
     double ts[5];
     int n = stroke_critical_points(ss, q, ts);
     double best = 1e300;
     for (int i = 0; i < n; ++i) {
-        double v = distance(seg_eval(s, ts[i]), q) - hw;
+        double v = distance(seg_eval(ss.seg, ts[i]), q) - item_hw(ss, ts[i]);
         if (v < best) {
             best = v;
             if (t_best) *t_best = ts[i];
@@ -248,41 +257,10 @@ VF_HD double sweep_sdf(const StrokeSegment& ss, Vec2 q, double hw, double* t_bes
     return best;
 }
 
-// Whether q is within `reach` of the segment's control-point hull's chord-frame box.
-VF_HD bool near_segment(const StrokeSegment& ss, Vec2 q, double reach) {
-    Vec2 r = q - ss.seg.p[0];
-    double s = dot(r, ss.frame_u), n = cross(ss.frame_u, r);
-    return s >= ss.s_min - reach && s <= ss.s_max + reach && n >= ss.n_min - reach && n <= ss.n_max + reach;
-}
-
-VF_HD bool sweep_contains(const StrokeSegment& ss, Vec2 q, double hw) {
+// Whether q lies in the sweep of normals of half length hw(t) (see the top comment).
+VF_HD bool sweep_contains(const StrokeSegment& ss, Vec2 q) {
     const Segment& s = ss.seg;
-    if (s.degree == 1) {  // the rectangle around the line
-        Vec2 d = s.p[1] - s.p[0];
-        double l2 = dot(d, d);
-        if (l2 <= 0) return false;
-        double t = dot(q - s.p[0], d) / l2;
-        return t >= 0 && t <= 1 && std::fabs(cross(d, q - s.p[0])) <= hw * std::sqrt(l2);
-    }
-    double ts[5];
-    int n = stroke_critical_points(ss, q, ts);
-    for (int i = 0; i < n; ++i)
-        if (dot(seg_eval(s, ts[i]) - q, seg_eval(s, ts[i]) - q) <= hw * hw) return true;
-    return false;
-}
-
-VF_HD bool stroke_item_contains(const StrokeSegment& s, Vec2 q, double hw) {
-    return end_contains(s.end, q) || end_contains(s.start, q) ||
-           (near_segment(s, q, hw) && sweep_contains(s, q, hw));
-}
-
-// Per-point widths: the half width along the piece.
-VF_HD double item_hw(const StrokeSegment& s, double t) { return bez_scalar(s.hw, s.seg.degree, t); }
-
-// The sweep of normals of half length hw(t) (per-point widths; see the top comment).
-VF_HD bool sweep_contains_varying(const StrokeSegment& ss, Vec2 q) {
-    const Segment& s = ss.seg;
-    if (s.degree == 1) {  // the trapezoid around the line: the normal through q is at t
+    if (s.degree == 1) {  // the rectangle (trapezoid) around the line: the normal through q is at t
         Vec2 d = s.p[1] - s.p[0];
         double l2 = dot(d, d);
         if (l2 <= 0) return false;
@@ -299,35 +277,17 @@ VF_HD bool sweep_contains_varying(const StrokeSegment& ss, Vec2 q) {
     return false;
 }
 
-// min over critical points of |B(t*) - q| - hw(t*); +huge when there are none.
-VF_HD double sweep_sdf_varying(const StrokeSegment& ss, Vec2 q, double* t_best = nullptr) {
-    double ts[5];
-    int n = stroke_critical_points(ss, q, ts);
-    double best = 1e300;
-    for (int i = 0; i < n; ++i) {
-        double v = distance(seg_eval(ss.seg, ts[i]), q) - item_hw(ss, ts[i]);
-        if (v < best) {
-            best = v;
-            if (t_best) *t_best = ts[i];
-        }
-    }
-    return best;
-}
-
-VF_HD bool stroke_item_contains_varying(const StrokeSegment& s, Vec2 q) {
+VF_HD bool stroke_item_contains(const StrokeSegment& s, Vec2 q) {
     return end_contains(s.end, q) || end_contains(s.start, q) ||
-           (near_segment(s, q, s.hw_max) && sweep_contains_varying(s, q));
+           (near_segment(s, q, s.hw_max) && sweep_contains(s, q));
 }
 
 // Signed distance (stroke space) to this item's pieces. The butt end lines of free ends
 // bound the sweep; other end normals are interior seams covered by a join or cap.
-// varying: per-point widths (the item's own hw profile; hw is then unused).
-VF_HD double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double hw, double limit, SdfArg* arg = nullptr,
-                              bool varying = false) {
+VF_HD double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double limit, SdfArg* arg = nullptr) {
     // Farther than hw + limit from the hull: the sweep cannot bring the distance under limit.
     double t = 0;
-    double sd = !near_segment(s, q, (varying ? s.hw_max : hw) + limit) ? 1e300
-                : varying ? sweep_sdf_varying(s, q, &t) : sweep_sdf(s, q, hw, &t);
+    double sd = near_segment(s, q, s.hw_max + limit) ? sweep_sdf(s, q, &t) : 1e300;
     SdfArg::Kind kind = SdfArg::SWEEP;
     int side = 0;
     if (s.butt_start || s.butt_end) {
@@ -421,7 +381,7 @@ VF_HD bool stroke_contains(const SceneView& sc, const PreparedDraw& d, const Ite
     for (int i = 0; i < items.size(); ++i) {
         const StrokeSegment& s = all[items[i]];
         if (p.x < s.box.x0 || p.x > s.box.x1 || p.y < s.box.y0 || p.y > s.box.y1) continue;
-        if (d.varying ? stroke_item_contains_varying(s, q) : stroke_item_contains(s, q, hw)) return true;
+        if (stroke_item_contains(s, q)) return true;
     }
     return false;
 }
@@ -446,8 +406,7 @@ VF_HD double stroke_sdf(const SceneView& sc, const PreparedDraw& d, const Items&
         for (int i = 0; i < items.size(); ++i) {
             Box b = grown(all[items[i]].box, limit);
             if (p.x < b.x0 || p.x > b.x1 || p.y < b.y0 || p.y > b.y1) continue;
-            double v = stroke_item_sdf(all[items[i]], q, hw, limit / d.metric_scale, arg ? &local : nullptr,
-                                       d.varying);
+            double v = stroke_item_sdf(all[items[i]], q, limit / d.metric_scale, arg ? &local : nullptr);
             if (v < sd) {
                 sd = v;
                 if (arg) {

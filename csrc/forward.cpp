@@ -8,19 +8,28 @@
 
 namespace vf {
 
+RenderOptions settled(const RenderOptions& o) {
+    RenderOptions s = o;
+    s.samples = std::max(1, o.samples);
+    s.filter_radius = o.filter == FILTER_BOX ? 0.5 : std::max(0.5, o.filter_radius);
+    return s;
+}
+
+void premultiplied_background(const RenderOptions& o, double out[4]) {
+    for (int i = 0; i < 4; ++i) out[i] = 0;
+    if (!o.has_background) return;
+    double a = std::clamp(o.background[3], 0.0, 1.0);
+    for (int i = 0; i < 3; ++i) out[i] = std::clamp(o.background[i], 0.0, 1.0) * a;
+    out[3] = a;
+}
+
 ForwardPlan plan_forward(const PreparedScene& sc, const RenderOptions& o) {
     ForwardPlan plan;
-    plan.options = o;
-    plan.options.samples = std::max(1, o.samples);
-    const double R = o.filter == FILTER_BOX ? 0.5 : std::max(0.5, o.filter_radius);
-    plan.options.filter_radius = R;
+    plan.options = settled(o);
+    const double R = plan.options.filter_radius;
     double margin = std::max(0.0, R - 0.5) + (o.mode == MODE_ANALYTIC ? R : 0.0);
     plan.bins = bin_draws(sc, o.width, o.height, margin + 1e-6, o.brute_force);
-    if (o.has_background) {
-        double a = std::clamp(o.background[3], 0.0, 1.0);
-        for (int i = 0; i < 3; ++i) plan.background[i] = std::clamp(o.background[i], 0.0, 1.0) * a;
-        plan.background[3] = a;
-    }
+    premultiplied_background(o, plan.background);
     return plan;
 }
 

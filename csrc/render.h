@@ -23,6 +23,12 @@ struct RenderOptions {
     double background[4] = {0, 0, 0, 0};  // straight RGBA
 };
 
+// The options as both passes use them: at least one sample, and the filter radius settled
+// (the box filter covers exactly the pixel; the others reach at least that far).
+RenderOptions settled(const RenderOptions& options);
+// The background, clamped and premultiplied (zero without one).
+void premultiplied_background(const RenderOptions& options, double out[4]);
+
 // What the per-pixel work needs besides the scene: the options with the filter radius
 // settled, the tiles, and the premultiplied background.
 struct ForwardPlan {

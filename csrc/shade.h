@@ -51,32 +51,27 @@ struct Compositor {
     }
 };
 
-struct LocalItems {
-    const LocalItem* li;
-    int n;
-    VF_HD int size() const { return n; }
-    VF_HD int operator[](int i) const { return li[i].item; }
-};
-
 // Coverage of one draw at p in [0, 1]: a step (Monte Carlo) or the prefiltered kernel.
 VF_HD double entry_coverage(const SceneView& sc, const TileView& bins, const TileEntry& e, const Box& region,
                             Vec2 p, const RenderOptions& o) {
     const PreparedDraw& d = sc.draws[e.draw];
     const bool analytic = o.mode == MODE_ANALYTIC;
     const double r = o.filter_radius;
-    const bool brute = o.brute_force;
-    LocalItems local{bins.items.data() + e.first, e.count};
+    if (!analytic && !o.brute_force) return entry_covers(sc, bins, e, region, p) ? 1.0 : 0.0;
+    if (d.is_ellipse && d.kind == DRAW_FILL) {
+        if (analytic) return kernel_coverage(ellipse_fill_sdf(d, p, r) / r);
+        return ellipse_contains(d.ellipse, p) ? 1.0 : 0.0;
+    }
+    // The analytical prefilter, or the brute-force check of the tiles (every item of the draw).
+    LocalItems local(bins, e);
     AllItems all{d.n_items};
+    const bool brute = o.brute_force;
     if (d.kind == DRAW_STROKE) {
         if (analytic) {
             double sd = brute ? stroke_sdf(sc, d, all, p, r) : stroke_sdf(sc, d, local, p, r);
             return kernel_coverage(sd / r);
         }
-        return (brute ? stroke_contains(sc, d, all, p) : stroke_contains(sc, d, local, p)) ? 1.0 : 0.0;
-    }
-    if (d.is_ellipse) {
-        if (analytic) return kernel_coverage(ellipse_fill_sdf(d, p, r) / r);
-        return ellipse_contains(d.ellipse, p) ? 1.0 : 0.0;
+        return stroke_contains(sc, d, all, p) ? 1.0 : 0.0;
     }
     int w = brute ? draw_winding_all(sc, d, p) : tile_winding(sc, bins, e, region, p);
     bool inside = winding_inside(w, d.fill_rule);

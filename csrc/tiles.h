@@ -85,4 +85,21 @@ VF_HD int tile_winding(const SceneView& sc, const TileView& bins, const TileEntr
     return w;
 }
 
+// The items a tile entry lists, as the coverage queries take them (see AllItems).
+struct LocalItems {
+    const LocalItem* li;
+    int n;
+    VF_HD LocalItems(const TileView& bins, const TileEntry& e) : li(bins.items.data() + e.first), n(e.count) {}
+    VF_HD int size() const { return n; }
+    VF_HD int operator[](int i) const { return li[i].item; }
+};
+
+// Whether the entry's draw covers p (a point of the tile region): the Monte Carlo test.
+VF_HD bool entry_covers(const SceneView& sc, const TileView& bins, const TileEntry& e, const Box& region, Vec2 p) {
+    const PreparedDraw& d = sc.draws[e.draw];
+    if (d.kind == DRAW_STROKE) return stroke_contains(sc, d, LocalItems(bins, e), p);
+    if (d.is_ellipse) return ellipse_contains(d.ellipse, p);
+    return winding_inside(tile_winding(sc, bins, e, region, p), d.fill_rule);
+}
+
 }  // namespace vf

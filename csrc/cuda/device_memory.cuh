@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "../gpu.h"
 #include "../scene.h"
 #include "../tiles.h"
 
@@ -70,11 +71,7 @@ inline TileView upload_bins(Uploads& up, const TileBins& b) {
 
 // Makes `device` current, with room on each thread's stack for the per-sample lists.
 inline void use_device(int device, size_t stack_bytes) {
-    int count = 0;
-    if (cudaGetDeviceCount(&count) != cudaSuccess) {
-        cudaGetLastError();
-        count = 0;
-    }
+    int count = device_count();
     if (device < 0 || device >= count)
         throw std::runtime_error("no CUDA device " + std::to_string(device) + " (found " + std::to_string(count) + ")");
     check(cudaSetDevice(device), "cudaSetDevice");
