@@ -33,7 +33,7 @@ bench: install
 # A GPU session (the `device` tool): the device machine reaches no registry and does not
 # see ../shared, so what it needs travels in .gpu/ (carry [".gpu"]); there, run
 # benchmarks/gpu_session.sh.
-SHARED ?= ../shared
+SHARED ?= $(or $(VECFIT_SHARED),../shared)
 gpu-carry: install
 	rm -rf .gpu && mkdir -p .gpu/wheels .gpu/shared/data
 	$(PY) -m pip download -q --no-deps -d .gpu/wheels svgelements
@@ -41,4 +41,4 @@ gpu-carry: install
 	cp -r $(SHARED)/data/scenes .gpu/shared/data/
 
 clean:
-	rm -rf build out tests/failures
+	rm -rf build out tests/failures .gpu

@@ -4,6 +4,7 @@ from __future__ import annotations
 import os
 import statistics
 import time
+import warnings
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -36,3 +37,35 @@ def resvg_rgb(svg, width: int, background=(1.0, 1.0, 1.0)):
     png = bytes(resvg_py.svg_to_bytes(svg_path=str(svg), width=width))
     rgba = np.asarray(Image.open(io.BytesIO(png)).convert("RGBA"), np.float64) / 255
     return to_rgb(rgba, background)
+
+
+def timed(fn, repeats):
+    """Medians of each of the values fn() returns, over `repeats` runs after one warm-up."""
+    fn()
+    out = []
+    for _ in range(repeats):
+        out.append(fn())
+    return [statistics.median(x) for x in zip(*out)]
+
+
+def scene_workload(name, mode, samples, threads, repeats, device="cpu"):
+    """Median (forward, backward) seconds of one benchmark scene, loss = sum of the squared
+    image, gradients of the path points; both times taken in the same run."""
+    import vecfit
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        scene = vecfit.load_svg(SCENES / f"{name}.svg")
+    params = [s.geometry.points for s in scene.shapes if hasattr(s.geometry, "points")]
+    for p in params:
+        p.requires_grad_(True)
+
+    def run():
+        t0 = time.perf_counter()
+        img = vecfit.render(scene, samples=samples, mode=mode, threads=threads, device=device)
+        t1 = time.perf_counter()
+        (img ** 2).sum().backward()
+        t2 = time.perf_counter()
+        for p in params:
+            p.grad = None
+        return t1 - t0, t2 - t1
+    return timed(run, repeats)

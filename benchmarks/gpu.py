@@ -6,42 +6,21 @@ paper's Table 1 (diffvg on a 2020 GPU).
 Needs a core built with VECFIT_CUDA=1 and a GPU; says so and stops otherwise. Times are
 medians after a warm-up and include everything render() does per call: packing, scene
 preparation and tile binning on the host, the uploads, the kernels and the copies back
-(loss = sum of the squared image, as in the gradient benchmark).
+(loss = sum of the squared image, gradients of the path points, as in
+benchmarks/gradients.py; forward and backward timed in the same runs).
 """
 from __future__ import annotations
 
 import argparse
 import sys
-import warnings
 
-from common import SCENES, median_time
+from common import scene_workload
 
 # Li et al. 2020, Table 1 (forward / backward seconds on their GPU).
 PAPER = {("tiger", "mc"): (0.060, 0.222), ("boston", "mc"): (0.074, 0.266),
          ("tiger", "analytic"): (0.098, 0.099)}
 CONFIGS = [("tiger", "mc", 2), ("tiger", "analytic", 1), ("mcseem2", "mc", 2), ("boston", "mc", 2),
            ("boston", "analytic", 1)]
-
-
-def times(scene, device, mode, samples, threads, repeats):
-    import vecfit
-    params = [t for ts in scene.parameters().values() for t in ts]
-    for t in params:
-        t.requires_grad_(True)
-    state = {}
-
-    def forward():
-        state["image"] = vecfit.render(scene, samples=samples, mode=mode, threads=threads, device=device)
-
-    def backward():
-        for t in params:
-            t.grad = None
-        image = vecfit.render(scene, samples=samples, mode=mode, threads=threads, device=device)
-        (image ** 2).sum().backward()
-
-    t_fwd = median_time(forward, repeats)
-    t_both = median_time(backward, repeats)
-    return t_fwd, max(0.0, t_both - t_fwd)
 
 
 def main():
@@ -63,14 +42,11 @@ def main():
     print(head)
     print("-" * len(head))
     for name, mode, samples in CONFIGS:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            scene = vecfit.load_svg(SCENES / f"{name}.svg")
-        cpu = times(scene, "cpu", mode, samples, args.threads, args.repeats)
-        gpu = times(scene, args.device, mode, samples, args.threads, args.repeats)
+        cpu = scene_workload(name, mode, samples, args.threads, args.repeats, device="cpu")
+        gpu = scene_workload(name, mode, samples, args.threads, args.repeats, device=args.device)
         paper = PAPER.get((name, mode))
         ref = f"{paper[0]:.3f}/{paper[1]:.3f}" if paper else "-"
-        speed = f"{paper[0] / gpu[0]:.1f}x/{paper[1] / gpu[1]:.1f}x" if paper and gpu[1] > 0 else "-"
+        speed = f"{paper[0] / gpu[0]:.1f}x/{paper[1] / gpu[1]:.1f}x" if paper else "-"
         label = f"{name} {mode} {samples}x{samples}"
         print(f"{label:22s} {cpu[0]:8.3f} {cpu[1]:8.3f} {gpu[0]:8.3f} {gpu[1]:8.3f} {ref:>14s} {speed:>12s}")
 

@@ -11,43 +11,14 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
-import warnings
 
 import numpy as np
 import torch
 
-from common import SCENES
+from common import scene_workload, timed
 
 import vecfit
 from vecfit.scene import Path, Scene, Shape, Solid
-
-
-def timed(fn, repeats):
-    fn()
-    out = []
-    for _ in range(repeats):
-        out.append(fn())
-    return [statistics.median(x) for x in zip(*out)]
-
-
-def scene_workload(name, mode, samples, threads, repeats):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        scene = vecfit.load_svg(SCENES / f"{name}.svg")
-    params = [s.geometry.points for s in scene.shapes if hasattr(s.geometry, "points")]
-    for p in params:
-        p.requires_grad_(True)
-
-    def run():
-        t0 = time.perf_counter()
-        img = vecfit.render(scene, samples=samples, mode=mode, threads=threads)
-        t1 = time.perf_counter()
-        (img ** 2).sum().backward()
-        t2 = time.perf_counter()
-        for p in params:
-            p.grad = None
-        return t1 - t0, t2 - t1
-    return timed(run, repeats)
 
 
 def strokes_scene(n, size, seed=0):

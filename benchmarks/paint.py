@@ -8,18 +8,15 @@ Usage: python benchmarks/paint.py [--iterations N] [--sizes 256,512] [--images a
 from __future__ import annotations
 
 import argparse
-import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 from PIL import Image
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from vecfit.config import resolve  # noqa: E402
-from vecfit.paint_job import paint  # noqa: E402
-from vecfit.refine import Outputs  # noqa: E402
+from vecfit.config import resolve
+from vecfit.paint_job import paint
+from vecfit.refine import Outputs
 
 CHECKPOINTS = (0, 50, 100, 200, 300, 400, 500)
 

@@ -8,18 +8,15 @@ Usage: python benchmarks/refine.py [--iterations N] [--threads T] [--images kitt
 from __future__ import annotations
 
 import argparse
-import sys
 import tempfile
 import warnings
 from pathlib import Path
 
+from common import SHARED, resvg_rgb
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import ROOT, SHARED, resvg_rgb  # noqa: E402
-
-from vecfit.config import resolve  # noqa: E402
-from vecfit.metrics import compare, to_rgb  # noqa: E402
-from vecfit.refine import Outputs, load_target, refine  # noqa: E402
+from vecfit.config import resolve
+from vecfit.metrics import compare, to_rgb
+from vecfit.refine import Outputs, load_target, refine
 
 PHOTOS = SHARED / "data" / "photos"
 TARGETS = {"kitty": "kitty.jpg", "peppers": "peppers.png"}

@@ -17,6 +17,7 @@ import argparse
 import os
 import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -115,17 +116,13 @@ def main():
 
 def refine_table(budgets, images, iterations, threads):
     """Trace + refine with the defaults: PSNR before / after and wall time per image."""
-    import sys
-    from pathlib import Path
-
     from PIL import Image
 
     from vecfit.config import resolve
     from vecfit.metrics import compare
     from vecfit.refine import Outputs
     from vecfit.trace_job import trace
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
-    from common import resvg_rgb
+    from common import resvg_rgb  # (benchmarks/ is on sys.path: the script's own folder)
 
     print("| image | budget | paths | PSNR trace | PSNR refined (vecfit) | PSNR refined (resvg) "
           "| trace s | refine s | s/iter | total s |")

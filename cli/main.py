@@ -10,9 +10,7 @@ from pathlib import Path
 
 import click
 
-EXIT_FAILURE = 1
-EXIT_USAGE = 2
-EXIT_INTERRUPTED = 130  # as a shell reports a process stopped by Ctrl-C
+from vecfit.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE
 
 DEVICE_OPTION = dict(metavar="auto|cpu|cuda[:N]",
                      help="Where pixels are shaded: auto (a GPU when vecfit was built with CUDA and "
@@ -95,7 +93,7 @@ def render(inputs, output, out_dir, width, height, samples, mode, filter_, filte
         _echo_err(f"[{i + 1}/{len(inputs)}] {src} -> {dst} ({w}x{h}, {time.perf_counter() - start:.2f} s)")
     if failed:
         _echo_err(f"{failed} of {len(inputs)} inputs failed")
-        sys.exit(EXIT_FAILURE)
+        sys.exit(EXIT_FAILED)
 
 
 @main.command()
@@ -121,7 +119,7 @@ def info(svg, build):
             scene = vecfit.load_svg(svg)
     except VecfitError as e:
         _echo_err(f"error: {e}")
-        sys.exit(EXIT_FAILURE)
+        sys.exit(EXIT_FAILED)
     click.echo(describe(scene))
 
 
@@ -221,7 +219,7 @@ def _run_job(label, iterations, quiet, job):
             report = job(bar)
     except VecfitError as e:
         _echo_err(f"error: {e}")
-        sys.exit(EXIT_FAILURE)
+        sys.exit(EXIT_FAILED)
     except KeyboardInterrupt:
         _echo_err("interrupted: nothing written")
         sys.exit(EXIT_INTERRUPTED)

@@ -12,20 +12,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from click.testing import CliRunner
 from PIL import Image
 
 from vecfit.batch import (DONE, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, FAILED,
                           INTERRUPTED, NOT_RUN, SKIPPED, UNPAIRED, available_cores, run_batch)
 from vecfit.batch.execute import CRASHED
-from vecfit.cli.main import main
+from helpers import run
 from vecfit.config import configs_dir
 
 SIZE = 32
-
-
-def run(*args):
-    return CliRunner().invoke(main, [str(a) for a in args], catch_exceptions=False)
 
 
 def disc_png(path: Path, cx, cy, r, color) -> Path:

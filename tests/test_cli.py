@@ -5,10 +5,9 @@ import os
 
 import numpy as np
 import pytest
-from click.testing import CliRunner
 from PIL import Image
 
-from vecfit.cli.main import main
+from helpers import run
 
 SQUARE = """<svg xmlns="http://www.w3.org/2000/svg" width="40" height="20" viewBox="0 0 40 20">
 <rect x="10" y="5" width="20" height="10" fill="#ff0000"/></svg>"""
@@ -19,10 +18,6 @@ def svg(tmp_path):
     p = tmp_path / "square.svg"
     p.write_text(SQUARE)
     return p
-
-
-def run(*args):
-    return CliRunner().invoke(main, [str(a) for a in args], catch_exceptions=False)
 
 
 def test_render_writes_rgba_png(svg, tmp_path):

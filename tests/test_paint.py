@@ -3,38 +3,23 @@ from __future__ import annotations
 
 import io
 import json
-import warnings
 
 import numpy as np
 import pytest
 import torch
-from click.testing import CliRunner
 from PIL import Image
 
 import vecfit
-from vecfit.cli.main import main
+from helpers import photo_png, quiet_load, run
 from vecfit.metrics import compare
 from vecfit.optimize import Step, Target
 from vecfit.painterly import PaintSettings, Reseeder, initial_svg
 from vecfit.scene import Path as PathGeometry, Scene, Shape, Solid
 
 
-def run(*args):
-    return CliRunner().invoke(main, [str(a) for a in args], catch_exceptions=False)
-
-
 @pytest.fixture(scope="module")
 def astronaut(tmp_path_factory):
-    from skimage.data import astronaut as load
-    d = tmp_path_factory.mktemp("astronaut")
-    Image.fromarray(load()).resize((64, 64), Image.LANCZOS).save(d / "a.png")
-    return d / "a.png"
-
-
-def load(path):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return vecfit.load_svg(path)
+    return photo_png(tmp_path_factory, "astronaut", (64, 64))
 
 
 def test_paint_strokes_fit_the_target(astronaut, tmp_path):
@@ -49,7 +34,7 @@ def test_paint_strokes_fit_the_target(astronaut, tmp_path):
     assert min(curve) < curve[0] / 4
     assert report["optimized"]["psnr"] > report["initial"]["psnr"] + 6
     assert report["paint"]["kind"] == "strokes" and report["paint"]["paths"] == 64
-    scene = load(out)
+    scene = quiet_load(out)
     # the canvas colour (from the target's corners) as a first rect, then the strokes
     assert len(scene.shapes) == 65 and scene.shapes[0].source == "vecfit-background"
     # strokes, some perhaps thinned to nothing (written as width 0, read back as no stroke)
@@ -70,7 +55,7 @@ def test_paint_shapes_and_resvg_agrees(astronaut, tmp_path):
     assert r.exit_code == 0, r.output
     report = json.loads((tmp_path / "s.report.json").read_text())
     assert report["optimized"]["psnr"] > report["initial"]["psnr"] + 3
-    scene = load(out)
+    scene = quiet_load(out)
     assert all(s.fill is not None and s.stroke is None for s in scene.shapes[-32:])
     png = bytes(resvg_py.svg_to_bytes(svg_path=str(out), width=256))
     theirs = np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), np.float64) / 255

@@ -18,7 +18,7 @@ import torch
 import vecfit
 from test_gradients import OFF_GRID, W, background, check, solid
 from vecfit.errors import VecfitError
-from vecfit.scene import Path, Scene, Shape, Solid
+from vecfit.scene import Path, Scene, Shape
 
 CURVE = torch.tensor([[7.0, 30.0], [12.0, 5.0], [26.0, 36.0], [33.0, 10.0]])
 CURVE_WIDTHS = torch.tensor([2.0, 6.0, 3.0, 5.0])
@@ -118,6 +118,17 @@ def test_tiles_match_brute_force(mode):
 
 # ------------------------------------------------------------------------ gradients
 
+def check_points_and_widths(build, points, widths, mode):
+    """Finite differences of points and widths in either mode: MC with 0.3 px steps; the
+    analytical prefilter with 0.01 steps, off the pixel grid, to 2% (+0.01)."""
+    if mode == "mc":
+        errors = check(build, {"points": points, "widths": widths}, {"points": 0.3, "widths": 0.3})
+    else:
+        errors = check(build, {"points": points + OFF_GRID, "widths": widths}, {"points": 0.01, "widths": 0.01},
+                       rtol=0.02, atol=0.01, mode="analytic")
+    report(errors)
+
+
 @pytest.mark.parametrize("mode", ["mc", "analytic"])
 @pytest.mark.parametrize("cap", ["butt", "round"])
 def test_tapered_open_cubic_gradients(mode, cap):
@@ -125,12 +136,7 @@ def test_tapered_open_cubic_gradients(mode, cap):
         path = Path(points=points, degrees=np.array([3]), subpaths=[(0, 1, False)], widths=widths)
         return Scene(width=40, height=40, shapes=[background(), Shape(
             geometry=path, stroke=solid(0.1, 0.3, 0.9, 1), linecap=cap)])
-    if mode == "mc":
-        errors = check(build, {"points": CURVE, "widths": CURVE_WIDTHS}, {"points": 0.3, "widths": 0.3})
-    else:
-        errors = check(build, {"points": CURVE + OFF_GRID, "widths": CURVE_WIDTHS}, {"points": 0.01, "widths": 0.01},
-                       rtol=0.02, atol=0.01, mode="analytic")
-    report(errors)
+    check_points_and_widths(build, CURVE, CURVE_WIDTHS, mode)
 
 
 @pytest.mark.parametrize("mode", ["mc", "analytic"])
@@ -140,12 +146,7 @@ def test_closed_tapered_polygon_gradients(mode, join):
         path = Path(points=points, degrees=np.array([1, 1, 1, 1, 1]), subpaths=[(0, 5, True)], widths=widths)
         return Scene(width=40, height=40, shapes=[background(), Shape(
             geometry=path, stroke=solid(0.9, 0.3, 0.1, 1), linejoin=join, miter_limit=10)])
-    if mode == "mc":
-        errors = check(build, {"points": POLYGON, "widths": POLYGON_WIDTHS}, {"points": 0.3, "widths": 0.3})
-    else:
-        errors = check(build, {"points": POLYGON + OFF_GRID, "widths": POLYGON_WIDTHS},
-                       {"points": 0.01, "widths": 0.01}, rtol=0.02, atol=0.01, mode="analytic")
-    report(errors)
+    check_points_and_widths(build, POLYGON, POLYGON_WIDTHS, mode)
 
 
 @pytest.mark.parametrize("mode", ["mc", "analytic"])
@@ -157,12 +158,7 @@ def test_steep_taper_gradients(mode):
         return Scene(width=40, height=40, shapes=[background(), Shape(
             geometry=path, stroke=solid(0.1, 0.3, 0.9, 1), linecap="round", linejoin="round")])
     pts, widths = torch.tensor([[10.0, 21.0], [24.0, 18.0], [30.0, 30.0]]), torch.tensor([1.0, 14.0, 2.0])
-    if mode == "mc":
-        errors = check(build, {"points": pts, "widths": widths}, {"points": 0.3, "widths": 0.3})
-    else:
-        errors = check(build, {"points": pts + OFF_GRID, "widths": widths}, {"points": 0.01, "widths": 0.01},
-                       rtol=0.02, atol=0.01, mode="analytic")
-    report(errors)
+    check_points_and_widths(build, pts, widths, mode)
 
 
 @pytest.mark.parametrize("mode", ["mc", "analytic"])

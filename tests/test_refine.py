@@ -6,17 +6,15 @@ import json
 import math
 import os
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
 import torch
-from click.testing import CliRunner
 from PIL import Image
 
 import vecfit
 from vecfit import losses
-from vecfit.cli.main import main
+from helpers import need, run
 from vecfit.config import resolve
 from vecfit.errors import VecfitError
 from vecfit.metrics import compare
@@ -26,16 +24,6 @@ from vecfit.scene import Circle, LinearGradient, Scene, Shape, Solid
 from shared_data import SHARED
 PEPPERS = SHARED / "data" / "photos" / "peppers.png"
 PEPPERS_SVG = SHARED / "data" / "photos" / "peppers.svg"
-
-
-def need(path: Path) -> Path:
-    if not path.exists():
-        pytest.skip(f"shared data not found: {path}")
-    return path
-
-
-def run(*args):
-    return CliRunner().invoke(main, [str(a) for a in args], catch_exceptions=False)
 
 
 @pytest.fixture(scope="module")
@@ -413,3 +401,19 @@ def test_settings_are_checked():
         Settings(loss="l3").check()
     with pytest.raises(VecfitError, match="nothing to optimise"):
         optimize(_circle_scene(), _disc_target(), Settings(iterations=2, lr={"points": 0.0}))
+
+
+def test_target_is_compared_over_an_explicit_background():
+    """With a background given, the loss sees the target over it, as the render is: a
+    transparent target pixel over white is white, not its (black) RGB."""
+    from vecfit.optimize import Target
+    image = torch.zeros(2, 2, 4)
+    image[0, 0] = torch.tensor([1.0, 0.0, 0.0, 1.0])
+    seen = Target(image, background=(1.0, 1.0, 1.0, 1.0)).compared(image)
+    assert torch.equal(seen[0, 0], torch.tensor([1.0, 0.0, 0.0]))
+    assert torch.equal(seen[1, 1], torch.tensor([1.0, 1.0, 1.0]))
+
+
+def test_translucent_background_is_a_usage_error(tmp_path):
+    r = run("refine", tmp_path / "a.png", tmp_path / "a.svg", "--background", "#ffffff80")
+    assert r.exit_code == 2 and "opaque" in r.output, r.output

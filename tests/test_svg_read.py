@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 import torch
 
+from helpers import need
 from vecfit.describe import describe
 from vecfit.errors import SvgError
 from vecfit.scene import (Circle, Ellipse, LinearGradient, Path as PathGeometry, RadialGradient,
@@ -25,12 +26,6 @@ CORPUS = SHARED / "conformance"
 DATA = SHARED / "data"
 SVG_HEAD = ('<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" '
             '{attrs}>')
-
-
-def need(path: Path) -> Path:
-    if not path.exists():
-        pytest.skip(f"shared data not found: {path}")
-    return path
 
 
 def write(tmp_path, body: str, attrs: str = 'viewBox="0 0 200 200"', name="t.svg") -> Path:

@@ -15,8 +15,7 @@ import torch
 
 import vecfit
 from vecfit.errors import SvgError, VecfitError
-from vecfit.scene import (Circle, Ellipse, LinearGradient, Path as PathGeometry, RadialGradient,
-                          Rect, Solid)
+from vecfit.scene import Circle, Ellipse, LinearGradient, Path as PathGeometry, Solid
 from vecfit.svg import VecfitWarning, load_svg
 from vecfit.svg.write import fmt, path_data, write_svg
 

@@ -109,7 +109,10 @@ def validate(settings: dict) -> None:
     from .optimize import Settings
 
     if settings["optimize"]["background"].strip().lower() != "auto":
-        parse_background(settings["optimize"]["background"])
+        bg = parse_background(settings["optimize"]["background"])
+        if bg is not None and bg[3] < 1:
+            raise VecfitError("background must be opaque (no alpha below ff) or none: the shapes are "
+                              "fitted to the target seen over it")
     Settings.from_config(settings["optimize"])
     seed = settings["optimize"]["seed"]
     if "trace" in settings:

@@ -24,15 +24,10 @@ def cuda_device_count() -> int:
     return int(_core.cuda_device_count())
 
 
-def resolve(device, tensors=()) -> int:
-    """The core's device index for `device`: None (the GPU the scene's tensors are on, else
-    the CPU), "auto" (the first GPU if there is one), "cpu", "cuda", "cuda:N" or a
-    torch.device. Raises VecfitError when a GPU is asked for and cannot be had."""
-    if device is None:
-        on_gpu = [t.device for t in tensors if t.device.type == "cuda"]
-        if not on_gpu:
-            return CPU
-        device = on_gpu[0]
+def resolve(device) -> int:
+    """The core's device index for `device`: "auto" (the first GPU if there is one), "cpu",
+    "cuda", "cuda:N" or a torch.device. Raises VecfitError when a GPU is asked for and
+    cannot be had."""
     if isinstance(device, torch.device):
         device = str(device)
     if not isinstance(device, str):

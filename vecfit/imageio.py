@@ -37,6 +37,14 @@ def atomic_write(path: str | os.PathLike, write) -> None:
         raise
 
 
+def atomic_write_text(path: str | os.PathLike, text: str) -> None:
+    """Writes text (UTF-8, newlines as given) atomically, as atomic_write."""
+    def write(tmp):
+        with open(tmp, "w", encoding="utf-8", newline="") as f:
+            f.write(text)
+    atomic_write(path, write)
+
+
 def save_png(image, path: str | os.PathLike) -> None:
     """Save an [H, W, 4] straight-RGBA float image as an 8-bit RGBA PNG."""
     pixels = to_uint8(image)

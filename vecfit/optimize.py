@@ -18,7 +18,7 @@ import torch
 
 from . import device as devices
 from . import losses
-from .errors import VecfitError
+from .errors import NonFiniteScene, VecfitError
 from .pack import local_bbox_size, shape_pixel_scales
 from .render import MODES, render
 from .scene import LinearGradient, RadialGradient, Scene
@@ -87,10 +87,14 @@ class Target:
         return self.background is not None
 
     def compared(self, rgba: torch.Tensor) -> torch.Tensor:
-        """The channels the loss sees: RGB over an opaque background, else premultiplied RGBA."""
+        """The channels the loss sees: RGB over the opaque background (a render is already
+        over it; a target with transparent parts is put over it here), else premultiplied
+        RGBA."""
+        alpha = rgba[..., 3:]
         if self.opaque:
-            return rgba[..., :3]
-        return torch.cat([rgba[..., :3] * rgba[..., 3:], rgba[..., 3:]], dim=-1)
+            bg = torch.tensor(self.background[:3], dtype=rgba.dtype)
+            return rgba[..., :3] * alpha + bg * (1 - alpha)
+        return torch.cat([rgba[..., :3] * alpha, alpha], dim=-1)
 
 
 @dataclass
@@ -272,6 +276,7 @@ def optimize(scene: Scene, target: Target, settings: Settings,
     loss_fn = losses.get(settings.loss)
     height, width = target.image.shape[:2]
     goal = target.compared(target.image.float())
+    device = devices.describe(devices.resolve(settings.device))  # "auto" settled once
     kinds = _kinds(scene, settings.lr, width, height, settings.fixed_alpha, keep_alpha)
     if not kinds:
         raise VecfitError("nothing to optimise: the scene has no parameters with a learning rate above 0")
@@ -290,7 +295,7 @@ def optimize(scene: Scene, target: Target, settings: Settings,
             image = render(scene, width, height, samples=settings.samples, mode=settings.mode,
                            seed=settings.seed + iteration, background=target.background,
                            threads=settings.threads, boundary_samples=settings.boundary_samples,
-                           device=settings.device)
+                           device=device)
             frame["image"] = image.detach()
             return loss_fn(target.compared(image), goal)
 
@@ -315,8 +320,8 @@ def optimize(scene: Scene, target: Target, settings: Settings,
         for it in range(settings.iterations):
             try:
                 loss = evaluate(it, grad=True)
-            except VecfitError:
-                loss = None  # e.g. the scene went non-finite: treated like a NaN loss
+            except NonFiniteScene:
+                loss = None  # treated like a NaN loss
             value = float(loss.detach()) if loss is not None else math.nan
             curve.append(value)
             grads = None

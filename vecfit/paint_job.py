@@ -2,14 +2,11 @@
 loop of `vecfit refine`, with re-seeding and optional frames."""
 from __future__ import annotations
 
-import tempfile
-import warnings
 from pathlib import Path
 
 from .config import settings_of
 from .painterly import FrameSaver, PaintSettings, Reseeder, initial_svg
-from .refine import Outputs, fit, load_target
-from .svg.read import load_svg
+from .refine import Outputs, fit, generated_source, load_target
 
 
 def paint(target_path, config: dict, outputs: Outputs, progress=None, frames=None) -> dict:
@@ -24,12 +21,7 @@ def paint(target_path, config: dict, outputs: Outputs, progress=None, frames=Non
     if frames is not None:
         saver = FrameSaver(frames, settings.frames_every)
         hooks.append(saver)
-    with tempfile.TemporaryDirectory(prefix="vecfit-paint-") as tmp:
-        source = Path(tmp) / (target_path.stem + ".paint.svg")
-        source.write_text(initial_svg(target, settings), encoding="utf-8")
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            scene = load_svg(source)
+    with generated_source(initial_svg(target, settings), target_path.stem + ".paint.svg") as (scene, source):
 
         def frames_entry():  # called when the report is made, after the last frame
             if saver is None:

@@ -3,7 +3,9 @@ picture written next to each other. `vecfit trace` and `vecfit paint` end in the
 with an initial SVG of their own making."""
 from __future__ import annotations
 
+import contextlib
 import math
+import tempfile
 import time
 import warnings
 from dataclasses import dataclass
@@ -24,7 +26,7 @@ from .render import render
 from .report import save_comparison, save_report
 from .scene import Scene
 from .svg.read import load_svg
-from .svg.write import write_svg
+from .svg.write import hex_color, write_svg
 
 OPAQUE = 0.999  # a target whose every alpha is at least this is treated as opaque
 ASPECT_TOLERANCE = 0.01
@@ -118,6 +120,20 @@ def check_sizes(scene: Scene, target: np.ndarray, svg_path, target_path) -> None
                           f"{w}x{h}: their aspect ratios differ")
 
 
+@contextlib.contextmanager
+def generated_source(svg_text: str, name: str):
+    """A generated SVG (a trace, random strokes) as a temporary file and its Scene, for
+    fit (which writes its result into the source's structure, so the file must exist
+    while it runs). Yields (scene, path)."""
+    with tempfile.TemporaryDirectory(prefix="vecfit-") as tmp:
+        source = Path(tmp) / name
+        source.write_text(svg_text, encoding="utf-8")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            scene = load_svg(source)
+        yield scene, source
+
+
 # --------------------------------------------------------------------------- run
 
 def _render_full(scene, w, h, config) -> torch.Tensor:
@@ -175,8 +191,7 @@ def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Out
         "report": str(outputs.report),
         "size": [w, h],
         "optimized_size": [sw, sh],
-        "background": None if background is None else "#%02x%02x%02x" % tuple(
-            round(c * 255) for c in background[:3]),
+        "background": None if background is None else hex_color(background),
         "initial": initial,
         "optimized": final,
         "psnr_gain_db": final["psnr"] - initial["psnr"],

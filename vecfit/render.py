@@ -11,7 +11,7 @@ import torch
 
 from . import _core
 from . import device as devices
-from .errors import VecfitError
+from .errors import NonFiniteScene, VecfitError
 from .pack import pack_scene
 from .scene import Scene
 
@@ -58,8 +58,7 @@ class _Render(torch.autograd.Function):
         ctx.scene, ctx.image = _core_render(settings, structure, floats)
         ctx.settings, ctx.boundary_density = settings, boundary_density
         ctx.shapes = [t.shape for t in floats]
-        ctx.tensor_device = floats[0].device
-        return torch.from_numpy(ctx.image).to(ctx.tensor_device)
+        return torch.from_numpy(ctx.image)
 
     @staticmethod
     def backward(ctx, grad_image):
@@ -71,15 +70,14 @@ class _Render(torch.autograd.Function):
                                       ctx.boundary_density, s["device"])
         except RuntimeError as e:  # the GPU failed (out of memory, driver)
             raise VecfitError(f"gradients on {devices.describe(s['device'])} failed: {e}") from None
-        out = [torch.from_numpy(grads[name]).reshape(shape).to(ctx.tensor_device)
-               for name, shape in zip(FLOAT_INPUTS, ctx.shapes)]
+        out = [torch.from_numpy(grads[name]).reshape(shape) for name, shape in zip(FLOAT_INPUTS, ctx.shapes)]
         return (None, None, None, *out)
 
 
 def render(scene: Scene, width: int | None = None, height: int | None = None, *,
            samples: int = 2, mode: str = "mc", filter: str = "box", filter_radius: float = 0.5,
            seed: int = 0, background=None, threads: int | None = None, boundary_samples: float = 2.0,
-           device=None, _brute_force: bool = False) -> torch.Tensor:
+           device: str = "cpu", _brute_force: bool = False) -> torch.Tensor:
     """Render ``scene`` into an [H, W, 4] float tensor of straight RGBA.
 
     samples: N means N x N stratified samples per pixel (jittered in "mc" mode, at the
@@ -91,11 +89,11 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     the backward pass samples the boundaries (``boundary_samples`` points per pixel of
     boundary length, same seed); in "analytic" mode it differentiates the prefilter.
 
-    device: where the pixels are shaded: None (a GPU if the scene's tensors are on one,
-    else the CPU), "auto", "cpu", "cuda" or "cuda:N" (needs a core built with
-    VECFIT_CUDA=1; see vecfit.has_cuda()). The same seed gives the same image on either.
-    The result lies on the device of the scene's tensors; gradients are computed where
-    the image was.
+    device: where the pixels are shaded: "cpu", "cuda" or "cuda:N" (needs a core built
+    with VECFIT_CUDA=1; see vecfit.has_cuda()), or "auto" (a GPU when there is one). The
+    same seed gives the same image on either; gradients are computed where the image was.
+    The scene's tensors and the result are CPU tensors either way (the scene is packed
+    and prepared on the host).
     """
     if mode not in MODES:
         raise VecfitError(f"mode must be one of {', '.join(MODES)}, not {mode!r}")
@@ -120,12 +118,12 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     floats = [arrays[name].to(torch.float32) for name in FLOAT_INPUTS]
     for name, value in zip(FLOAT_INPUTS, floats):
         if not torch.isfinite(value.detach()).all():
-            raise VecfitError(f"the scene has non-finite values ({name})")
+            raise NonFiniteScene(f"the scene has non-finite values ({name})")
     structure = {k: v for k, v in arrays.items() if k not in FLOAT_INPUTS}
     settings = dict(width=width, height=height, samples=int(samples), mode=mode, filter=filter,
                     filter_radius=float(filter_radius), seed=int(seed), threads=int(threads or 0),
-                    background=background, device=devices.resolve(device, floats))
+                    background=background, device=devices.resolve(device))
     if torch.is_grad_enabled() and any(t.requires_grad for t in floats) and not _brute_force:
         return _Render.apply(settings, float(boundary_samples), structure, *floats)
     image = _core_render(settings, structure, floats, brute_force=_brute_force)[1]
-    return torch.from_numpy(image).to(floats[0].device)
+    return torch.from_numpy(image)

@@ -9,7 +9,7 @@ import cv2
 import numpy as np
 from PIL import Image
 
-from .imageio import atomic_write, to_uint8
+from .imageio import atomic_write, atomic_write_text, to_uint8
 
 PANEL_MAX = 512   # longest side of one panel of the comparison picture
 GAP = 4           # pixels between panels
@@ -62,10 +62,4 @@ def _jsonable(value):
 
 
 def save_report(path, report: dict) -> None:
-    text = json.dumps(_jsonable(report), indent=2, allow_nan=False) + "\n"
-
-    def write(tmp):
-        with open(tmp, "w", encoding="utf-8") as f:
-            f.write(text)
-
-    atomic_write(path, write)
+    atomic_write_text(path, json.dumps(_jsonable(report), indent=2, allow_nan=False) + "\n")

@@ -2,15 +2,12 @@
 it with the same loop as `vecfit refine` (vecfit.refine.fit)."""
 from __future__ import annotations
 
-import tempfile
-import warnings
 from pathlib import Path
 
 from .config import settings_of
 from .errors import VecfitError
-from .refine import Outputs, fit, load_target
+from .refine import Outputs, fit, generated_source, load_target
 from .scene import Rect, Solid
-from .svg.read import load_svg
 from .trace import TraceSettings, trace_image
 
 
@@ -30,12 +27,7 @@ def trace(target_path, config: dict, outputs: Outputs, progress=None, refine: bo
                f"in {traced.seconds:.1f} s")
     if not refine:
         config = {**config, "optimize": {**config["optimize"], "iterations": 0}}
-    with tempfile.TemporaryDirectory(prefix="vecfit-trace-") as tmp:
-        source = Path(tmp) / (target_path.stem + ".trace.svg")
-        source.write_text(traced.svg, encoding="utf-8")
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            scene = load_svg(source)
+    with generated_source(traced.svg, target_path.stem + ".trace.svg") as (scene, source):
         if not scene.shapes:
             raise VecfitError(f"{target_path}: nothing to trace (the image is fully transparent)")
         # The tracer's backdrop (an opaque rect past the canvas's edges) stays opaque, so

@@ -20,10 +20,7 @@ from .plan import (DONE, FAILED, INTERRUPTED, JOBS, MODES, NOT_RUN, SKIPPED, STA
                    UNPAIRED, Plan, Task, find_images, finished_report, make_plan, result_row)
 from .summary import SUMMARY_FILES, THUMBS, count, write_all
 
-EXIT_OK = 0            # every image done, or skipped as finished
-EXIT_FAILED = 1        # some image failed or was unpaired (the others are done)
-EXIT_USAGE = 2         # bad usage: no IN_DIR, bad options or config, no scheduler
-EXIT_INTERRUPTED = 130  # Ctrl-C
+from ..errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE  # noqa: F401 (part of this API)
 
 
 class BatchUsageError(VecfitError):
@@ -51,13 +48,14 @@ def available_cores() -> int:
         return max(1, os.cpu_count() or 1)
 
 
-def resolve_config(mode: str, preset: str | None = None, config_file=None) -> dict:
-    """The command's settings (vecfit.config.resolve, which also checks the values);
-    BatchUsageError when they are bad."""
+def resolve_config(mode: str, preset: str | None = None, config_file=None, device: str | None = None) -> dict:
+    """The command's settings (vecfit.config.resolve, which also checks the values, the
+    device included); BatchUsageError when they are bad."""
     from ..config import resolve
 
     try:
-        return resolve(mode, preset=preset, config_file=config_file)
+        return resolve(mode, preset=preset, config_file=config_file,
+                       overrides={"optimize": {"device": device}})
     except VecfitError as e:
         raise BatchUsageError(str(e)) from None
 
@@ -156,14 +154,7 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
                                   "taken for inputs)")
     if jobs < 0 or (threads is not None and threads < 1):
         raise BatchUsageError("jobs must be >= 0 and threads >= 1")
-    config = resolve_config(mode, preset, config_file)
-    if device is not None:
-        from ..device import resolve as resolve_device
-        try:
-            resolve_device(device)
-        except VecfitError as e:
-            raise BatchUsageError(str(e)) from None
-        config["optimize"]["device"] = device
+    config = resolve_config(mode, preset, config_file, device)
     if scheduler is not None and client is None:
         from .execute import connect
         try:
@@ -231,7 +222,7 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
         result = BatchResult(rows=ordered, interrupted=interrupted,
                              workers=workers if client is None else 0, threads=per_worker)
         counts = result.counts
-        if interrupted:
+        if interrupted or counts[INTERRUPTED] or counts[NOT_RUN]:
             result.exit_code = EXIT_INTERRUPTED
         elif counts[FAILED] or counts[UNPAIRED]:
             result.exit_code = EXIT_FAILED

@@ -57,8 +57,7 @@ def _workers_ignore_sigint():
 
 
 def _workers_of(executor) -> list:
-    procs = getattr(executor, "_processes", None)
-    return list(procs.values()) if procs else multiprocessing.active_children()
+    return list((getattr(executor, "_processes", None) or {}).values())
 
 
 def _round(tasks: list[Task], workers: int, threads: int, on_row) -> tuple[list[Task], bool]:
@@ -194,10 +193,20 @@ def run_dask(tasks: list[Task], client, on_row) -> bool:
             finished.add(i)
             on_row(row)
     except KeyboardInterrupt:
-        # Tasks already running on the cluster finish (their atomic writes complete);
-        # the others are cancelled.
+        # The tasks not started are cancelled; those already running on the cluster cannot
+        # be, so they are waited for (their outputs are written atomically, and the run's
+        # lock and its sweep of temporaries must not come before they finish). A second
+        # Ctrl-C stops waiting.
+        pending = [f for f, i in futures.items() if i not in finished]
         try:
-            client.cancel([f for f, i in futures.items() if i not in finished])
+            client.cancel(pending)
+        except Exception:
+            pass
+        try:
+            from distributed import wait
+            wait(pending)
+        except KeyboardInterrupt:
+            pass
         except Exception:
             pass
         return True

@@ -5,37 +5,19 @@ from __future__ import annotations
 import csv
 import html
 import io
-import json
 import math
 from pathlib import Path
 from urllib.parse import quote
 
 from PIL import Image
 
-from ..imageio import atomic_write
-from ..report import GAP
+from ..imageio import atomic_write, atomic_write_text
+from ..report import GAP, save_report
 from .plan import DONE, INTERRUPTED, NOT_RUN, ROW_FIELDS, SKIPPED, STATUSES
 
 THUMB = 160  # longest side of a thumbnail, pixels
 THUMBS = "thumbs"
 SUMMARY_FILES = ("summary.csv", "summary.json", "index.html")
-
-
-def _write_text(path: Path, text: str) -> None:
-    def write(tmp):
-        with open(tmp, "w", encoding="utf-8", newline="") as f:
-            f.write(text)
-    atomic_write(path, write)
-
-
-def _json_value(v):
-    if isinstance(v, float) and not math.isfinite(v):
-        return None  # JSON has no NaN / Infinity (a PSNR of a perfect match is inf)
-    if isinstance(v, dict):
-        return {k: _json_value(x) for k, x in v.items()}
-    if isinstance(v, (list, tuple)):
-        return [_json_value(x) for x in v]
-    return v
 
 
 def write_csv(path: Path, rows: list[dict]) -> None:
@@ -45,12 +27,11 @@ def write_csv(path: Path, rows: list[dict]) -> None:
     for row in rows:
         w.writerow(["" if row.get(k) is None else
                     (repr(row[k]) if isinstance(row[k], float) else row[k]) for k in ROW_FIELDS])
-    _write_text(path, buf.getvalue())
+    atomic_write_text(path, buf.getvalue())
 
 
 def write_json(path: Path, meta: dict, rows: list[dict]) -> None:
-    data = {**meta, "images": rows}
-    _write_text(path, json.dumps(_json_value(data), indent=2, allow_nan=False) + "\n")
+    save_report(path, {**meta, "images": rows})  # (non-finite numbers, e.g. a perfect PSNR, as null)
 
 
 # ------------------------------------------------------------------- thumbnails
@@ -200,7 +181,7 @@ def write_html(path: Path, meta: dict, rows: list[dict]) -> None:
             f'<td class="num">{_num(row.get("seconds"), 2)}</td>'
             f'<td>{" ".join(links)}</td></tr>')
     parts += ["</tbody></table>", "</body></html>", ""]
-    _write_text(path, "\n".join(parts))
+    atomic_write_text(path, "\n".join(parts))
 
 
 def write_all(out_dir: Path, in_dir: Path, meta: dict, rows: list[dict]) -> dict:

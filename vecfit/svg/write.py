@@ -34,7 +34,7 @@ from .dom import local_name, read_root
 from .paint import GRADIENTS
 from .skips import VecfitWarning
 from .style import INHERITED
-from .units import parse_length, translate
+from .units import parse_length, parse_viewbox, translate
 
 __all__ = ["write_svg"]
 
@@ -353,14 +353,12 @@ def _add_background(root, color) -> None:
     if any(e.get("id") == "vecfit-background" for e in root.iter()):
         return
     ns = root.tag[:root.tag.index("}") + 1] if root.tag.startswith("{") else ""
-    box = re.split(r"[\s,]+", (root.get("viewBox") or "").strip())
+    box = parse_viewbox(root.get("viewBox"))
     rect = ET.Element(f"{ns}rect")
-    try:
-        x, y, w, h = (float(v) for v in box)
-        if w <= 0 or h <= 0:
-            raise ValueError
+    if box is not None and box[2] > 0 and box[3] > 0:
+        x, y, w, h = box
         rect.attrib.update(x=fmt(x), y=fmt(y), width=fmt(w), height=fmt(h))
-    except ValueError:
+    else:
         rect.attrib.update(x="0", y="0", width="100%", height="100%")
     rect.set("id", "vecfit-background")
     rect.set("fill", hex_color(color))
