@@ -156,6 +156,24 @@ def test_transparent_background_stays_transparent(tmp_path):
     assert psnr(over_white(image), over_white(out)) >= 27
 
 
+def test_transparent_holes_are_cut_out(tmp_path):
+    """A ring on a transparent canvas with a dot of another colour in its hole: the ring's
+    shape leaves the transparent part of the hole open (even-odd), and the dot is drawn
+    in it. Alpha PSNR measured 22.3 dB (11.8 when holes were filled)."""
+    ring = coverage(lambda x, y: np.abs(np.hypot(x - 32, y - 32) - 16) < 6, 64, 64)
+    dot = coverage(lambda x, y: np.hypot(x - 32, y - 32) < 4, 64, 64)
+    image = paint([(ring, (0.8, 0.2, 0.1)), (dot, (0.1, 0.3, 0.8))], 64, 64)
+    result = trace_image(image)
+    assert result.paths == 2 and 'fill-rule="evenodd"' in result.svg
+    out = render(result, 64, 64, tmp_path, background=None)
+    import cv2
+    gap = cv2.erode((image[..., 3] == 0).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
+    gap[:, :] &= np.hypot(*np.mgrid[-32:32, -32:32]) < 12  # the hole, not the outside
+    assert gap.sum() > 60 and out[..., 3][gap].max() == 0
+    assert out[32, 32, 3] == 1 and abs(out[32, 32, 2] - 0.8) < 0.05  # the dot
+    assert psnr(image[..., 3], out[..., 3]) >= 21
+
+
 def two_regions(width=72, height=48):
     """Two colours, both darker than white in every channel, meeting along a wavy line,
     on a transparent canvas (so that neither becomes a full-canvas background rect and

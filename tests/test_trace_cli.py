@@ -51,14 +51,15 @@ def test_no_refine_writes_the_trace(coffee, tmp_path):
 def test_transparent_target_stays_transparent(tmp_path):
     a = np.zeros((40, 40, 4), np.uint8)
     yy, xx = np.mgrid[0:40, 0:40]
-    a[(xx - 20) ** 2 + (yy - 20) ** 2 < 100] = (200, 30, 30, 255)
-    Image.fromarray(a, "RGBA").save(tmp_path / "dot.png")
-    r = run("trace", tmp_path / "dot.png", "--iterations", 10, "-q")
+    r2 = (xx - 20) ** 2 + (yy - 20) ** 2
+    a[(r2 >= 36) & (r2 < 196)] = (200, 30, 30, 255)  # a ring: its hole stays transparent too
+    Image.fromarray(a, "RGBA").save(tmp_path / "ring.png")
+    r = run("trace", tmp_path / "ring.png", "--iterations", 10, "-q")
     assert r.exit_code == 0, r.output
-    scene = quiet_load(tmp_path / "dot.vecfit.svg")
+    scene = quiet_load(tmp_path / "ring.vecfit.svg")
     img = vecfit.render(scene, 40, 40, samples=2).numpy()
-    assert img[0, 0, 3] == 0 and img[20, 20, 3] > 0.99
-    assert "vecfit-background" not in (tmp_path / "dot.vecfit.svg").read_text()
+    assert img[0, 0, 3] == 0 and img[20, 20, 3] == 0 and img[20, 30, 3] > 0.99
+    assert "vecfit-background" not in (tmp_path / "ring.vecfit.svg").read_text()
 
 
 @pytest.mark.parametrize("case", ["missing", "not an image", "folder"])

@@ -16,7 +16,7 @@ from scipy import ndimage
 def crack_outlines(mask: np.ndarray, origin=(0, 0)) -> list[np.ndarray]:
     """Outer boundaries of a boolean mask along pixel edges: closed polygons, float
     [N, 2] (x, y) in image coordinates (origin = (x0, y0) of the mask), vertices every
-    half pixel. Holes are not traced: what lies in them is drawn later, on top."""
+    half pixel. Holes are not traced (see shape_outlines)."""
     h, w = mask.shape
     grid = np.zeros((2 * h + 3, 2 * w + 3), np.uint8)  # cell j <-> coordinate (j - 1) / 2
     grid[2:2 * h + 1:2, 2:2 * w + 1:2] = mask
@@ -24,6 +24,31 @@ def crack_outlines(mask: np.ndarray, origin=(0, 0)) -> list[np.ndarray]:
     contours, _ = cv2.findContours(grid, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     x0, y0 = origin
     return [c[:, 0, :].astype(np.float64) * 0.5 + (x0 - 0.5, y0 - 0.5) for c in contours]
+
+
+def shape_outlines(mask: np.ndarray, transparent: np.ndarray, origin=(0, 0)):
+    """The outlines of the shape that draws a region, and which of them are holes.
+
+    A hole of the region that holds other regions needs no outline: they are drawn later,
+    on top. Only its transparent pixels must be cut out, or the shape would paint over
+    them (a ring on a transparent canvas would become a disc). So the shape is the mask
+    with its holes filled except for their transparent pixels; its boundaries alternate,
+    outline, hole, island in the hole..., and are filled even-odd. Returns (outlines as
+    crack_outlines gives them, a bool per outline: is it a hole)."""
+    if not transparent.any():  # nothing to cut: the outer outlines alone (the usual case)
+        found = crack_outlines(mask, origin)
+        return found, [False] * len(found)
+    shape = ndimage.binary_fill_holes(mask) & (mask | ~transparent)
+    outlines, holes = [], []
+    level, hole = shape, False
+    while level.any():
+        found = crack_outlines(level, origin)
+        outlines += found
+        holes += [hole] * len(found)
+        # what this level encloses without being part of it: the next level in
+        level = ndimage.binary_fill_holes(level) & ~level
+        hole = not hole
+    return outlines, holes
 
 
 def polygon_area(p: np.ndarray) -> float:

@@ -39,5 +39,6 @@ def rect_element(ident: str, width: int, height: int, fill: str) -> str:
             f'fill="{fill}"/>')
 
 
-def path_element(ident: str, d: str, fill: str) -> str:
-    return f'<path id="{ident}" d="{d}" fill="{fill}"/>'
+def path_element(ident: str, d: str, fill: str, evenodd: bool = False) -> str:
+    rule = ' fill-rule="evenodd"' if evenodd else ""
+    return f'<path id="{ident}" d="{d}" fill="{fill}"{rule}/>'

@@ -2,8 +2,9 @@
 
 Pipeline: colour quantisation (k-means in CIELAB) -> connected regions of each colour ->
 speckles and slivers merged into neighbours, then merges until the path budget holds ->
-regions stacked by filled area, largest first, each drawn as its filled outer outline,
-grown a pixel under the regions on top of it -> outlines fitted with cubic Béziers.
+regions stacked by filled area, largest first, each drawn as its filled outer outline
+(less any transparent pixels it encloses, cut out even-odd), grown a pixel under the
+regions on top of it -> outlines fitted with cubic Béziers.
 """
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ import numpy as np
 
 from ..errors import VecfitError
 from .bezier import fit_outlines
-from .outlines import crack_outlines, drawing_order, grown_mask, region_boxes
+from .outlines import drawing_order, grown_mask, region_boxes, shape_outlines
 from .quantize import OPAQUE, prefilter, quantize
 from .regions import build_regions, palette_colors
 from .settings import TraceResult, TraceSettings, check_settings
@@ -81,19 +82,23 @@ def trace_image(image: np.ndarray, settings: TraceSettings = TraceSettings(),
     background = order[0] if regions.count and opaque.all() else None
 
     report("outline", 0.4)
-    shapes, outlines = [], []  # shapes: (region, its outlines' slice of `outlines`)
+    shapes, outlines, holes = [], [], []  # shapes: (region, its outlines' slice of `outlines`)
     for j, i in enumerate(order):
         if i == background:
             continue
-        mask, origin = grown_mask(regions.labels, rank, i, boxes[i], int(s.overlap))
-        found = crack_outlines(mask, origin)
+        mask, (x0, y0) = grown_mask(regions.labels, rank, i, boxes[i], int(s.overlap))
+        # pixels no region draws (transparent, or an isolated speck that was dropped)
+        transparent = regions.labels[y0:y0 + mask.shape[0], x0:x0 + mask.shape[1]] < 0
+        found, is_hole = shape_outlines(mask, transparent, (x0, y0))
         shapes.append((i, slice(len(outlines), len(outlines) + len(found))))
         outlines.extend(found)
+        holes.extend(is_hole)
         if j % 64 == 0:
             report("outline", 0.4 + 0.3 * j / regions.count)
     if s.subpixel:
         owners = np.array([i for i, sl in shapes for _ in range(sl.start, sl.stop)], np.int64)
-        outlines = refine_outlines(outlines, owners, regions.labels, rank, regions.color, rgb, alpha)
+        outlines = refine_outlines(outlines, owners, regions.labels, rank, regions.color, rgb, alpha,
+                                   np.array(holes, bool))
     report("fit", 0.7)
     # one batched fit of all outlines (see bezier.py)
     fitted = fit_outlines(outlines, s.tolerance, s.corner_angle, s.smoothing)
@@ -110,7 +115,8 @@ def trace_image(image: np.ndarray, settings: TraceSettings = TraceSettings(),
             continue
         fill = hex_color(paint[i])
         fills.add(fill)
-        elements.append(path_element(f"p{len(elements)}", path_data(subpaths), fill))
+        cut = any(holes[sl])
+        elements.append(path_element(f"p{len(elements)}", path_data(subpaths), fill, evenodd=cut))
         segments += sum(len(sp) for sp in subpaths)
     report("fit", 1.0)
     return TraceResult(svg=svg_document(w, h, elements), paths=len(elements), colors=len(fills),
