@@ -272,7 +272,7 @@ def test_nan_loss_never_reaches_the_scene(monkeypatch):
 
     monkeypatch.setitem(losses.__dict__, "l2", flaky)
     scene = _circle_scene()
-    result = optimize(scene, _disc_target(), Settings(iterations=12, samples=2, threads=1,
+    result = optimize(scene, _disc_target(), Settings(iterations=12, lr_warmup=0, samples=2, threads=1,
                                                       lr={"points": 1.0, "colors": 0.05, "radii": 1.0}))
     assert result.skipped_steps == 2
     assert math.isnan(result.losses[2]) and math.isnan(result.losses[3])
@@ -294,7 +294,7 @@ def test_nan_gradient_is_refused(monkeypatch):
 
     monkeypatch.setattr(opt._Kind, "gradient", poisoned)
     scene = _circle_scene()
-    result = optimize(scene, _disc_target(), Settings(iterations=6, threads=1, lr={"points": 1.0}))
+    result = optimize(scene, _disc_target(), Settings(iterations=6, lr_warmup=0, threads=1, lr={"points": 1.0}))
     assert result.skipped_steps == 1
     assert torch.isfinite(scene.shapes[0].geometry.center).all()
 
@@ -308,7 +308,7 @@ def test_interrupt_keeps_the_best_so_far():
         if p.iteration == 8:
             raise KeyboardInterrupt
 
-    result = optimize(scene, _disc_target(), Settings(iterations=50, threads=1,
+    result = optimize(scene, _disc_target(), Settings(iterations=50, lr_warmup=0, threads=1,
                                                       lr={"points": 1.0, "colors": 0.05}),
                       progress=progress)
     assert result.interrupted and result.iterations == 8
@@ -351,7 +351,7 @@ def test_learning_rates_are_in_pixels_whatever_the_svg_units():
         view = torch.diag(torch.tensor([1 / unit, 1 / unit, 1.0]))
         scene = Scene(40, 32, [shape], view=view)
         start = shape.geometry.center.clone()
-        optimize(scene, _disc_target(), Settings(iterations=1, threads=1, lr_decay=1.0,
+        optimize(scene, _disc_target(), Settings(iterations=1, lr_warmup=0, threads=1, lr_decay=1.0,
                                                  lr={"points": 0.5}))
         # the best of (initial, after one step) is kept: take the step's size in pixels
         moved.append(float((shape.geometry.center - start).abs().max()) / unit)
@@ -365,7 +365,7 @@ def test_bounds_hold_after_steps():
                                                                          [0, 0, 1, 1]]))
     shape = Shape(Circle(torch.tensor([20.0, 16.0]), torch.tensor(10.0)), fill=grad)
     scene = Scene(40, 32, [shape])
-    optimize(scene, _disc_target(), Settings(iterations=15, threads=1,
+    optimize(scene, _disc_target(), Settings(iterations=15, lr_warmup=0, threads=1,
                                              lr={"colors": 0.5, "stop_offsets": 0.2, "radii": 4.0}))
     assert float(grad.colors.min()) >= 0 and float(grad.colors.max()) <= 1
     offs = grad.offsets
@@ -389,7 +389,7 @@ def test_ssim_loss_matches_scikit_image():
 @pytest.mark.parametrize("loss,factor", [("l1", 0.6), ("ssim", 0.9), ("pyramid", 0.6)])
 def test_other_losses_also_fit(loss, factor):
     scene = _circle_scene()
-    result = optimize(scene, _disc_target(), Settings(iterations=25, threads=1, loss=loss,
+    result = optimize(scene, _disc_target(), Settings(iterations=25, lr_warmup=0, threads=1, loss=loss,
                                                       lr={"points": 1.0, "colors": 0.05, "radii": 0.5}))
     assert result.best_loss < factor * result.losses[0]
 
@@ -400,7 +400,7 @@ def test_settings_are_checked():
     with pytest.raises(VecfitError, match="loss must be one of"):
         Settings(loss="l3").check()
     with pytest.raises(VecfitError, match="nothing to optimise"):
-        optimize(_circle_scene(), _disc_target(), Settings(iterations=2, lr={"points": 0.0}))
+        optimize(_circle_scene(), _disc_target(), Settings(iterations=2, lr_warmup=0, lr={"points": 0.0}))
 
 
 def test_target_is_compared_over_an_explicit_background():
@@ -417,3 +417,9 @@ def test_target_is_compared_over_an_explicit_background():
 def test_translucent_background_is_a_usage_error(tmp_path):
     r = run("refine", tmp_path / "a.png", tmp_path / "a.svg", "--background", "#ffffff80")
     assert r.exit_code == 2 and "opaque" in r.output, r.output
+
+
+def test_settings_defaults_are_the_config_defaults():
+    """The Python API's Settings() starts where `vecfit refine` does."""
+    from vecfit.config import configs_dir, read_toml
+    assert Settings() == Settings.from_config(read_toml(configs_dir() / "refine.toml")["optimize"])

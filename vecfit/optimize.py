@@ -30,8 +30,15 @@ KINDS = ("points", "colors", "stroke_widths", "opacities", "radii", "gradient_po
 LENGTH_KINDS = ("points", "stroke_widths", "radii", "gradient_points", "gradient_radii")
 
 
+def _default_rates() -> dict:
+    return {"points": 2.0, "colors": 0.02, "stroke_widths": 0.1, "opacities": 0.0, "radii": 1.0,
+            "gradient_points": 2.0, "gradient_radii": 1.0, "stop_offsets": 0.005, "transforms": 0.0}
+
+
 @dataclass
 class Settings:
+    """The loop's settings. The defaults are those of configs/refine.toml's [optimize]
+    table (a test holds them equal), so the Python API and the CLI start alike."""
     iterations: int = 250
     loss: str = "l2"
     mode: str = "mc"
@@ -41,9 +48,9 @@ class Settings:
     threads: int = 0
     device: str = "auto"
     lr_decay: float = 0.1
-    lr_warmup: int = 0
+    lr_warmup: int = 20
     fixed_alpha: bool = False
-    lr: dict = field(default_factory=lambda: {"points": 2.0, "colors": 0.02})
+    lr: dict = field(default_factory=_default_rates)
 
     @classmethod
     def from_config(cls, table: dict) -> "Settings":
