@@ -7,7 +7,9 @@ Needs a core built with VECFIT_CUDA=1 and a GPU; says so and stops otherwise. Ti
 medians after a warm-up and include everything render() does per call: packing, scene
 preparation and tile binning on the host, the uploads, the kernels and the copies back
 (loss = sum of the squared image, gradients of the path points, as in
-benchmarks/gradients.py; forward and backward timed in the same runs).
+benchmarks/gradients.py; forward and backward timed in the same runs). "CPU redo" counts
+the GPU backward passes that were redone on the CPU because a sample needed longer lists
+than a GPU thread holds (their time is then the CPU's): it should read 0.
 """
 from __future__ import annotations
 
@@ -32,23 +34,26 @@ def main():
 
     import vecfit
     from vecfit.device import build_summary
+    from vecfit.render import backward_fallbacks
     print(build_summary())
     if not vecfit.has_cuda() or vecfit.cuda_device_count() == 0:
         sys.exit("no CUDA build or no GPU here: nothing to measure")
 
     head = (f"{'workload':22s} {'CPU fwd':>8s} {'CPU bwd':>8s} {'GPU fwd':>8s} {'GPU bwd':>8s} "
-            f"{'paper fwd/bwd':>14s} {'vs paper':>12s}")
+            f"{'paper fwd/bwd':>14s} {'vs paper':>12s} {'CPU redo':>8s}")
     print(f"median of {args.repeats}, seconds")
     print(head)
     print("-" * len(head))
     for name, mode, samples in CONFIGS:
         cpu = scene_workload(name, mode, samples, args.threads, args.repeats, device="cpu")
+        redone = backward_fallbacks()
         gpu = scene_workload(name, mode, samples, args.threads, args.repeats, device=args.device)
+        redone = backward_fallbacks() - redone
         paper = PAPER.get((name, mode))
         ref = f"{paper[0]:.3f}/{paper[1]:.3f}" if paper else "-"
         speed = f"{paper[0] / gpu[0]:.1f}x/{paper[1] / gpu[1]:.1f}x" if paper else "-"
         label = f"{name} {mode} {samples}x{samples}"
-        print(f"{label:22s} {cpu[0]:8.3f} {cpu[1]:8.3f} {gpu[0]:8.3f} {gpu[1]:8.3f} {ref:>14s} {speed:>12s}")
+        print(f"{label:22s} {cpu[0]:8.3f} {cpu[1]:8.3f} {gpu[0]:8.3f} {gpu[1]:8.3f} {ref:>14s} {speed:>12s} {redone:8d}")
 
 
 if __name__ == "__main__":

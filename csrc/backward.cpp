@@ -114,8 +114,8 @@ BackwardPlan plan_backward(const PreparedScene& prepared, const RenderOptions& o
     return plan;
 }
 
-void render_backward(const PreparedScene& prepared, const SceneArrays& a, const RenderOptions& o, const float* image,
-                     const float* d_image, double boundary_density, SceneGrads& out) {
+bool render_backward(const PreparedScene& prepared, const SceneArrays& a, const RenderOptions& o, const float* image,
+                     const float* d_image, double boundary_density, SceneGrads& out, const ListSizes* fixed) {
     BackwardPlan plan = plan_backward(prepared, o, image, d_image, boundary_density);
     const SceneView sc = prepared.view();
     const TileView bins = plan.bins.view();
@@ -124,20 +124,23 @@ void render_backward(const PreparedScene& prepared, const SceneArrays& a, const 
     std::vector<SceneGrads> grads(lanes);
     for (SceneGrads& g : grads) g.resize_like(a);
     const int n_tiles = bins.nx * bins.ny;
+    const ListSizes sizes = fixed ? *fixed : ListSizes{plan.max_hits, plan.max_ops};
+    std::vector<char> overflowed(lanes, 0);
 
-    // Per lane: its own gradients and lists, sized so that no sample can overflow them.
+    // Per lane: its own gradients and lists (sized so that no sample can overflow them,
+    // unless fixed sizes were asked for).
     struct LaneLists {
         std::vector<Hit> hits;
         std::vector<TapeOp> ops;
         std::vector<Quad> g_hits;
-        explicit LaneLists(const BackwardPlan& p) : hits(p.max_hits), ops(p.max_ops), g_hits(p.max_hits) {}
+        explicit LaneLists(ListSizes n) : hits(n.hits), ops(n.ops), g_hits(n.hits) {}
         InteriorScratch scratch() {
             return {{hits.data(), (int)hits.size()}, {{ops.data(), (int)ops.size()}}, {g_hits.data(), (int)g_hits.size()}};
         }
     };
     ThreadPool::instance().parallel_for(lanes, lanes, [&](int lane, int) {
         const GradView g = grads[lane].view();
-        LaneLists lists(plan);
+        LaneLists lists(sizes);
         InteriorScratch w = lists.scratch();
         for (int tile = lane; tile < n_tiles; tile += lanes) {
             int tx = tile % bins.nx, ty = tile / bins.nx;
@@ -145,23 +148,28 @@ void render_backward(const PreparedScene& prepared, const SceneArrays& a, const 
                 for (int x = tx * TILE; x < std::min(W, (tx + 1) * TILE); ++x)
                     interior_pixel(sc, bins, plan.options, plan.gpix.data() + 4 * ((size_t)y * W + x), x, y, w, g);
         }
+        if (w.overflow()) overflowed[lane] = 1;  // (the flags stay set once raised)
     });
 
     if (!plan.pieces.empty()) {
         BoundarySampler pass{sc, o.seed};
         ThreadPool::instance().parallel_for(lanes, lanes, [&](int lane, int) {
             const GradView g = grads[lane].view();
-            LaneLists lists(plan);
+            LaneLists lists(sizes);
             Buffer<Hit> hits{lists.hits.data(), (int)lists.hits.size()};
             for (size_t k = lane; k < plan.pieces.size(); k += lanes) {
                 const Piece& pc = plan.pieces[k];
                 for (int j = 0; j < pc.count; ++j) boundary_sample(sc, bins, pass, pc, j, (uint64_t)k, plan.boundary, hits, g);
             }
+            if (hits.overflow) overflowed[lane] = 1;
         });
     }
 
+    for (char f : overflowed)
+        if (f) return false;
     out = grads[0];
     for (int l = 1; l < lanes; ++l) out.add(grads[l]);
+    return true;
 }
 
 }  // namespace vf

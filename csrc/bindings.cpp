@@ -3,6 +3,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
 #include <stdexcept>
 #include <string>
 
@@ -135,9 +136,13 @@ py::array_t<float> render(const py::dict& scene, int width, int height, int samp
     return image;
 }
 
+// Backward passes redone on the CPU because a sample overflowed a GPU thread's lists.
+std::atomic<long> backward_fallbacks{0};
+
 py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_image, int width, int height,
                      int samples, const std::string& mode, const std::string& filter, double filter_radius,
-                     uint64_t seed, int threads, py::object background, double boundary_density, int device) {
+                     uint64_t seed, int threads, py::object background, double boundary_density, int device,
+                     bool emulate_gpu_lists) {
     SceneInput in = scene_input(scene);
     SceneArrays a = in.arrays();
     RenderOptions o = render_options(width, height, samples, mode, filter, filter_radius, seed, threads, background);
@@ -147,9 +152,15 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
     {
         py::gil_scoped_release release;
         PreparedScene prepared = prepare_scene(a);
-        // (on the GPU when asked, unless a sample there needs longer lists than a thread holds)
-        bool done = device >= 0 &&
-                    gpu::render_backward(prepared, a, o, image.data(), d_image.data(), boundary_density, device, g);
+        // On the GPU when asked, unless a sample there needs longer lists than a thread
+        // holds: then on the CPU. emulate_gpu_lists runs the CPU lanes with a GPU thread's
+        // lists first, to see on the CPU what a GPU run would do.
+        bool fixed = device >= 0 || emulate_gpu_lists, done = false;
+        if (device >= 0)
+            done = gpu::render_backward(prepared, a, o, image.data(), d_image.data(), boundary_density, device, g);
+        else if (emulate_gpu_lists)
+            done = render_backward(prepared, a, o, image.data(), d_image.data(), boundary_density, g, &GPU_LISTS);
+        if (fixed && !done) ++backward_fallbacks;
         if (!done) render_backward(prepared, a, o, image.data(), d_image.data(), boundary_density, g);
     }
     auto out = [](const std::vector<double>& v, py::ssize_t cols) {
@@ -191,7 +202,10 @@ PYBIND11_MODULE(_core, m) {
           "Gradients of the scene arrays given the forward image and dL/d(image)",
           py::arg("scene"), py::arg("image"), py::arg("d_image"), py::arg("width"), py::arg("height"),
           py::arg("samples"), py::arg("mode"), py::arg("filter"), py::arg("filter_radius"), py::arg("seed"),
-          py::arg("threads"), py::arg("background"), py::arg("boundary_density"), py::arg("device") = -1);
+          py::arg("threads"), py::arg("background"), py::arg("boundary_density"), py::arg("device") = -1,
+          py::arg("emulate_gpu_lists") = false);
+    m.def("backward_fallbacks", [] { return backward_fallbacks.load(); },
+          "Backward passes redone on the CPU so far because a sample needed longer lists than a GPU thread has");
     m.def("hardware_threads", &ThreadPool::hardware_threads);
     m.def("has_cuda", &gpu::compiled, "Whether this build has the CUDA kernels");
     m.def("cuda_device_count", &gpu::device_count, "CUDA devices usable now (0 without a CUDA build)");

@@ -119,6 +119,63 @@ def test_info_needs_svg_or_build():
     assert run.exit_code == 2
 
 
+# ------------------------------------- a GPU thread's list sizes, checked on the CPU
+
+def stacked_discs(n: int) -> vecfit.Scene:
+    """n translucent discs over one another: n draws hit the centre."""
+    shapes = [vecfit.Shape(geometry=vecfit.Circle(center=torch.tensor([16.0, 16.0]),
+                                                  radius=torch.tensor(12.0 - 0.2 * i)),
+                           fill=vecfit.Solid(torch.tensor([i / n, 0.5, 1 - i / n, 0.3])))
+              for i in range(n)]
+    return vecfit.Scene(width=32, height=32, shapes=shapes)
+
+
+def gradients(scene, mode, gpu_lists):
+    params = [t for ts in scene.parameters().values() for t in ts]
+    for t in params:
+        t.requires_grad_(True)
+        t.grad = None
+    img = vecfit.render(scene, samples=2, mode=mode, threads=2, _gpu_lists=gpu_lists)
+    (img ** 2).sum().backward()
+    return torch.cat([t.grad.flatten() for t in params if t.grad is not None])
+
+
+@pytest.mark.parametrize("mode", ["mc", "analytic"])
+@pytest.mark.parametrize("depth,falls_back", [(20, False), (40, True)])
+def test_gpu_list_sizes_on_the_cpu(mode, depth, falls_back):
+    """The CPU lanes run with a GPU thread's lists (32 hits): 20 discs deep fits and gives
+    the very same gradients; 40 deep overflows, is flagged, and the pass is redone with
+    lists sized to the scene, as a GPU run would be."""
+    from vecfit.render import backward_fallbacks
+    scene = stacked_discs(depth)
+    before = backward_fallbacks()
+    emulated = gradients(scene, mode, gpu_lists=True)
+    assert backward_fallbacks() - before == int(falls_back)
+    exact = gradients(scene, mode, gpu_lists=False)
+    assert backward_fallbacks() - before == int(falls_back)  # (only fixed lists count)
+    assert exact.abs().max() > 0 and torch.equal(emulated, exact)
+
+
+def test_benchmark_scenes_fit_a_gpu_thread():
+    """The scenes the GPU is timed on never overflow a GPU thread's lists, so the GPU
+    timings are not CPU fallbacks."""
+    from shared_data import SCENES
+    from vecfit.render import backward_fallbacks
+    names = ["tiger", "boston", "mcseem2"]
+    if not all((SCENES / f"{n}.svg").exists() for n in names):
+        pytest.skip("the shared benchmark scenes are not present")
+    before = backward_fallbacks()
+    for name in names:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            scene = vecfit.load_svg(SCENES / f"{name}.svg")
+        for mode, samples in (("mc", 2), ("analytic", 1)):
+            for t in (t for ts in scene.parameters().values() for t in ts):
+                t.requires_grad_(True)
+            vecfit.render(scene, samples=samples, mode=mode, _gpu_lists=True).sum().backward()
+    assert backward_fallbacks() == before
+
+
 # ------------------------------------------------------- with a GPU (the `device` tool)
 
 @pytest.mark.skipif(not GPU, reason="needs a CUDA build and a GPU")
@@ -153,8 +210,10 @@ def test_gpu_gradients_match_cpu(mode):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         scene = vecfit.load_svg(ROOT / "examples" / "tiger.svg")
+    from vecfit.render import backward_fallbacks
     params = [t for ts in scene.parameters().values() for t in ts]
     grads = {}
+    fallbacks = backward_fallbacks()
     for device in ("cpu", "cuda"):
         for t in params:
             t.requires_grad_(True)
@@ -162,6 +221,7 @@ def test_gpu_gradients_match_cpu(mode):
         img = vecfit.render(scene, 160, 160, samples=2, mode=mode, device=device)
         (img ** 2).sum().backward()
         grads[device] = torch.cat([t.grad.flatten() for t in params if t.grad is not None])
+    assert backward_fallbacks() == fallbacks  # the GPU's gradients came from the GPU
     cpu, gpu = grads["cpu"], grads["cuda"]
     assert cpu.abs().max() > 0
     scale = float(cpu.abs().max())

@@ -54,9 +54,10 @@ class _Render(torch.autograd.Function):
     (the autograd graph of vecfit.pack carries them on to the Scene's tensors)."""
 
     @staticmethod
-    def forward(ctx, settings, boundary_density, structure, *floats):
+    def forward(ctx, settings, boundary_density, emulate_gpu_lists, structure, *floats):
         ctx.scene, ctx.image = _core_render(settings, structure, floats)
         ctx.settings, ctx.boundary_density = settings, boundary_density
+        ctx.emulate_gpu_lists = emulate_gpu_lists
         ctx.shapes = [t.shape for t in floats]
         return torch.from_numpy(ctx.image)
 
@@ -67,17 +68,17 @@ class _Render(torch.autograd.Function):
             grads = _core.render_grad(ctx.scene, ctx.image, grad_image.detach().cpu().contiguous().numpy(),
                                       s["width"], s["height"], s["samples"], s["mode"], s["filter"],
                                       s["filter_radius"], s["seed"], s["threads"], s["background"],
-                                      ctx.boundary_density, s["device"])
+                                      ctx.boundary_density, s["device"], ctx.emulate_gpu_lists)
         except RuntimeError as e:  # the GPU failed (out of memory, driver)
             raise VecfitError(f"gradients on {devices.describe(s['device'])} failed: {e}") from None
         out = [torch.from_numpy(grads[name]).reshape(shape) for name, shape in zip(FLOAT_INPUTS, ctx.shapes)]
-        return (None, None, None, *out)
+        return (None, None, None, None, *out)
 
 
 def render(scene: Scene, width: int | None = None, height: int | None = None, *,
            samples: int = 2, mode: str = "mc", filter: str = "box", filter_radius: float = 0.5,
            seed: int = 0, background=None, threads: int | None = None, boundary_samples: float = 2.0,
-           device: str = "cpu", _brute_force: bool = False) -> torch.Tensor:
+           device: str = "cpu", _brute_force: bool = False, _gpu_lists: bool = False) -> torch.Tensor:
     """Render ``scene`` into an [H, W, 4] float tensor of straight RGBA.
 
     samples: N means N x N stratified samples per pixel (jittered in "mc" mode, at the
@@ -94,6 +95,9 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     same seed gives the same image on either; gradients are computed where the image was.
     The scene's tensors and the result are CPU tensors either way (the scene is packed
     and prepared on the host).
+
+    (_brute_force and _gpu_lists are for tests: every draw tested at every sample, and the
+    CPU backward pass run first with a GPU thread's list sizes, see backward_fallbacks.)
     """
     if mode not in MODES:
         raise VecfitError(f"mode must be one of {', '.join(MODES)}, not {mode!r}")
@@ -124,6 +128,14 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
                     filter_radius=float(filter_radius), seed=int(seed), threads=int(threads or 0),
                     background=background, device=devices.resolve(device))
     if torch.is_grad_enabled() and any(t.requires_grad for t in floats) and not _brute_force:
-        return _Render.apply(settings, float(boundary_samples), structure, *floats)
+        return _Render.apply(settings, float(boundary_samples), bool(_gpu_lists), structure, *floats)
     image = _core_render(settings, structure, floats, brute_force=_brute_force)[1]
     return torch.from_numpy(image)
+
+
+def backward_fallbacks() -> int:
+    """How many backward passes so far (in this process) were redone on the CPU because a
+    sample needed longer lists than a GPU thread holds (more than 32 draws over one point,
+    or a compositing tape of over 96 steps). A GPU run that falls back is no faster."""
+    return int(_core.backward_fallbacks())
+

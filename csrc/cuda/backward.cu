@@ -15,9 +15,9 @@ namespace vf {
 namespace gpu {
 namespace {
 
-// Per-thread list sizes. Past them a thread flags an overflow and the host redoes the
-// pass on the CPU, whose lists are sized to the scene.
-constexpr int GPU_HITS = 32, GPU_OPS = 96;
+// Per-thread list sizes (backward.h): past them a thread flags an overflow and the host
+// redoes the pass on the CPU, whose lists are sized to the scene.
+constexpr int GPU_HITS = GPU_LISTS.hits, GPU_OPS = GPU_LISTS.ops;
 // Room for those lists, the compositor's layer stacks and the root finder's recursion.
 constexpr size_t STACK_BYTES = 24576;
 
