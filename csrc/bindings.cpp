@@ -237,6 +237,11 @@ PYBIND11_MODULE(_core, m) {
         return py::make_tuple(c.t, c.dist);
     }, py::arg("points"), py::arg("p"));
 
+    m.def("segment_bounds", [](Array<double> pts) {
+        Box b = seg_bbox(segment_from(pts));
+        return py::make_tuple(b.x0, b.y0, b.x1, b.y1);
+    }, py::arg("points"), "Bounds (x0, y0, x1, y1) of a segment's curve, as the tiles use them");
+
     m.def("closest_point_on_ellipse", [](std::pair<double, double> center, Array<double> axes,
                                          std::pair<double, double> p) {
         if (axes.size() != 4) throw std::invalid_argument("axes must be a 2x2 matrix");

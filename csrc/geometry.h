@@ -394,12 +394,6 @@ VF_HD Segment seg_part(const Segment& s, double t0, double t1) {
     return out;
 }
 
-VF_HD Box seg_bbox(const Segment& s) {  // of the control polygon (contains the curve)
-    Box b;
-    for (int i = 0; i <= s.degree; ++i) expand(b, s.p[i]);
-    return b;
-}
-
 // Tangent direction at t = 0 (end = false) or t = 1 (end = true), skipping coincident
 // control points; zero for a segment that is a single point.
 VF_HD Vec2 seg_end_tangent(const Segment& s, bool end) {
@@ -441,6 +435,22 @@ VF_HD int seg_extrema(const Segment& s, int axis, double* ts) {
     for (int i = 0; i < n; ++i)
         if (ts[i] > 0 && ts[i] < 1) ts[m++] = ts[i];
     return m;
+}
+
+// The curve's own bounds: its ends and its x and y extrema (a cubic's control polygon can
+// reach far past the curve, which refinement makes common, and every box feeds the tile
+// binning). Grown by a hair so that rounding in the extrema never leaves a curve point out.
+VF_HD Box seg_bbox(const Segment& s) {
+    Box b;
+    expand(b, s.p[0]);
+    expand(b, s.p[s.degree]);
+    double ts[2];
+    for (int axis = 0; axis < 2; ++axis) {
+        int n = seg_extrema(s, axis, ts);
+        for (int i = 0; i < n; ++i) expand(b, seg_eval(s, ts[i]));
+    }
+    double size = vmax(vmax(std::fabs(b.x0), std::fabs(b.x1)), vmax(std::fabs(b.y0), std::fabs(b.y1)));
+    return grown(b, 1e-9 * (1 + size));
 }
 
 // Power-basis coefficients of one coordinate of a segment: coord(t) = sum a[k] t^k.

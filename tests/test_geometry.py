@@ -147,6 +147,30 @@ def test_closest_point_on_segment(ctrl, p):
     _check_closest(at, basins, at(t_core), d_core, p, scale, well_conditioned)
 
 
+@SETTINGS
+@given(ctrl=bezier())
+def test_segment_bounds_hold_the_curve_tightly(ctrl):
+    """The tiles bin each segment by the bounds of its curve, not of its control polygon
+    (which refinement pulls far out): every curve point lies inside, and each side is
+    reached by the curve."""
+    ctrl = np.asarray(ctrl, np.float64)
+    x0, y0, x1, y1 = core.segment_bounds(ctrl)
+    curve = bezier_eval(ctrl, np.linspace(0, 1, 20001))
+    scale = _scale(ctrl)
+    assert curve[:, 0].min() >= x0 and curve[:, 0].max() <= x1
+    assert curve[:, 1].min() >= y0 and curve[:, 1].max() <= y1
+    lo, hi = curve.min(0), curve.max(0)
+    assert np.allclose([x0, y0], lo, rtol=0, atol=1e-6 * scale)
+    assert np.allclose([x1, y1], hi, rtol=0, atol=1e-6 * scale)
+
+
+def test_segment_bounds_of_a_loop_are_inside_its_control_polygon():
+    # control points pulled far out, as refinement leaves them: the curve reaches only 3/4
+    ctrl = np.array([[0.0, 0.0], [40.0, 30.0], [-40.0, 30.0], [0.0, 0.0]])
+    x0, y0, x1, y1 = core.segment_bounds(ctrl)
+    assert y1 == pytest.approx(22.5, abs=1e-6) and x1 < 12 and x0 > -12 and y0 == pytest.approx(0, abs=1e-6)
+
+
 @pytest.mark.parametrize("ctrl,p,q", [
     ([[0, 0], [10, 0]], (5, 3), (5, 0)),
     ([[0, 0], [10, 0]], (-5, 3), (0, 0)),
