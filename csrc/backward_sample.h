@@ -913,6 +913,10 @@ VF_HD void interior_pixel(const SceneView& sc, const TileView& bins, const Rende
         if (w.hits.empty()) continue;
         double c[4], gs[4];
         composite(sc, w.hits, &w.tape, c);
+        // Past a list's end (a GPU thread's fixed lists) the tape may have lost the POP
+        // of a PUSH it kept, which composite_backward cannot walk back. The pass will be
+        // redone with longer lists anyway: stop here.
+        if (w.overflow()) return;
         for (int i = 0; i < 4; ++i) gs[i] = wt * gp[i];
         composite_backward(sc, w.hits, w.tape, gs, w.g_hits, g);
         for (int k = 0; k < w.hits.size(); ++k) {

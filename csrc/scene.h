@@ -54,7 +54,7 @@ struct PreparedSegment {
     Box box;
     double split[4];        // 0, y-extrema in (0,1) ascending, 1: y-monotone pieces
     double split_y[4];      // y at each split
-    double piece_x0[3], piece_x1[3];  // x range of each piece (of its control points)
+    double piece_x0[3], piece_x1[3];  // x range of each piece (of the curve, see seg_bbox)
     double ax[4], ay[4];    // power-basis coefficients of x(t) and y(t)
     int n_split = 2;
 };

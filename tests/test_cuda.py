@@ -130,6 +130,21 @@ def stacked_discs(n: int) -> vecfit.Scene:
     return vecfit.Scene(width=32, height=32, shapes=shapes)
 
 
+def grouped_discs(n: int, depth: int = 3) -> vecfit.Scene:
+    """n translucent discs, two by two in groups nested `depth` deep with opacity (a group
+    over one draw would fold into its alpha): fewer hits than a GPU thread holds, but each
+    pair opens and closes its layers, so the compositing tape (96 steps) runs out first."""
+    scene = stacked_discs(n)
+    for i in range(0, n, 2):
+        parent = -1
+        for _ in range(depth):
+            scene.groups.append(vecfit.Group(opacity=torch.tensor(0.9), parent=parent))
+            parent = len(scene.groups) - 1
+        for shape in scene.shapes[i:i + 2]:
+            shape.group = parent
+    return scene
+
+
 def gradients(scene, mode, gpu_lists):
     params = [t for ts in scene.parameters().values() for t in ts]
     for t in params:
@@ -141,13 +156,16 @@ def gradients(scene, mode, gpu_lists):
 
 
 @pytest.mark.parametrize("mode", ["mc", "analytic"])
-@pytest.mark.parametrize("depth,falls_back", [(20, False), (40, True)])
-def test_gpu_list_sizes_on_the_cpu(mode, depth, falls_back):
-    """The CPU lanes run with a GPU thread's lists (32 hits): 20 discs deep fits and gives
-    the very same gradients; 40 deep overflows, is flagged, and the pass is redone with
-    lists sized to the scene, as a GPU run would be."""
+@pytest.mark.parametrize("make,depth,falls_back", [(stacked_discs, 20, False), (stacked_discs, 40, True),
+                                                   (grouped_discs, 16, False), (grouped_discs, 30, True)],
+                         ids=["20-discs", "40-discs", "16-grouped", "30-grouped"])
+def test_gpu_list_sizes_on_the_cpu(mode, make, depth, falls_back):
+    """The CPU lanes run with a GPU thread's lists (32 hits, 96 compositing steps): 20
+    discs deep fits and gives the very same gradients, as do 16 in nested groups; 40 deep
+    overflow the hits, 30 in nested groups the tape (15 pairs x 8 steps), which is flagged,
+    and the pass is redone with lists sized to the scene, as a GPU run would be."""
     from vecfit.render import backward_fallbacks
-    scene = stacked_discs(depth)
+    scene = make(depth)
     before = backward_fallbacks()
     emulated = gradients(scene, mode, gpu_lists=True)
     assert backward_fallbacks() - before == int(falls_back)

@@ -63,7 +63,8 @@ def region_boxes(labels: np.ndarray, count: int) -> list:
 
 def drawing_order(labels: np.ndarray, count: int, boxes) -> np.ndarray:
     """Regions sorted by filled area (pixels plus holes), largest first: a region that
-    encloses another always comes before it, so holes need no cutting out."""
+    encloses another always comes before it, so its holes need no cutting out where other
+    regions fill them (only their transparent pixels are cut, see shape_outlines)."""
     filled = np.zeros(count)
     for i, box in enumerate(boxes):
         mask = labels[box] == i
