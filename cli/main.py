@@ -189,16 +189,17 @@ def _resolve_config(command, preset, config_file, options, extra=None):
 
 
 class _ProgressBar:
-    """An Adam progress bar on stderr, with the loss; silent when quiet."""
+    """An Adam progress bar on stderr, with the loss; silent when quiet. It appears with
+    the first iteration, so an error in the inputs is not preceded by a bar (or, in a log,
+    by the bar's label alone)."""
 
     def __init__(self, label: str, iterations: int, quiet: bool):
-        self.bar = None if quiet or iterations == 0 else click.progressbar(
+        self.make = None if quiet or iterations == 0 else lambda: click.progressbar(
             length=iterations, label=label, file=sys.stderr, show_pos=True, show_eta=True,
             item_show_func=lambda p: None if p is None else f"loss {p.loss:.5g}")
+        self.bar = None
 
     def __enter__(self):
-        if self.bar is not None:
-            self.bar.__enter__()
         return self
 
     def __exit__(self, *exc):
@@ -206,8 +207,12 @@ class _ProgressBar:
             self.bar.__exit__(*exc)
 
     def __call__(self, progress) -> None:
-        if self.bar is not None:
-            self.bar.update(1, current_item=progress)
+        if self.make is None:
+            return
+        if self.bar is None:
+            self.bar = self.make()
+            self.bar.__enter__()
+        self.bar.update(1, current_item=progress)
 
 
 def _run_job(label, iterations, quiet, job):

@@ -193,9 +193,10 @@ def test_bad_input_is_a_clear_error_and_leaves_no_files(case, tmp_path):
         args[1] = circle_svg(tmp_path / "tiny.svg", cx=5, cy=4, r=2, size=(10, 8))
         expect = "too small (10x8 pixels"
     before = sorted(os.listdir(tmp_path))
-    r = run("refine", *args, "--iterations", 2, "-q")
+    r = run("refine", *args, "--iterations", 2)  # (not quiet: no progress bar before the error)
     assert r.exit_code == 1, r.output
     assert expect in r.output and "Traceback" not in r.output
+    assert r.output.startswith("error: "), r.output
     assert sorted(os.listdir(tmp_path)) == before  # nothing written, inputs untouched
     assert svg.read_text().startswith("<svg")
 
