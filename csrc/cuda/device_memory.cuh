@@ -69,15 +69,57 @@ inline TileView upload_bins(Uploads& up, const TileBins& b) {
     return {b.nx, b.ny, b.margin, up.put(b.start), up.put(b.entries), up.put(b.items)};
 }
 
-// Makes `device` current, with room on each thread's stack for the per-sample lists.
-inline void use_device(int device, size_t stack_bytes) {
-    int count = device_count();
-    if (device < 0 || device >= count)
-        throw std::runtime_error("no CUDA device " + std::to_string(device) + " (found " + std::to_string(count) + ")");
-    check(cudaSetDevice(device), "cudaSetDevice");
-    size_t current = 0;
-    check(cudaDeviceGetLimit(&current, cudaLimitStackSize), "cudaDeviceGetLimit");
-    if (current < stack_bytes) check(cudaDeviceSetLimit(cudaLimitStackSize, stack_bytes), "cudaDeviceSetLimit");
+// Per-thread stack the root finder's recursion needs on top of a kernel's own frame (which
+// the compiler counts; the recursion it cannot): for a quintic, 4 levels of poly_roots,
+// 15 of isolate and 3 of roots_by_derivative, 7,384 bytes on sm_90 (ptxas -v), rounded up.
+constexpr size_t RECURSION_STACK = 10240;
+
+// Makes `device` current for the scope of one pass (and the caller's current device, e.g.
+// torch's, current again afterwards), with `stack_bytes` on each thread's stack.
+class DeviceScope {
+public:
+    DeviceScope(int device, size_t stack_bytes) {
+        int count = device_count();
+        if (device < 0 || device >= count)
+            throw std::runtime_error("no CUDA device " + std::to_string(device) + " (found " + std::to_string(count) + ")");
+        check(cudaGetDevice(&previous_), "cudaGetDevice");
+        check(cudaSetDevice(device), "cudaSetDevice");
+        try {
+            reserve_stack(stack_bytes);
+        } catch (...) {
+            cudaSetDevice(previous_);
+            throw;
+        }
+    }
+    ~DeviceScope() { cudaSetDevice(previous_); }
+    DeviceScope(const DeviceScope&) = delete;
+    DeviceScope& operator=(const DeviceScope&) = delete;
+
+private:
+    int previous_ = 0;
+
+    static void reserve_stack(size_t stack_bytes) {
+        size_t current = 0;
+        check(cudaDeviceGetLimit(&current, cudaLimitStackSize), "cudaDeviceGetLimit");
+        if (current >= stack_bytes) return;
+        // The driver reserves this much for every thread the GPU can hold at once.
+        cudaError_t status = cudaDeviceSetLimit(cudaLimitStackSize, stack_bytes);
+        if (status == cudaErrorMemoryAllocation) {
+            cudaGetLastError();
+            throw std::runtime_error("the GPU has too little free memory for a per-thread stack of " +
+                                     std::to_string(stack_bytes) + " bytes");
+        }
+        check(status, "cudaDeviceSetLimit");
+    }
+};
+
+// One block of TILE x TILE threads per tile, the tiles numbered along x alone (a grid's y
+// extent stops at 65,535 blocks, which a tall image would pass).
+inline unsigned tile_blocks(const TileView& bins) { return (unsigned)(bins.nx * bins.ny); }
+__device__ inline void tile_pixel(const TileView& bins, int& x, int& y) {
+    int tile = (int)blockIdx.x;
+    x = (tile % bins.nx) * TILE + (int)threadIdx.x;
+    y = (tile / bins.nx) * TILE + (int)threadIdx.y;
 }
 
 }  // namespace gpu

@@ -20,13 +20,15 @@ struct Background {
 };
 
 __global__ void shade_kernel(SceneView sc, TileView bins, RenderOptions o, Background bg, float* out) {
-    int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
+    int x, y;
+    tile_pixel(bins, x, y);
     if (x >= o.width || y >= o.height) return;
     shade_pixel(sc, bins, o, bg.c, x, y, out + 4 * ((size_t)y * o.width + x));
 }
 
-// Per-thread stack for the compositor's layer stack and the root finder's recursion.
-constexpr size_t STACK_BYTES = 8192;
+// Per-thread stack: the kernel's frame (3.3 KB on sm_80/90, mostly the compositor's layer
+// stack) and the root finder's recursion.
+constexpr size_t STACK_BYTES = 6144 + RECURSION_STACK;
 
 }  // namespace
 
@@ -47,7 +49,13 @@ std::string build_info() {
     cudaDriverGetVersion(&driver);
     auto version = [](int v) { return v ? std::to_string(v / 1000) + "." + std::to_string(v % 1000 / 10) : "none"; };
     std::string info = "CUDA: compiled for " VECFIT_CUDA_ARCHS ", runtime " + version(runtime) + ", driver " + version(driver);
-    int n = device_count();
+    int n = 0;
+    cudaError_t status = cudaGetDeviceCount(&n);
+    if (status != cudaSuccess) {  // e.g. a driver older than the runtime: say so, not just "0"
+        info += std::string(", no devices (") + cudaGetErrorString(status) + ")";
+        cudaGetLastError();
+        return info;
+    }
     info += ", " + std::to_string(n) + " device(s)";
     for (int i = 0; i < n; ++i) {
         cudaDeviceProp prop;
@@ -59,7 +67,7 @@ std::string build_info() {
 }
 
 void render_forward(const PreparedScene& scene, const RenderOptions& options, int device, float* out) {
-    use_device(device, STACK_BYTES);
+    DeviceScope scope(device, STACK_BYTES);
     ForwardPlan plan = plan_forward(scene, options);
     Uploads up;
     SceneView sc = upload_scene(up, scene);
@@ -67,8 +75,7 @@ void render_forward(const PreparedScene& scene, const RenderOptions& options, in
     size_t bytes = (size_t)options.width * options.height * 4 * sizeof(float);
     DeviceBuffer image(bytes);
     Background bg{{plan.background[0], plan.background[1], plan.background[2], plan.background[3]}};
-    dim3 block(TILE, TILE), grid((options.width + TILE - 1) / TILE, (options.height + TILE - 1) / TILE);
-    shade_kernel<<<grid, block>>>(sc, bins, plan.options, bg, static_cast<float*>(image.get()));
+    shade_kernel<<<tile_blocks(bins), dim3(TILE, TILE)>>>(sc, bins, plan.options, bg, static_cast<float*>(image.get()));
     check(cudaGetLastError(), "shade_kernel launch");
     check(cudaMemcpy(out, image.get(), bytes, cudaMemcpyDeviceToHost), "cudaMemcpy (image)");
 }
