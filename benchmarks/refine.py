@@ -14,6 +14,7 @@ from pathlib import Path
 
 from common import SHARED, resvg_rgb
 
+from vecfit.colors import parse_background
 from vecfit.config import resolve
 from vecfit.metrics import compare, to_rgb
 from vecfit.refine import Outputs, load_target, refine
@@ -65,7 +66,7 @@ def main() -> None:
                 warnings.simplefilter("ignore")
                 report = refine(target_path, svg_path, config, outputs)
             target = load_target(target_path)
-            bg = tuple(int(report["background"][i:i + 2], 16) / 255 for i in (1, 3, 5))
+            bg = parse_background(report["background"])
             goal = to_rgb(target, bg)
             before = compare(resvg_rgb(svg_path, target.shape[1], bg), goal)
             after = compare(resvg_rgb(outputs.svg, target.shape[1], bg), goal)

@@ -118,6 +118,7 @@ def refine_table(budgets, images, iterations, threads):
     """Trace + refine with the defaults: PSNR before / after and wall time per image."""
     from PIL import Image
 
+    from vecfit.colors import parse_background
     from vecfit.config import resolve
     from vecfit.metrics import compare
     from vecfit.refine import Outputs
@@ -140,7 +141,7 @@ def refine_table(budgets, images, iterations, threads):
                 config = resolve("trace", overrides=overrides)
                 out = Outputs.beside(target, Path(tmp) / f"{name}_{b}.svg")
                 rep = trace(target, config, out)
-                bg = [int(rep["background"][i:i + 2], 16) / 255 for i in (1, 3, 5)]
+                bg = parse_background(rep["background"])
                 theirs = resvg_rgb(out.svg, image.shape[1], bg)
                 resvg_psnr = compare(theirs, image[..., :3].astype(np.float64))["psnr"]
                 means[b].append(resvg_psnr)

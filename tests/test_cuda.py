@@ -6,27 +6,26 @@ from __future__ import annotations
 import os
 import shutil
 import subprocess
-import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
 import torch
-from click.testing import CliRunner
 
 import vecfit
-from shared_data import ROOT
-from vecfit.cli.main import main
+from helpers import quiet_load, run
+from shared_data import ROOT, SCENES
 from vecfit.errors import VecfitError
 CUDA_SOURCES = sorted((ROOT / "csrc" / "cuda").glob("*.cu"))
 GPU = vecfit.has_cuda() and vecfit.cuda_device_count() > 0
 
 
 def find_nvcc() -> str | None:
-    for candidate in (os.environ.get("CUDACXX"), shutil.which("nvcc"), "/usr/local/cuda/bin/nvcc"):
-        if candidate and Path(candidate).is_file():
-            return candidate
-    return None
+    """nvcc where CMakeLists.txt looks for it: CUDACXX, PATH, CUDA_HOME, CUDA_PATH, /usr/local/cuda."""
+    homes = [os.environ.get(v) for v in ("CUDA_HOME", "CUDA_PATH")] + ["/usr/local/cuda"]
+    candidates = [os.environ.get("CUDACXX"), shutil.which("nvcc")]
+    candidates += [str(Path(h) / "bin" / "nvcc") for h in homes if h]
+    return next((c for c in candidates if c and Path(c).is_file()), None)
 
 
 @pytest.mark.skipif(find_nvcc() is None, reason="nvcc is not installed")
@@ -37,8 +36,8 @@ def test_cuda_source_compiles(source, tmp_path):
     cmd = [find_nvcc(), "-std=c++17", "-arch=sm_80", "--Werror=cross-execution-space-call",
            "-DVECFIT_WITH_CUDA=1", '-DVECFIT_CUDA_ARCHS="sm_80"', f"-I{ROOT / 'csrc'}",
            "-c", str(source), "-o", str(tmp_path / "out.o")]
-    run = subprocess.run(cmd, capture_output=True, text=True)
-    assert run.returncode == 0, f"nvcc failed on {source.name}:\n{run.stderr[-4000:]}"
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    assert done.returncode == 0, f"nvcc failed on {source.name}:\n{done.stderr[-4000:]}"
     assert (tmp_path / "out.o").stat().st_size > 0
 
 
@@ -68,16 +67,16 @@ class TestWithoutCuda:
             vecfit.render(small_scene(), device="gpu")
 
     def test_info_build(self):
-        run = CliRunner().invoke(main, ["info", "--build"])
-        assert run.exit_code == 0, run.output
-        assert "CUDA: not compiled" in run.output and "device auto resolves to: cpu" in run.output
+        r = run("info", "--build")
+        assert r.exit_code == 0, r.output
+        assert "CUDA: not compiled" in r.output and "device auto resolves to: cpu" in r.output
 
     def test_cli_device_cuda_is_a_usage_error(self, tmp_path):
         svg = tmp_path / "a.svg"
         svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="8" height="8">'
                        '<rect width="4" height="4"/></svg>')
-        run = CliRunner().invoke(main, ["render", str(svg), "-o", str(tmp_path / "a.png"), "--device", "cuda"])
-        assert run.exit_code == 2 and "without CUDA" in run.output
+        r = run("render", str(svg), "-o", str(tmp_path / "a.png"), "--device", "cuda")
+        assert r.exit_code == 2 and "without CUDA" in r.output
         assert not (tmp_path / "a.png").exists()
 
 
@@ -86,16 +85,16 @@ class TestWithoutCuda:
         save_png(torch.from_numpy(np.full((16, 16, 4), 0.5, np.float32)), tmp_path / "in" / "a.png")
         for args in (["trace", str(tmp_path / "in" / "a.png"), "-o", str(tmp_path / "a.svg")],
                      ["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--mode", "trace"]):
-            run = CliRunner().invoke(main, args + ["--device", "cuda"])
-            assert run.exit_code == 2 and "without CUDA" in run.output, run.output
+            r = run(*args, "--device", "cuda")
+            assert r.exit_code == 2 and "without CUDA" in r.output, r.output
         assert not (tmp_path / "a.svg").exists() and not (tmp_path / "out").exists()
 
 
 def test_bad_device_in_a_config_is_a_usage_error(tmp_path):
     cfg = tmp_path / "c.toml"
     cfg.write_text('[optimize]\ndevice = "gpu"\n')
-    run = CliRunner().invoke(main, ["refine", "a.png", "a.svg", "--config", str(cfg)])
-    assert run.exit_code == 2 and "device must be" in run.output, run.output
+    r = run("refine", "a.png", "a.svg", "--config", str(cfg))
+    assert r.exit_code == 2 and "device must be" in r.output, r.output
 
 
 def test_device_does_not_change_a_batch_settings_key():
@@ -110,13 +109,13 @@ def test_cuda_build_names_a_missing_device():
     n = vecfit.cuda_device_count()
     with pytest.raises(VecfitError, match=f"no CUDA device {n}: this machine has {n}"):
         vecfit.render(small_scene(), device=f"cuda:{n}")
-    run = CliRunner().invoke(main, ["info", "--build"])
-    assert run.exit_code == 0 and "CUDA: compiled for" in run.output
+    r = run("info", "--build")
+    assert r.exit_code == 0 and "CUDA: compiled for" in r.output
 
 
 def test_info_needs_svg_or_build():
-    run = CliRunner().invoke(main, ["info"])
-    assert run.exit_code == 2
+    r = run("info")
+    assert r.exit_code == 2
 
 
 # ------------------------------------- a GPU thread's list sizes, checked on the CPU
@@ -145,12 +144,13 @@ def grouped_discs(n: int, depth: int = 3) -> vecfit.Scene:
     return scene
 
 
-def gradients(scene, mode, gpu_lists):
+def gradients(scene, **render_options) -> torch.Tensor:
+    """All of the scene's gradients, flat, for loss = sum of the squared render."""
     params = [t for ts in scene.parameters().values() for t in ts]
     for t in params:
         t.requires_grad_(True)
         t.grad = None
-    img = vecfit.render(scene, samples=2, mode=mode, threads=2, _gpu_lists=gpu_lists)
+    img = vecfit.render(scene, **render_options)
     (img ** 2).sum().backward()
     return torch.cat([t.grad.flatten() for t in params if t.grad is not None])
 
@@ -167,9 +167,9 @@ def test_gpu_list_sizes_on_the_cpu(mode, make, depth, falls_back):
     from vecfit.render import backward_fallbacks
     scene = make(depth)
     before = backward_fallbacks()
-    emulated = gradients(scene, mode, gpu_lists=True)
+    emulated = gradients(scene, samples=2, mode=mode, threads=2, _gpu_lists=True)
     assert backward_fallbacks() - before == int(falls_back)
-    exact = gradients(scene, mode, gpu_lists=False)
+    exact = gradients(scene, samples=2, mode=mode, threads=2)
     assert backward_fallbacks() - before == int(falls_back)  # (only fixed lists count)
     assert exact.abs().max() > 0 and torch.equal(emulated, exact)
 
@@ -177,20 +177,15 @@ def test_gpu_list_sizes_on_the_cpu(mode, make, depth, falls_back):
 def test_benchmark_scenes_fit_a_gpu_thread():
     """The scenes the GPU is timed on never overflow a GPU thread's lists, so the GPU
     timings are not CPU fallbacks."""
-    from shared_data import SCENES
     from vecfit.render import backward_fallbacks
     names = ["tiger", "boston", "mcseem2"]
     if not all((SCENES / f"{n}.svg").exists() for n in names):
         pytest.skip("the shared benchmark scenes are not present")
     before = backward_fallbacks()
     for name in names:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            scene = vecfit.load_svg(SCENES / f"{name}.svg")
+        scene = quiet_load(SCENES / f"{name}.svg")
         for mode, samples in (("mc", 2), ("analytic", 1)):
-            for t in (t for ts in scene.parameters().values() for t in ts):
-                t.requires_grad_(True)
-            vecfit.render(scene, samples=samples, mode=mode, _gpu_lists=True).sum().backward()
+            gradients(scene, samples=samples, mode=mode, _gpu_lists=True)
     assert backward_fallbacks() == before
 
 
@@ -204,9 +199,7 @@ def test_gpu_matches_cpu_on_conformance_corpus():
     worst, compared = 0.0, 0
     for case in conf.load_manifest():
         try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                scene = vecfit.load_svg(case.svg)
+            scene = quiet_load(case.svg)
         except VecfitError:
             continue  # a case that is an error on both (malformed input)
         for mode, samples in (("mc", 4), ("analytic", 1)):
@@ -225,20 +218,11 @@ def test_gpu_matches_cpu_on_conformance_corpus():
 def test_gpu_gradients_match_cpu(mode):
     # The tiger: fills and strokes, many overlaps, group transforms. Same seed, so the
     # same pixel and boundary samples on both devices; only the order of the sums differs.
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        scene = vecfit.load_svg(ROOT / "examples" / "tiger.svg")
     from vecfit.render import backward_fallbacks
-    params = [t for ts in scene.parameters().values() for t in ts]
-    grads = {}
+    scene = quiet_load(ROOT / "examples" / "tiger.svg")
     fallbacks = backward_fallbacks()
-    for device in ("cpu", "cuda"):
-        for t in params:
-            t.requires_grad_(True)
-            t.grad = None
-        img = vecfit.render(scene, 160, 160, samples=2, mode=mode, device=device)
-        (img ** 2).sum().backward()
-        grads[device] = torch.cat([t.grad.flatten() for t in params if t.grad is not None])
+    grads = {device: gradients(scene, width=160, height=160, samples=2, mode=mode, device=device)
+             for device in ("cpu", "cuda")}
     assert backward_fallbacks() == fallbacks  # the GPU's gradients came from the GPU
     cpu, gpu = grads["cpu"], grads["cuda"]
     assert cpu.abs().max() > 0

@@ -5,7 +5,6 @@ import io
 import json
 import math
 import os
-import warnings
 
 import numpy as np
 import pytest
@@ -14,7 +13,8 @@ from PIL import Image
 
 import vecfit
 from vecfit import losses
-from helpers import need, run
+from helpers import need, quiet_load, run
+from vecfit.colors import parse_background
 from vecfit.config import resolve
 from vecfit.errors import VecfitError
 from vecfit.metrics import compare
@@ -79,11 +79,9 @@ def test_refine_improves_a_real_trace(small_peppers):
     with Image.open(cmp_png) as im:
         assert im.size == (4 * 128 + 3 * 4, 128)
     # the written file re-renders like the report says
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        scene = vecfit.load_svg(svg)
+    scene = quiet_load(svg)
     target = np.asarray(Image.open(d / "peppers.png").convert("RGB"), np.float64) / 255
-    bg = [int(report["background"][i:i + 2], 16) / 255 for i in (1, 3, 5)] + [1.0]
+    bg = parse_background(report["background"])
     img = vecfit.render(scene, 128, 128, samples=4, background=bg).numpy()[..., :3]
     assert abs(compare(img.astype(np.float64), target)["psnr"] - report["optimized"]["psnr"]) < 0.3
     # ids, classes and the style sheet of the input are kept
@@ -101,9 +99,7 @@ def test_written_svg_matches_resvg(small_peppers, tmp_path):
     assert (tmp_path / "p.report.json").exists() and (tmp_path / "p.compare.png").exists()
     png = bytes(resvg_py.svg_to_bytes(svg_path=str(out), width=256))
     theirs = np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), np.float64) / 255
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        scene = vecfit.load_svg(out)
+    scene = quiet_load(out)
     ours = vecfit.render(scene, 256, 256, samples=4, mode="mc", background=[1, 1, 1, 1])
     psnr = compare(ours.numpy()[..., :3].astype(np.float64), theirs)["psnr"]
     # unrefined, the Adobe file agrees with resvg to ~31 dB at this size (conflation
@@ -121,9 +117,7 @@ def test_background_rect_written_where_the_svg_leaves_canvas_bare(tmp_path):
     report = json.loads((tmp_path / "t.vecfit.report.json").read_text())
     assert report["background"] == "#008000"
     # the circle moved towards the disc and turned blue
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        scene = vecfit.load_svg(tmp_path / "t.vecfit.svg")
+    scene = quiet_load(tmp_path / "t.vecfit.svg")
     circle = [s for s in scene.shapes if isinstance(s.geometry, Circle)][0]
     assert float(circle.geometry.center[0]) > 20.5
     assert float(circle.geometry.radius) > 6.5
@@ -139,9 +133,7 @@ def test_max_size_optimises_small_and_writes_full_size(tmp_path):
     assert r.exit_code == 0, r.output
     report = json.loads((tmp_path / "t.vecfit.report.json").read_text())
     assert report["optimized_size"] == [40, 32] and report["size"] == [160, 128]
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        scene = vecfit.load_svg(tmp_path / "t.vecfit.svg")
+    scene = quiet_load(tmp_path / "t.vecfit.svg")
     c = [s for s in scene.shapes if isinstance(s.geometry, Circle)][0].geometry
     # in full-size coordinates: the centre went from (80, 64) towards (88, 60)
     assert abs(float(c.center[0]) - 88) < 3 and abs(float(c.center[1]) - 60) < 3

@@ -7,7 +7,6 @@ import math
 import os
 import warnings
 import xml.etree.ElementTree as ET
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,26 +15,15 @@ import torch
 import vecfit
 from vecfit.errors import SvgError, VecfitError
 from vecfit.scene import Circle, Ellipse, LinearGradient, Path as PathGeometry, Solid
-from vecfit.svg import VecfitWarning, load_svg
+from vecfit.svg import VecfitWarning
 from vecfit.svg.write import fmt, path_data, write_svg
 
+from helpers import need, quiet_load
 from shared_data import SHARED
 CONFORMANCE = SHARED / "conformance"
 KITTY = SHARED / "data" / "photos" / "kitty.svg"
 TIGER = SHARED / "data" / "scenes" / "tiger.svg"
 SVG_NS = "http://www.w3.org/2000/svg"
-
-
-def need(path: Path) -> Path:
-    if not path.exists():
-        pytest.skip(f"shared data not found: {path}")
-    return path
-
-
-def quiet_load(path):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", VecfitWarning)
-        return load_svg(path)
 
 
 def quiet_write(scene, src, out, **kw):

@@ -23,3 +23,14 @@ def parse_background(text: str | None) -> tuple[float, float, float, float] | No
             if values:
                 return tuple(values + [1.0] * (4 - len(values)))
     raise VecfitError(f"background must be none, white, black or #rrggbb[aa], not {text!r}")
+
+
+def fitting_background(text: str | None) -> tuple[float, float, float, float] | None:
+    """A background to fit against (an [optimize] background other than auto): none or an
+    opaque colour. The shapes are fitted to the target as seen over it, so it cannot be
+    translucent."""
+    bg = parse_background(text)
+    if bg is not None and bg[3] < 1:
+        raise VecfitError("background must be opaque (no alpha below ff) or none: the shapes are "
+                          "fitted to the target seen over it")
+    return bg

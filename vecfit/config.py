@@ -105,14 +105,11 @@ def resolve(command: str, *, preset: str | None = None, config_file=None,
 def validate(settings: dict) -> None:
     """Checks the values, not just the keys and types: a bad background, loss, rate, trace
     or paint setting is refused here, before any work starts (VecfitError)."""
-    from .colors import parse_background
+    from .colors import fitting_background
     from .optimize import Settings
 
     if settings["optimize"]["background"].strip().lower() != "auto":
-        bg = parse_background(settings["optimize"]["background"])
-        if bg is not None and bg[3] < 1:
-            raise VecfitError("background must be opaque (no alpha below ff) or none: the shapes are "
-                              "fitted to the target seen over it")
+        fitting_background(settings["optimize"]["background"])
     Settings.from_config(settings["optimize"])
     seed = settings["optimize"]["seed"]
     if "trace" in settings:

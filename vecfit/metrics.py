@@ -8,10 +8,13 @@ from skimage.metrics import structural_similarity
 
 
 def to_rgb(image: np.ndarray, background=(1.0, 1.0, 1.0)) -> np.ndarray:
-    """[H, W, 4] straight RGBA (or [H, W, 3]) -> [H, W, 3] RGB composited over background."""
+    """[H, W, 4] straight RGBA (or [H, W, 3]) -> [H, W, 3] RGB composited over background
+    (RGB or RGBA, its alpha ignored; None: white)."""
     image = np.asarray(image, dtype=np.float64)
     if image.shape[2] == 3:
         return image
+    if background is None:
+        background = (1.0, 1.0, 1.0)
     a = image[..., 3:4]
     return image[..., :3] * a + np.asarray(background[:3], dtype=np.float64) * (1 - a)
 

@@ -205,8 +205,7 @@ class FrameSaver:
     def __call__(self, step) -> None:
         if step.iteration % self.every:
             return
-        bg = step.target.background
-        rgb = to_uint8(to_rgb(step.image.numpy(), bg[:3] if bg is not None else (1.0, 1.0, 1.0)))
+        rgb = to_uint8(to_rgb(step.image.numpy(), step.target.background))
         path = self.folder / f"frame_{step.iteration:05d}.png"
         atomic_write(path, lambda tmp: Image.fromarray(rgb, "RGB").save(tmp, format="PNG"))
         self.files.append(path)

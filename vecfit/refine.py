@@ -17,7 +17,7 @@ import torch
 
 from . import __version__
 from . import device as devices
-from .colors import parse_background
+from .colors import fitting_background
 from .errors import VecfitError
 from .imageio import load_rgba
 from .metrics import compare, to_rgb
@@ -93,7 +93,7 @@ def background_for(image: np.ndarray, setting: str) -> tuple | None:
     """'auto': transparent for a target with transparency, else its corners' colour."""
     if setting.strip().lower() == "auto":
         return None if float(image[..., 3].min()) < OPAQUE else corner_color(image)
-    return parse_background(setting)
+    return fitting_background(setting)
 
 
 def downscaled(image: np.ndarray, max_size: int) -> np.ndarray:
@@ -154,24 +154,24 @@ def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Out
     # The report marks a finished run: an old one must not sit beside new outputs if this
     # run dies before it writes its own.
     outputs.report.unlink(missing_ok=True)
-    opt = config["optimize"]
+    # "auto" settled once, for the loop, the full-size renders and the report alike
+    opt = {**config["optimize"], "device": devices.describe(devices.resolve(config["optimize"]["device"]))}
     settings = Settings.from_config(opt)
     background = background_for(target, opt["background"])
     h, w = target.shape[:2]
     small = downscaled(target, opt["max_size"])
     sh, sw = small.shape[:2]
     goal = Target(torch.from_numpy(small), background)
-    under = background[:3] if background is not None else (1.0, 1.0, 1.0)  # metrics: over white
-    target_rgb = to_rgb(target, under)
+    target_rgb = to_rgb(target, background)  # (metrics of a transparent target: over white)
 
     # Rendered bare and composited here (the same arithmetic as the core's background):
     # the alpha then also says whether the shapes cover the canvas.
     initial_image = _render_full(scene, w, h, opt)
-    initial_rgb = to_rgb(initial_image.numpy(), under)
+    initial_rgb = to_rgb(initial_image.numpy(), background)
     initial = compare(initial_rgb, target_rgb)
     result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
     final_image = initial_image if result.iterations == 0 else _render_full(scene, w, h, opt)
-    final_rgb = to_rgb(final_image.numpy(), under)
+    final_rgb = to_rgb(final_image.numpy(), background)
     final = compare(final_rgb, target_rgb)
     if not all(math.isfinite(final[k]) or (k == "psnr" and final["mse"] == 0) for k in final):
         raise VecfitError(f"the optimised image has non-finite values ({final}); nothing written")
@@ -179,7 +179,7 @@ def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Out
     # The SVG must look like what was optimised: where the shapes leave the canvas
     # uncovered, the background is written in as a first rect.
     covered = float(final_image[..., 3].min()) >= OPAQUE
-    svg_background = background if background is not None and background[3] > 0 and not covered else None
+    svg_background = background if background is not None and not covered else None
     write_svg(scene, source_svg, outputs.svg, background=svg_background)
     save_comparison(outputs.comparison, target_rgb, initial_rgb, final_rgb)
     seconds = time.perf_counter() - started
@@ -206,7 +206,7 @@ def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Out
         "loss": settings.loss,
         "loss_curve": result.losses,
         "seed": opt["seed"],
-        "device": devices.describe(devices.resolve(opt["device"])),  # what "auto" came to
+        "device": opt["device"],  # what "auto" came to
         "config": config,
     }
     save_report(outputs.report, report)

@@ -64,7 +64,7 @@ def robust_offsets(offset, valid, normal, mid, lengths) -> np.ndarray:
 
 def refine_outlines(outlines: list[np.ndarray], regions: np.ndarray, labels: np.ndarray,
                     rank: np.ndarray, colors: np.ndarray, rgb: np.ndarray,
-                    alpha: np.ndarray, holes: np.ndarray | None = None) -> list[np.ndarray]:
+                    alpha: np.ndarray, holes: np.ndarray) -> list[np.ndarray]:
     """The outlines (each [N, 2], vertices at the pixel corners and edge midpoints, as
     outlines.crack_outlines gives them; regions[k] is outline k's region, holes[k] whether
     it bounds a hole cut out of that region) with their visible edges moved to where the
@@ -82,8 +82,7 @@ def refine_outlines(outlines: list[np.ndarray], regions: np.ndarray, labels: np.
     # outward normal of each midpoint's edge, from the outline's direction and orientation
     x, y = pts[:, 0], pts[:, 1]
     ccw = np.bincount(owner, weights=x * y[nxt] - y * x[nxt], minlength=len(outlines)) > 0
-    if holes is not None:  # a hole's outside is the region
-        ccw ^= np.asarray(holes, bool)
+    ccw ^= holes  # a hole's outside is the region
     d = pts[nxt] - pts[prev]
     normal = np.stack([d[:, 1], -d[:, 0]], 1) * np.where(ccw[owner], 1.0, -1.0)[:, None]
     normal /= np.maximum(np.abs(normal).sum(1, keepdims=True), 1e-12)
