@@ -157,8 +157,8 @@ bool render_backward(const PreparedScene& prepared, const SceneArrays& a, const 
         BoundarySampler pass{sc, o.seed};
         ThreadPool::instance().parallel_for(lanes, lanes, [&](int lane, int) {
             const GradView g = grads[lane].view();
-            LaneLists lists(sizes);
-            Buffer<Hit> hits{lists.hits.data(), (int)lists.hits.size()};
+            std::vector<Hit> hit_list(sizes.hits);  // (the boundary term needs no tape)
+            Buffer<Hit> hits{hit_list.data(), (int)hit_list.size()};
             for (size_t k = lane; k < plan.pieces.size(); k += lanes) {
                 const Piece& pc = plan.pieces[k];
                 for (int j = 0; j < pc.count; ++j) boundary_sample(sc, bins, pass, pc, j, (uint64_t)k, plan.boundary, hits, g);

@@ -120,18 +120,9 @@ VF_HD void collect_hits_analytic(const SceneView& sc, const TileView& bins, Vec2
         const PreparedDraw& d = sc.draws[e.draw];
         Box near = grown(d.box, r);
         if (p.x < near.x0 || p.x > near.x1 || p.y < near.y0 || p.y > near.y1) continue;
-        LocalItems local(bins, e);
         Hit h;
         h.draw = e.draw;
-        if (d.kind == DRAW_STROKE) {
-            h.sd = stroke_sdf(sc, d, local, p, r, &h.arg);
-        } else if (d.is_ellipse) {
-            h.sd = ellipse_fill_sdf(d, p, r, &h.arg);
-        } else {
-            double dist = fill_distance(sc, d, local, p, r, &h.arg);
-            bool inside = winding_inside(tile_winding(sc, bins, e, region, p), d.fill_rule);
-            h.sd = inside ? -dist : dist;
-        }
+        h.sd = entry_sdf(sc, bins, e, region, p, r, &h.arg);
         h.cov = kernel_coverage(h.sd / r);
         if (h.cov <= 0) continue;
         paint_color(sc, sc.paints[d.paint], p, h.paint);

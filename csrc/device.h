@@ -21,7 +21,6 @@ struct Span {
     VF_HD const T& operator[](size_t i) const { return ptr[i]; }
     VF_HD const T* data() const { return ptr; }
     VF_HD size_t size() const { return n; }
-    VF_HD bool empty() const { return n == 0; }
 };
 
 template <class Vector>

@@ -437,20 +437,27 @@ VF_HD int seg_extrema(const Segment& s, int axis, double* ts) {
     return m;
 }
 
-// The curve's own bounds: its ends and its x and y extrema (a cubic's control polygon can
-// reach far past the curve, which refinement makes common, and every box feeds the tile
-// binning). Grown by a hair so that rounding in the extrema never leaves a curve point out.
-VF_HD Box seg_bbox(const Segment& s) {
+// The bounds of the curve's part on [t0, t1]: its ends and its x and y extrema inside
+// (tx, ty: the segment's, as seg_extrema gives them). A cubic's control polygon can reach
+// far past the curve, which refinement makes common, and every box feeds the tile
+// binning. Grown by a hair so that rounding in the extrema never leaves a curve point out.
+VF_HD Box seg_bbox(const Segment& s, double t0, double t1, const double* tx, int nx, const double* ty, int ny) {
     Box b;
-    expand(b, s.p[0]);
-    expand(b, s.p[s.degree]);
-    double ts[2];
-    for (int axis = 0; axis < 2; ++axis) {
-        int n = seg_extrema(s, axis, ts);
-        for (int i = 0; i < n; ++i) expand(b, seg_eval(s, ts[i]));
-    }
+    expand(b, seg_eval(s, t0));
+    expand(b, seg_eval(s, t1));
+    for (int i = 0; i < nx; ++i)
+        if (tx[i] > t0 && tx[i] < t1) expand(b, seg_eval(s, tx[i]));
+    for (int i = 0; i < ny; ++i)
+        if (ty[i] > t0 && ty[i] < t1) expand(b, seg_eval(s, ty[i]));
     double size = vmax(vmax(std::fabs(b.x0), std::fabs(b.x1)), vmax(std::fabs(b.y0), std::fabs(b.y1)));
     return grown(b, 1e-9 * (1 + size));
+}
+
+// The whole curve's bounds.
+VF_HD Box seg_bbox(const Segment& s) {
+    double tx[2], ty[2];
+    int nx = seg_extrema(s, 0, tx), ny = seg_extrema(s, 1, ty);
+    return seg_bbox(s, 0, 1, tx, nx, ty, ny);
 }
 
 // Power-basis coefficients of one coordinate of a segment: coord(t) = sum a[k] t^k.

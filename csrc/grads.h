@@ -21,7 +21,6 @@ struct GradRef {
         *p += v;
 #endif
     }
-    VF_HD void operator-=(double v) const { *this += -v; }
 };
 
 struct GradPtr {

@@ -23,19 +23,19 @@ PreparedSegment prepare_segment(const Segment& s, const int32_t* idx) {
     PreparedSegment ps;
     ps.seg = s;
     for (int i = 0; i < 4; ++i) ps.point_index[i] = idx ? idx[i] : -1;
-    ps.box = seg_bbox(s);
-    double ext[2];
-    int n = seg_extrema(s, 1, ext);
+    double tx[2], ty[2];
+    int nx = seg_extrema(s, 0, tx), ny = seg_extrema(s, 1, ty);
+    ps.box = seg_bbox(s, 0, 1, tx, nx, ty, ny);
     ps.n_split = 0;
     ps.split[ps.n_split++] = 0;
-    for (int i = 0; i < n; ++i)
-        if (ext[i] > ps.split[ps.n_split - 1]) ps.split[ps.n_split++] = ext[i];
+    for (int i = 0; i < ny; ++i)
+        if (ty[i] > ps.split[ps.n_split - 1]) ps.split[ps.n_split++] = ty[i];
     ps.split[ps.n_split++] = 1;
     for (int i = 0; i < ps.n_split; ++i) ps.split_y[i] = seg_eval(s, ps.split[i]).y;
     seg_axis_poly(s, 0, ps.ax);
     seg_axis_poly(s, 1, ps.ay);
     for (int k = 0; k + 1 < ps.n_split; ++k) {
-        Box b = seg_bbox(seg_part(s, ps.split[k], ps.split[k + 1]));
+        Box b = seg_bbox(s, ps.split[k], ps.split[k + 1], tx, nx, nullptr, 0);  // (no y-extrema inside)
         ps.piece_x0[k] = b.x0;
         ps.piece_x1[k] = b.x1;
     }

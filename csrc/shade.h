@@ -51,32 +51,29 @@ struct Compositor {
     }
 };
 
-// Coverage of one draw at p in [0, 1]: a step (Monte Carlo) or the prefiltered kernel.
+// Coverage of one draw at p in [0, 1]: a step (Monte Carlo) or the prefiltered kernel,
+// from the tile's entry, or, brute force, from every item of the draw.
 VF_HD double entry_coverage(const SceneView& sc, const TileView& bins, const TileEntry& e, const Box& region,
                             Vec2 p, const RenderOptions& o) {
-    const PreparedDraw& d = sc.draws[e.draw];
     const bool analytic = o.mode == MODE_ANALYTIC;
     const double r = o.filter_radius;
-    if (!analytic && !o.brute_force) return entry_covers(sc, bins, e, region, p) ? 1.0 : 0.0;
+    if (!o.brute_force) {
+        if (analytic) return kernel_coverage(entry_sdf(sc, bins, e, region, p, r) / r);
+        return entry_covers(sc, bins, e, region, p) ? 1.0 : 0.0;
+    }
+    const PreparedDraw& d = sc.draws[e.draw];
     if (d.is_ellipse && d.kind == DRAW_FILL) {
         if (analytic) return kernel_coverage(ellipse_fill_sdf(d, p, r) / r);
         return ellipse_contains(d.ellipse, p) ? 1.0 : 0.0;
     }
-    // The analytical prefilter, or the brute-force check of the tiles (every item of the draw).
-    LocalItems local(bins, e);
     AllItems all{d.n_items};
-    const bool brute = o.brute_force;
     if (d.kind == DRAW_STROKE) {
-        if (analytic) {
-            double sd = brute ? stroke_sdf(sc, d, all, p, r) : stroke_sdf(sc, d, local, p, r);
-            return kernel_coverage(sd / r);
-        }
+        if (analytic) return kernel_coverage(stroke_sdf(sc, d, all, p, r) / r);
         return stroke_contains(sc, d, all, p) ? 1.0 : 0.0;
     }
-    int w = brute ? draw_winding_all(sc, d, p) : tile_winding(sc, bins, e, region, p);
-    bool inside = winding_inside(w, d.fill_rule);
+    bool inside = winding_inside(draw_winding_all(sc, d, p), d.fill_rule);
     if (!analytic) return inside ? 1.0 : 0.0;
-    double dist = brute ? fill_distance(sc, d, all, p, r) : fill_distance(sc, d, local, p, r);
+    double dist = fill_distance(sc, d, all, p, r);
     return kernel_coverage((inside ? -dist : dist) / r);
 }
 

@@ -102,4 +102,16 @@ VF_HD bool entry_covers(const SceneView& sc, const TileView& bins, const TileEnt
     return winding_inside(tile_winding(sc, bins, e, region, p), d.fill_rule);
 }
 
+// Signed distance from p to the entry's draw (negative inside; searched within r): what
+// the analytical prefilter's coverage is made from. `arg`, if given, says where the
+// closest point lies, for the derivatives.
+VF_HD double entry_sdf(const SceneView& sc, const TileView& bins, const TileEntry& e, const Box& region, Vec2 p,
+                       double r, SdfArg* arg = nullptr) {
+    const PreparedDraw& d = sc.draws[e.draw];
+    if (d.kind == DRAW_STROKE) return stroke_sdf(sc, d, LocalItems(bins, e), p, r, arg);
+    if (d.is_ellipse) return ellipse_fill_sdf(d, p, r, arg);
+    double dist = fill_distance(sc, d, LocalItems(bins, e), p, r, arg);
+    return winding_inside(tile_winding(sc, bins, e, region, p), d.fill_rule) ? -dist : dist;
+}
+
 }  // namespace vf
