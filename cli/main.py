@@ -25,8 +25,18 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
     _echo_err(f"warning: {message}")
 
 
+def _print_version(ctx, param, value):
+    if not value or ctx.resilient_parsing:
+        return
+    from vecfit import __version__
+    from vecfit.device import core_build
+    click.echo(f"vecfit {__version__} (core: {core_build()})")
+    ctx.exit()
+
+
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(package_name="vecfit")
+@click.option("--version", is_flag=True, expose_value=False, is_eager=True, callback=_print_version,
+              help="Show the version and the compiled core's build, then exit.")
 def main():
     """vecfit: turn raster images into vector graphics and refine vector graphics
     against images, with a differentiable rasterizer."""

@@ -221,6 +221,11 @@ PYBIND11_MODULE(_core, m) {
 #endif
         );
         info["cuda"] = gpu::build_info();
+#ifdef VECFIT_WITH_CUDA
+        info["cuda_archs"] = std::string(VECFIT_CUDA_ARCHS);
+#else
+        info["cuda_archs"] = std::string();
+#endif
         info["hardware_threads"] = ThreadPool::hardware_threads();
         return info;
     });

@@ -10,19 +10,24 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import importlib.resources
 import tomllib
 from pathlib import Path
 
 from .errors import VecfitError
 
 
-def configs_dir() -> Path:
-    """configs/ of a source checkout or an editable install, else the installed copy."""
-    here = Path(__file__).resolve().parent
-    for candidate in (here / "configs", here.parent / "configs"):
-        if (candidate / "refine.toml").is_file():
-            return candidate
-    raise VecfitError("the default settings (configs/refine.toml) are missing from this installation")
+def configs_dir():
+    """The default settings: the package vecfit.configs, which the wheel and the editable
+    install both map to the repository's configs/ (pyproject.toml's wheel.packages)."""
+    try:
+        root = importlib.resources.files("vecfit.configs")
+    except ModuleNotFoundError:
+        root = None
+    if root is None or not (root / "refine.toml").is_file():
+        raise VecfitError("the default settings (vecfit/configs/refine.toml) are missing from "
+                          "this installation: reinstall vecfit")
+    return root
 
 
 def read_toml(path) -> dict:

@@ -52,6 +52,14 @@ def describe(index: int) -> str:
     return "cpu" if index == CPU else f"cuda:{index}"
 
 
+def core_build() -> str:
+    """The compiled core in a few words, e.g. "CPU, gcc 12.2.0" or "CPU + CUDA 80-real
+    90-real, gcc 12.2.0" (`vecfit --version`)."""
+    info = _core.build_info()
+    kinds = f"CPU + CUDA {info['cuda_archs']}" if info["cuda_archs"] else "CPU"
+    return f"{kinds}, {info['compiler']}"
+
+
 def build_summary() -> str:
     """What this build of the core has, one fact a line (`vecfit info --build`)."""
     from . import __version__
