@@ -33,7 +33,7 @@ def resvg_rgb(svg, width: int, background=(1.0, 1.0, 1.0)):
     import resvg_py
     from PIL import Image
 
-    from vecfit.metrics import to_rgb
+    from vecfit.fitting.metrics import to_rgb
     png = bytes(resvg_py.svg_to_bytes(svg_path=str(svg), width=width))
     rgba = np.asarray(Image.open(io.BytesIO(png)).convert("RGBA"), np.float64) / 255
     return to_rgb(rgba, background)

@@ -33,8 +33,8 @@ def main():
     args = ap.parse_args()
 
     import vecfit
-    from vecfit.device import build_summary
-    from vecfit.render import backward_fallbacks
+    from vecfit.renderer.device import build_summary
+    from vecfit.renderer.raster import backward_fallbacks
     print(build_summary())
     if not vecfit.has_cuda() or vecfit.cuda_device_count() == 0:
         sys.exit("no CUDA build or no GPU here: nothing to measure")

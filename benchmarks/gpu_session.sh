@@ -21,7 +21,7 @@ nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv || echo "(n
 # A CUDA build that sees no device would skip every GPU test: stop here instead, saying why.
 python3 -c "
 import sys, vecfit
-from vecfit.device import build_summary
+from vecfit.renderer.device import build_summary
 print(build_summary())
 sys.exit(0 if vecfit.cuda_device_count() > 0 else 'no CUDA device is visible to vecfit')" || exit 1
 status=0

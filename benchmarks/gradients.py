@@ -18,7 +18,7 @@ import torch
 from common import scene_workload, timed
 
 import vecfit
-from vecfit.scene import Path, Scene, Shape, Solid
+from vecfit.renderer.scene import Path, Scene, Shape, Solid
 
 
 def strokes_scene(n, size, seed=0):

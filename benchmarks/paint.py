@@ -14,9 +14,9 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from vecfit.config import resolve
-from vecfit.paint_job import paint
-from vecfit.refine import Outputs
+from vecfit.jobs.config import resolve
+from vecfit.jobs.paint import run as paint
+from vecfit.jobs.fit import Outputs
 
 CHECKPOINTS = (0, 50, 100, 200, 300, 400, 500)
 

@@ -14,10 +14,11 @@ from pathlib import Path
 
 from common import SHARED, resvg_rgb
 
-from vecfit.colors import parse_background
-from vecfit.config import resolve
-from vecfit.metrics import compare, to_rgb
-from vecfit.refine import Outputs, load_target, refine
+from vecfit.io.colors import parse_background
+from vecfit.jobs.config import resolve
+from vecfit.fitting.metrics import compare, to_rgb
+from vecfit.jobs.fit import Outputs, load_target
+from vecfit.jobs.refine import run as refine
 
 PHOTOS = SHARED / "data" / "photos"
 TARGETS = {"kitty": "kitty.jpg", "peppers": "peppers.png"}

@@ -50,7 +50,7 @@ def render_svg(svg: str, width: int, height: int) -> np.ndarray:
 def measure(image: np.ndarray, settings) -> dict:
     from skimage.metrics import peak_signal_noise_ratio
 
-    from vecfit.trace import trace_image
+    from vecfit.initial.trace import trace_image
 
     start = time.perf_counter()
     result = trace_image(image, settings)
@@ -77,7 +77,7 @@ def main():
     budgets = [int(b) for b in args.budgets.split(",")]
     images = args.images.split(",")
 
-    from vecfit.trace import TraceSettings
+    from vecfit.initial.trace import TraceSettings
 
     defaults = TraceSettings()
     print(f"defaults: colors={defaults.colors} min_area={defaults.min_area} "
@@ -118,11 +118,11 @@ def refine_table(budgets, images, iterations, threads):
     """Trace + refine with the defaults: PSNR before / after and wall time per image."""
     from PIL import Image
 
-    from vecfit.colors import parse_background
-    from vecfit.config import resolve
-    from vecfit.metrics import compare
-    from vecfit.refine import Outputs
-    from vecfit.trace_job import trace
+    from vecfit.io.colors import parse_background
+    from vecfit.jobs.config import resolve
+    from vecfit.fitting.metrics import compare
+    from vecfit.jobs.fit import Outputs
+    from vecfit.jobs.trace import run as trace
     from common import resvg_rgb  # (benchmarks/ is on sys.path: the script's own folder)
 
     print("| image | budget | paths | PSNR trace | PSNR refined (vecfit) | PSNR refined (resvg) "

@@ -63,7 +63,7 @@ def over_white(rgba: np.ndarray) -> np.ndarray:
 
 def run_case(case: Case) -> tuple[Result, np.ndarray | None, np.ndarray]:
     import vecfit
-    from vecfit.imageio import load_rgba, to_uint8
+    from vecfit.io.images import load_rgba, to_uint8
 
     expected = load_rgba(case.png)
     try:

@@ -9,7 +9,7 @@ import pytest
 from click.testing import CliRunner
 
 import vecfit
-from vecfit.cli.main import main
+from vecfit.cli.commands import main
 
 
 def run(*args):

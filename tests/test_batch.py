@@ -18,7 +18,7 @@ from vecfit.batch import (DONE, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, EXIT_USA
                           INTERRUPTED, NOT_RUN, SKIPPED, UNPAIRED, available_cores, run_batch)
 from vecfit.batch.execute import CRASHED
 from helpers import run
-from vecfit.config import configs_dir
+from vecfit.jobs.config import configs_dir
 
 SIZE = 32
 
@@ -206,8 +206,8 @@ def test_init_dir_pairs_svgs_from_another_folder(tmp_path):
 def test_interrupted_image_is_not_taken_as_finished(folder, tmp_path, monkeypatch):
     """Ctrl-C during b: exit 130, a kept, b's best-so-far marked interrupted, c not run;
     nothing half-written. The next run redoes b and only b."""
-    import vecfit.refine as refine_module
-    real = refine_module.optimize
+    import vecfit.jobs.fit as fit_module
+    real = fit_module.optimize
 
     def interrupted(scene, target, settings, progress=None, **kwargs):
         def stop(p):
@@ -215,7 +215,7 @@ def test_interrupted_image_is_not_taken_as_finished(folder, tmp_path, monkeypatc
                 raise KeyboardInterrupt
         return real(scene, target, settings, progress=stop, **kwargs)
 
-    monkeypatch.setattr(refine_module, "optimize", interrupted)
+    monkeypatch.setattr(fit_module, "optimize", interrupted)
     out = tmp_path / "out"
     cfg = config(tmp_path)
     r = run("batch", folder, "-o", out, "--mode", "refine", "--config", cfg)
@@ -226,7 +226,7 @@ def test_interrupted_image_is_not_taken_as_finished(folder, tmp_path, monkeypatc
     assert json.loads((out / "b.report.json").read_text())["interrupted"] is True
     no_leftovers(out)
 
-    monkeypatch.setattr(refine_module, "optimize", real)
+    monkeypatch.setattr(fit_module, "optimize", real)
     a = mtimes(out, "a.svg")
     assert run("batch", folder, "-o", out, "--mode", "refine", "--config", cfg).exit_code == 1
     assert statuses(out) == {"a.png": SKIPPED, "b.png": DONE, "c.png": FAILED, "d.png": UNPAIRED}
@@ -240,7 +240,7 @@ def test_interrupted_image_is_not_taken_as_finished(folder, tmp_path, monkeypatc
 def exploding_refine(target, svg, config, outputs, progress=None):
     if Path(target).stem == "a":
         raise RuntimeError("boom")
-    from vecfit.refine import refine
+    from vecfit.jobs.refine import run as refine
     report = refine(target, svg, config, outputs, progress=progress)
     if Path(target).stem == "b":
         report["optimized"]["mse"] = math.nan
@@ -250,7 +250,7 @@ def exploding_refine(target, svg, config, outputs, progress=None):
 def crashing_refine(target, svg, config, outputs, progress=None):
     if Path(target).stem == "crash":
         os._exit(3)  # as a crash in native code would end the worker
-    from vecfit.refine import refine
+    from vecfit.jobs.refine import run as refine
     return refine(target, svg, config, outputs, progress=progress)
 
 

@@ -81,7 +81,7 @@ class TestWithoutCuda:
 
 
     def test_optimising_commands_refuse_cuda(self, tmp_path):
-        from vecfit.imageio import save_png
+        from vecfit.io.images import save_png
         save_png(torch.from_numpy(np.full((16, 16, 4), 0.5, np.float32)), tmp_path / "in" / "a.png")
         for args in (["trace", str(tmp_path / "in" / "a.png"), "-o", str(tmp_path / "a.svg")],
                      ["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--mode", "trace"]):
@@ -164,7 +164,7 @@ def test_gpu_list_sizes_on_the_cpu(mode, make, depth, falls_back):
     discs deep fits and gives the very same gradients, as do 16 in nested groups; 40 deep
     overflow the hits, 30 in nested groups the tape (15 pairs x 8 steps), which is flagged,
     and the pass is redone with lists sized to the scene, as a GPU run would be."""
-    from vecfit.render import backward_fallbacks
+    from vecfit.renderer.raster import backward_fallbacks
     scene = make(depth)
     before = backward_fallbacks()
     emulated = gradients(scene, samples=2, mode=mode, threads=2, _gpu_lists=True)
@@ -177,7 +177,7 @@ def test_gpu_list_sizes_on_the_cpu(mode, make, depth, falls_back):
 def test_benchmark_scenes_fit_a_gpu_thread():
     """The scenes the GPU is timed on never overflow a GPU thread's lists, so the GPU
     timings are not CPU fallbacks."""
-    from vecfit.render import backward_fallbacks
+    from vecfit.renderer.raster import backward_fallbacks
     names = ["tiger", "boston", "mcseem2"]
     if not all((SCENES / f"{n}.svg").exists() for n in names):
         pytest.skip("the shared benchmark scenes are not present")
@@ -218,7 +218,7 @@ def test_gpu_matches_cpu_on_conformance_corpus():
 def test_gpu_gradients_match_cpu(mode):
     # The tiger: fills and strokes, many overlaps, group transforms. Same seed, so the
     # same pixel and boundary samples on both devices; only the order of the sums differs.
-    from vecfit.render import backward_fallbacks
+    from vecfit.renderer.raster import backward_fallbacks
     scene = quiet_load(ROOT / "examples" / "tiger.svg")
     fallbacks = backward_fallbacks()
     grads = {device: gradients(scene, width=160, height=160, samples=2, mode=mode, device=device)

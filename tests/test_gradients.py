@@ -20,8 +20,8 @@ import pytest
 import torch
 
 import vecfit
-from vecfit.scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient, Rect, Scene,
-                          Shape, Solid)
+from vecfit.renderer.scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient,
+                                   Rect, Scene, Shape, Solid)
 
 SIZE = 40
 SAMPLES = 16

@@ -122,7 +122,7 @@ def test_sdist_carries_the_sources(tmp_path):
         names = {n.split("/", 1)[1] for n in tar.getnames() if "/" in n}
     for needed in ("README.md", "LICENSE", "pyproject.toml", "CMakeLists.txt",
                    "configs/refine.toml", "configs/trace.toml", "configs/paint.toml",
-                   "cli/main.py", "vecfit/__init__.py", "vecfit/__main__.py"):
+                   "cli/commands.py", "vecfit/__init__.py", "vecfit/__main__.py"):
         assert needed in names, needed
     assert any(n.startswith("csrc/") and n.endswith(".cpp") for n in names)
     assert not any(n.startswith(("build/", ".venv/", "out/")) for n in names)

@@ -11,10 +11,10 @@ from PIL import Image
 
 import vecfit
 from helpers import photo_png, quiet_load, run
-from vecfit.metrics import compare
-from vecfit.optimize import Step, Target
-from vecfit.painterly import PaintSettings, Reseeder, initial_svg
-from vecfit.scene import Path as PathGeometry, Scene, Shape, Solid
+from vecfit.fitting.metrics import compare
+from vecfit.fitting.loop import Step, Target
+from vecfit.initial.strokes import PaintSettings, Reseeder, initial_svg
+from vecfit.renderer.scene import Path as PathGeometry, Scene, Shape, Solid
 
 
 @pytest.fixture(scope="module")

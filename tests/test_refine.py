@@ -12,14 +12,14 @@ import torch
 from PIL import Image
 
 import vecfit
-from vecfit import losses
+from vecfit.fitting import losses
 from helpers import need, quiet_load, run
-from vecfit.colors import parse_background
-from vecfit.config import resolve
+from vecfit.io.colors import parse_background
+from vecfit.jobs.config import resolve
 from vecfit.errors import VecfitError
-from vecfit.metrics import compare
-from vecfit.optimize import Settings, Target, optimize
-from vecfit.scene import Circle, LinearGradient, Scene, Shape, Solid
+from vecfit.fitting.metrics import compare
+from vecfit.fitting.loop import Settings, Target, optimize
+from vecfit.renderer.scene import Circle, LinearGradient, Scene, Shape, Solid
 
 from shared_data import SHARED
 PEPPERS = SHARED / "data" / "photos" / "peppers.png"
@@ -276,8 +276,8 @@ def test_nan_loss_never_reaches_the_scene(monkeypatch):
 
 
 def test_nan_gradient_is_refused(monkeypatch):
-    import vecfit.optimize as opt
-    real = opt._Kind.gradient
+    import vecfit.fitting.adam as adam
+    real = adam.ParameterKind.gradient
     calls = {"n": 0}
 
     def poisoned(self):
@@ -285,7 +285,7 @@ def test_nan_gradient_is_refused(monkeypatch):
         g = real(self)
         return g * float("inf") if calls["n"] == 2 else g
 
-    monkeypatch.setattr(opt._Kind, "gradient", poisoned)
+    monkeypatch.setattr(adam.ParameterKind, "gradient", poisoned)
     scene = _circle_scene()
     result = optimize(scene, _disc_target(), Settings(iterations=6, lr_warmup=0, threads=1, lr={"points": 1.0}))
     assert result.skipped_steps == 1
@@ -310,8 +310,8 @@ def test_interrupt_keeps_the_best_so_far():
 
 
 def test_interrupted_cli_run_writes_best_result(tmp_path, monkeypatch):
-    import vecfit.refine as refine_module
-    real = refine_module.optimize
+    import vecfit.jobs.fit as fit_module
+    real = fit_module.optimize
 
     def interrupted(scene, target, settings, progress=None, **kwargs):
         def stop(p):
@@ -321,7 +321,7 @@ def test_interrupted_cli_run_writes_best_result(tmp_path, monkeypatch):
                 raise KeyboardInterrupt
         return real(scene, target, settings, progress=stop, **kwargs)
 
-    monkeypatch.setattr(refine_module, "optimize", interrupted)
+    monkeypatch.setattr(fit_module, "optimize", interrupted)
     target = disc_image(tmp_path / "t.png")
     svg = circle_svg(tmp_path / "c.svg")
     r = run("refine", target, svg, "--iterations", 100, "--threads", 1, "-q")
@@ -399,7 +399,7 @@ def test_settings_are_checked():
 def test_target_is_compared_over_an_explicit_background():
     """With a background given, the loss sees the target over it, as the render is: a
     transparent target pixel over white is white, not its (black) RGB."""
-    from vecfit.optimize import Target
+    from vecfit.fitting.loop import Target
     image = torch.zeros(2, 2, 4)
     image[0, 0] = torch.tensor([1.0, 0.0, 0.0, 1.0])
     seen = Target(image, background=(1.0, 1.0, 1.0, 1.0)).compared(image)
@@ -414,5 +414,5 @@ def test_translucent_background_is_a_usage_error(tmp_path):
 
 def test_settings_defaults_are_the_config_defaults():
     """The Python API's Settings() starts where `vecfit refine` does."""
-    from vecfit.config import configs_dir, read_toml
+    from vecfit.jobs.config import configs_dir, read_toml
     assert Settings() == Settings.from_config(read_toml(configs_dir() / "refine.toml")["optimize"])

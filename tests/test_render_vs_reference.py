@@ -38,8 +38,8 @@ import pytest
 import torch
 
 from reference_render import premultiply, render_reference
-from vecfit.scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient, Rect,
-                          Scene, Shape, Solid)
+from vecfit.renderer.scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient,
+                                   Rect, Scene, Shape, Solid)
 
 pytest.importorskip(
     "vecfit._core", reason="vecfit._core is not built (compile the C++ core to run these tests)")

@@ -1,4 +1,4 @@
-"""The SVG reader: SVG files -> Scene (vecfit.svg.read.load_svg) and describe()."""
+"""The SVG reader: SVG files -> Scene (vecfit.svg.read.load_svg) and summarize()."""
 from __future__ import annotations
 
 import csv
@@ -13,10 +13,10 @@ import pytest
 import torch
 
 from helpers import need
-from vecfit.describe import describe
+from vecfit.io.scene_summary import summarize
 from vecfit.errors import SvgError
-from vecfit.scene import (Circle, Ellipse, LinearGradient, Path as PathGeometry, RadialGradient,
-                          Rect, Scene, Solid)
+from vecfit.renderer.scene import (Circle, Ellipse, LinearGradient, Path as PathGeometry,
+                                   RadialGradient, Rect, Scene, Solid)
 from vecfit.svg import VecfitWarning, load_svg
 from vecfit.svg.color import parse_color
 from vecfit.svg.pathdata import PathDataError, parse_path_data
@@ -816,7 +816,7 @@ def test_describe_counts(tmp_path):
             <g opacity="0.5"><path d="M0 0 L 1 1 Q 2 2 3 3 C 4 4 5 5 6 6 Z"/><rect width="1" height="1"
             fill="url(#g)" stroke="red"/></g><circle r="2" opacity="0.5"/><text id="t">x</text>""",
             'width="300" height="150" viewBox="0 0 200 100"'))
-    text = describe(scene)
+    text = summarize(scene)
     assert "canvas: 300 x 150 px" in text
     assert "viewBox: 0 0 200 100" in text
     assert "shapes: 3 (1 path, 1 rect, 1 circle, 0 ellipse)" in text
@@ -828,6 +828,6 @@ def test_describe_counts(tmp_path):
 
 
 def test_describe_tiger():
-    text = describe(quiet_load(need(DATA / "scenes" / "tiger.svg")))
+    text = summarize(quiet_load(need(DATA / "scenes" / "tiger.svg")))
     assert "shapes: 303 (303 path" in text and "segments: 2534" in text
     assert "skipped: nothing" in text

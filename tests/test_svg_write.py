@@ -14,9 +14,10 @@ import torch
 
 import vecfit
 from vecfit.errors import SvgError, VecfitError
-from vecfit.scene import Circle, Ellipse, LinearGradient, Path as PathGeometry, Solid
+from vecfit.renderer.scene import Circle, Ellipse, LinearGradient, Path as PathGeometry, Solid
 from vecfit.svg import VecfitWarning
-from vecfit.svg.write import fmt, path_data, write_svg
+from vecfit.svg.numbers import fmt
+from vecfit.svg.write import path_data, write_svg
 
 from helpers import need, quiet_load
 from shared_data import SHARED

@@ -10,8 +10,8 @@ from skimage.metrics import peak_signal_noise_ratio
 
 import vecfit
 from vecfit import VecfitError
-from vecfit.trace import TraceResult, TraceSettings, trace_image
-from vecfit.trace.bezier import bezier, fit_closed
+from vecfit.initial.trace import TraceResult, TraceSettings, trace_image
+from vecfit.initial.trace.bezier import bezier_at, fit_closed
 
 
 # ----------------------------------------------------------------------------- helpers
@@ -123,7 +123,7 @@ def test_circle_fit_within_tolerance(tolerance):
     segs = fit_closed(pts, tolerance, 135.0)
     assert 2 <= len(segs) <= (4 if tolerance == 1.0 else 8)
     assert np.allclose(segs[1:, 0], segs[:-1, 3]) and np.allclose(segs[0, 0], segs[-1, 3])
-    curve = np.concatenate([bezier(s, np.linspace(0, 1, 64)) for s in segs])
+    curve = np.concatenate([bezier_at(s, np.linspace(0, 1, 64)) for s in segs])
     radius = np.hypot(curve[:, 0] - 40, curve[:, 1] - 30)
     assert np.abs(radius - 20).max() <= tolerance
 

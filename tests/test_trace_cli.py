@@ -10,7 +10,7 @@ from PIL import Image
 
 import vecfit
 from helpers import photo_png, quiet_load, run
-from vecfit.metrics import compare
+from vecfit.fitting.metrics import compare
 
 
 @pytest.fixture(scope="module")

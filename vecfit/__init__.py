@@ -1,11 +1,17 @@
-"""vecfit: vectorize raster images and refine vector graphics against them."""
-from .device import cuda_device_count, has_cuda
+"""vecfit: vectorize raster images and refine vector graphics against them.
+
+The public API: load_svg, render, the Scene and its parts, and the device queries."""
 from .errors import SvgError, VecfitError
-from .render import render
-from .scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient, Rect,
-                    Scene, Shape, Solid)
+from .renderer.device import cuda_device_count, has_cuda
+from .renderer.raster import render
+from .renderer.scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient, Rect,
+                             Scene, Shape, Solid)
 
 __version__ = "0.1.0"
+
+__all__ = ["Circle", "Ellipse", "Group", "LinearGradient", "Path", "RadialGradient", "Rect", "Scene",
+           "Shape", "Solid", "SvgError", "VecfitError", "cuda_device_count", "has_cuda", "load_svg",
+           "render", "__version__"]
 
 
 def load_svg(path) -> Scene:

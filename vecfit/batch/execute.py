@@ -12,7 +12,8 @@ import threading
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 
-from ..errors import VecfitError
+from vecfit.errors import VecfitError
+
 from .plan import FAILED, INTERRUPTED, Task, result_row
 from .work import init_worker, run_task
 

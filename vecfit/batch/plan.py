@@ -15,14 +15,14 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..refine import Outputs, same_path
+from vecfit.jobs.fit import Outputs, same_path
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp")
 SVG_SUFFIXES = (".svg", ".svgz")
 MODES = ("refine", "trace", "paint")
 # The job function of each mode, as "module:function", imported where the task runs.
-JOBS = {"refine": "vecfit.refine:refine", "trace": "vecfit.trace_job:trace",
-        "paint": "vecfit.paint_job:paint"}
+JOBS = {"refine": "vecfit.jobs.refine:run", "trace": "vecfit.jobs.trace:run",
+        "paint": "vecfit.jobs.paint:run"}
 
 # Statuses of a summary row.
 DONE = "done"

@@ -10,7 +10,7 @@ import click
 from .plan import DONE, INTERRUPTED, SKIPPED
 
 
-def describe(row: dict) -> str:
+def outcome_line(row: dict) -> str:
     """One image's outcome in a line: status, PSNR before -> after, seconds or reason."""
     text = f"{row['file']}: {row['status']}"
     if row["status"] in (DONE, SKIPPED, INTERRUPTED) and row.get("psnr_after") is not None:
@@ -59,7 +59,7 @@ class Progress:
             return
         if self.bar is not None:  # the line goes above the bar: clear the bar's line first
             self.file.write("\r\033[K")
-        click.echo(f"[{self.done}/{self.total}] {describe(row)}", file=self.file)
+        click.echo(f"[{self.done}/{self.total}] {outcome_line(row)}", file=self.file)
         if self.bar is not None:
             self.bar.update(1)
 

@@ -11,8 +11,9 @@ from urllib.parse import quote
 
 from PIL import Image
 
-from ..imageio import atomic_write, atomic_write_text
-from ..report import GAP, save_report
+from vecfit.io.images import atomic_write, atomic_write_text
+from vecfit.io.report import GAP, save_report
+
 from .plan import DONE, INTERRUPTED, NOT_RUN, ROW_FIELDS, SKIPPED, STATUSES
 
 THUMB = 160  # longest side of a thumbnail, pixels

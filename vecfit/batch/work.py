@@ -18,7 +18,8 @@ import traceback
 import warnings
 from pathlib import Path
 
-from ..errors import VecfitError
+from vecfit.errors import VecfitError
+
 from .plan import DONE, FAILED, INTERRUPTED, NOT_RUN, Task, result_row
 
 _state = {"running": False, "stop": False, "raised": False, "event": None}

@@ -5,7 +5,7 @@ import gzip
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from ..errors import SvgError
+from vecfit.errors import SvgError
 
 SVG_NS = "http://www.w3.org/2000/svg"
 XLINK_HREF = "{http://www.w3.org/1999/xlink}href"

@@ -20,16 +20,17 @@ from collections import Counter
 import numpy as np
 import torch
 
-from ..errors import SvgError
-from ..scene import Group, Scene, Shape
+from vecfit.errors import SvgError
+from vecfit.renderer.scene import Group, Scene, Shape
+
+from .brushes import BLACK, Paints, parse_opacity, parse_paint
 from .color import parse_color
 from .dom import href_id, is_svg, local_name, read_root
-from .paint import BLACK, Paints, parse_opacity, parse_paint
 from .shapes import Limiter, ShapeReader
 from .skips import Skips, VecfitWarning
 from .style import Cascade, StyleSheet
-from .units import parse_length, parse_number, parse_transform, parse_viewbox, translate, \
-    view_transform
+from .units import (parse_length, parse_number, parse_transform, parse_viewbox, translate,
+                    view_transform)
 
 __all__ = ["load_svg", "VecfitWarning"]
 
@@ -59,7 +60,7 @@ def load_svg(path) -> Scene:
     ``scene.skipped``. An SVG without drawable shapes gives an empty Scene.
     """
     root = read_root(path)
-    reader = _Reader(path, root)
+    reader = Reader(path, root)
     try:
         scene = reader.read()
     except RecursionError:
@@ -91,7 +92,7 @@ def _singular(m: np.ndarray | None) -> bool:
     return m is not None and abs(m[0, 0] * m[1, 1] - m[0, 1] * m[1, 0]) == 0
 
 
-class _Reader:
+class Reader:
     def __init__(self, path, root):
         self.path = path
         self.root = root

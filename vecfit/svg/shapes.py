@@ -12,7 +12,8 @@ import re
 
 import torch
 
-from ..scene import Circle, Ellipse, Path, Rect
+from vecfit.renderer.scene import Circle, Ellipse, Path, Rect
+
 from .pathdata import PathDataError, Subpath, parse_path_data, to_arrays
 from .units import clamp_array, parse_length, parse_number
 

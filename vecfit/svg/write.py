@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import gzip
 import io
-import math
 import re
 import warnings
 import xml.etree.ElementTree as ET
@@ -27,11 +26,14 @@ from pathlib import Path as FsPath
 import numpy as np
 import torch
 
-from ..errors import VecfitError
-from ..imageio import atomic_write
-from ..scene import Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect, Scene, Solid
+from vecfit.errors import VecfitError
+from vecfit.io.images import atomic_write
+from vecfit.renderer.scene import (Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect,
+                                   Scene, Solid)
+
+from .brushes import GRADIENTS
 from .dom import local_name, read_root
-from .paint import GRADIENTS
+from .numbers import finite, fmt, hex_color, matrix
 from .skips import VecfitWarning
 from .style import INHERITED
 from .units import parse_length, parse_viewbox, translate
@@ -44,40 +46,9 @@ INITIAL = {"opacity": "1", "fill-opacity": "1", "stroke-opacity": "1", "stop-opa
            "fill": "black", "stroke": "none", "stroke-width": "1"}
 
 
-# ------------------------------------------------------------------------ numbers
-
-def fmt(value, decimals: int = 4) -> str:
-    """A finite number, compact: at most ``decimals`` decimals, no trailing zeros."""
-    v = float(value)
-    if not math.isfinite(v):
-        raise VecfitError(f"cannot write a non-finite value ({v}) to SVG")
-    s = f"{v:.{decimals}f}"
-    if "." in s:
-        s = s.rstrip("0").rstrip(".")
-    return "0" if s in ("-0", "") else s
-
-
-def hex_color(rgba) -> str:
-    r, g, b = (min(max(float(c), 0.0), 1.0) for c in _finite(rgba)[:3])
-    return "#{:02x}{:02x}{:02x}".format(*(int(round(c * 255)) for c in (r, g, b)))
-
-
-def matrix(m) -> str:
-    a = _finite(m)
-    return "matrix({})".format(" ".join(fmt(v, 6) for v in
-                                        (a[0, 0], a[1, 0], a[0, 1], a[1, 1], a[0, 2], a[1, 2])))
-
-
-def _finite(t) -> np.ndarray:
-    a = t.detach().cpu().double().numpy() if isinstance(t, torch.Tensor) else np.asarray(t, float)
-    if not np.isfinite(a).all():
-        raise VecfitError("cannot write non-finite values (NaN or infinity) to SVG")
-    return a
-
-
 def path_data(path: Path) -> str:
     """Absolute M/L/Q/C/Z path data; a closed subpath's closing line is Z."""
-    pts = _finite(path.points)
+    pts = finite(path.points)
     out, p = [], 0
     letters = {1: "L", 2: "Q", 3: "C"}
     for first, count, closed in path.subpaths:
@@ -276,13 +247,13 @@ def write_svg(scene: Scene, source_path, out_path, *, full: bool = False, backgr
     Raises VecfitError for non-finite values (nothing is written then) or a scene that
     does not match the source file.
     """
-    from .read import _Reader  # the reader's own cascade, viewport and original scene
+    from .read import Reader  # the reader's own cascade, viewport and original scene
 
     for tensors in scene.parameters().values():
         for t in tensors:
-            _finite(t)
+            finite(t)
     plain = read_root(source_path)
-    reader = _Reader(source_path, plain)
+    reader = Reader(source_path, plain)
     original = reader.read()
     if (len(original.shapes) != len(scene.shapes) or len(original.groups) != len(scene.groups)
             or any(a.source != b.source for a, b in zip(original.shapes, scene.shapes))
@@ -403,7 +374,7 @@ class _Writer:
             width = shape.geometry.widths.detach().double().mean()
             self.averaged.append(shape.source)
         if shape.stroke is not None and (full or not _same(width, orig.stroke_width)):
-            self.doc.set_property(e, "stroke-width", fmt(_finite(width), 4))
+            self.doc.set_property(e, "stroke-width", fmt(finite(width), 4))
             wrote = True
         if full or not _same(shape.opacity, orig.opacity):
             self._opacity(e, "opacity", shape.opacity)
@@ -416,21 +387,21 @@ class _Writer:
         if shape.miter_limit != orig.miter_limit:
             self.doc.set_property(e, "stroke-miterlimit", fmt(shape.miter_limit, 6))
         if not _same(shape.transform, orig.transform) or (full and e.get("transform") is not None):
-            self._transform(e, _finite(shape.transform))
+            self._transform(e, finite(shape.transform))
             wrote = True
         return wrote
 
     def _opacity(self, e, prop, value):
-        v = float(_finite(value))
+        v = float(finite(value))
         self.doc.set_property(e, prop, None if v >= 1 else fmt(min(max(v, 0.0), 1.0), 6))
 
     def _paint(self, e, prop, paint, opacity):
-        op = float(_finite(opacity))
+        op = float(finite(opacity))
         if paint is None:
             self.doc.set_property(e, prop, "none")
             return
         if isinstance(paint, Solid):
-            color = _finite(paint.color)
+            color = finite(paint.color)
             self.doc.set_property(e, prop, hex_color(color))
             op *= float(color[3])
         else:
@@ -448,7 +419,7 @@ class _Writer:
     def _geometry(self, e, g):
         tag = local_name(e.tag)
         if isinstance(g, Rect):
-            p0, p1, r = _finite(g.p_min), _finite(g.p_max), _finite(g.corner_radii)
+            p0, p1, r = finite(g.p_min), finite(g.p_max), finite(g.corner_radii)
             for name, v in (("x", p0[0]), ("y", p0[1]), ("width", p1[0] - p0[0]),
                             ("height", p1[1] - p0[1])):
                 e.set(name, fmt(v))
@@ -456,19 +427,19 @@ class _Writer:
                 if v != 0 or e.get(name) is not None:
                     e.set(name, fmt(v))
         elif isinstance(g, Circle):
-            c = _finite(g.center)
+            c = finite(g.center)
             e.set("cx", fmt(c[0]))
             e.set("cy", fmt(c[1]))
-            e.set("r", fmt(_finite(g.radius)))
+            e.set("r", fmt(finite(g.radius)))
         elif isinstance(g, Ellipse):
-            c, r = _finite(g.center), _finite(g.radii)
+            c, r = finite(g.center), finite(g.radii)
             for name, v in (("cx", c[0]), ("cy", c[1]), ("rx", r[0]), ("ry", r[1])):
                 e.set(name, fmt(v))
         else:
             self._path(e, tag, g)
 
     def _path(self, e, tag, g: Path):
-        pts = _finite(g.points)
+        pts = finite(g.points)
         degrees = [int(d) for d in g.degrees]
         lines = all(d == 1 for d in degrees) and len(g.subpaths) == 1
         closed = bool(g.subpaths[0][2]) if g.subpaths else False
@@ -497,7 +468,7 @@ class _Writer:
             self._opacity(e, "opacity", group.opacity)
             wrote = True
         if not _same(group.transform, orig.transform) or (self.full and e.get("transform")):
-            m = _finite(group.transform)
+            m = finite(group.transform)
             tag = local_name(e.tag)
             if tag == "use":
                 x = parse_length(e.get("x"), self.viewport[0]) or 0.0
@@ -538,10 +509,10 @@ class _Writer:
                       (("fx", "fy"), paint.focal, before and before.focal))
         for names, value, old in fields:
             if full or not _same(value, old):
-                for name, v in zip(names, _finite(value).reshape(-1)):
+                for name, v in zip(names, finite(value).reshape(-1)):
                     g.set(name, fmt(v, 6))
         if full or not _same(paint.transform, before.transform):
-            m = _finite(paint.transform)
+            m = finite(paint.transform)
             has = any(x.get("gradientTransform") is not None for x in chain)
             if has or not np.array_equal(m, np.eye(3)):
                 g.set("gradientTransform", matrix(m))
@@ -550,7 +521,7 @@ class _Writer:
             if holder is None:
                 raise VecfitError(f"gradient #{paint.source} has no stops to write")
             stops = [s for s in holder if isinstance(s.tag, str) and local_name(s.tag) == "stop"]
-            offsets, colors = _finite(paint.offsets), _finite(paint.colors)
+            offsets, colors = finite(paint.offsets), finite(paint.colors)
             if len(stops) != len(offsets):
                 raise VecfitError(f"gradient #{paint.source}: {len(offsets)} stops in the scene, "
                                   f"{len(stops)} in the file")

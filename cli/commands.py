@@ -29,7 +29,7 @@ def _print_version(ctx, param, value):
     if not value or ctx.resilient_parsing:
         return
     from vecfit import __version__
-    from vecfit.device import core_build
+    from vecfit.renderer.device import core_build
     click.echo(f"vecfit {__version__} (core: {core_build()})")
     ctx.exit()
 
@@ -66,10 +66,10 @@ def render(inputs, output, out_dir, width, height, samples, mode, filter_, filte
            background, seed, threads, device):
     """Render SVG files to PNG (8-bit RGBA)."""
     import vecfit
-    from vecfit.colors import parse_background
-    from vecfit.device import resolve as resolve_device
     from vecfit.errors import VecfitError
-    from vecfit.imageio import save_png
+    from vecfit.io.colors import parse_background
+    from vecfit.io.images import save_png
+    from vecfit.renderer.device import resolve as resolve_device
 
     if (output is None) == (out_dir is None):
         raise click.UsageError("give either -o OUT.png (one input) or --out-dir DIR")
@@ -113,11 +113,11 @@ def info(svg, build):
     """List the shapes, segments and paints of an SVG, and what was skipped; or, with
     --build, what the compiled core has."""
     import vecfit
-    from vecfit.describe import describe
     from vecfit.errors import VecfitError
+    from vecfit.io.scene_summary import summarize
 
     if build:
-        from vecfit.device import build_summary
+        from vecfit.renderer.device import build_summary
         click.echo(build_summary())
     if svg is None:
         if not build:
@@ -130,7 +130,7 @@ def info(svg, build):
     except VecfitError as e:
         _echo_err(f"error: {e}")
         sys.exit(EXIT_FAILED)
-    click.echo(describe(scene))
+    click.echo(summarize(scene))
 
 
 # ------------------------------------------------------------------ optimising commands
@@ -181,8 +181,8 @@ def _parse_learning_rates(items) -> dict:
 
 def _resolve_config(command, preset, config_file, options, extra=None):
     """Defaults, preset, --config file, options; a bad setting is a usage error."""
-    from vecfit.config import resolve
     from vecfit.errors import VecfitError
+    from vecfit.jobs.config import resolve
 
     overrides = {"optimize": {
         "iterations": options["iterations"], "loss": options["loss"], "mode": options["mode"],
@@ -260,7 +260,8 @@ def _summarise(report) -> None:
 @optimize_options
 def refine(target, init_svg, output, report, comparison, config_file, quiet, **options):
     """Optimise INIT_SVG's control points, colours and stroke widths to match TARGET."""
-    from vecfit.refine import Outputs, refine as run_refine
+    from vecfit.jobs.fit import Outputs
+    from vecfit.jobs.refine import run as run_refine
 
     config = _resolve_config("refine", None, config_file, options)
     outputs = Outputs.beside(Path(target), output, report, comparison)
@@ -283,8 +284,8 @@ def refine(target, init_svg, output, report, comparison, config_file, quiet, **o
 def trace(target, preset, paths, colors, min_area, tolerance, refine, output, report, comparison,
           config_file, quiet, **options):
     """Trace TARGET into an SVG (colour regions fitted with cubic curves), then refine it."""
-    from vecfit.refine import Outputs
-    from vecfit.trace_job import trace as run_trace
+    from vecfit.jobs.fit import Outputs
+    from vecfit.jobs.trace import run as run_trace
 
     config = _resolve_config("trace", preset, config_file, options, extra={"trace": {
         "paths": paths, "colors": colors, "min_area": min_area, "tolerance": tolerance}})
@@ -307,8 +308,8 @@ def trace(target, preset, paths, colors, min_area, tolerance, refine, output, re
 def paint(target, paths, kind, preset, frames, output, report, comparison, config_file, quiet,
           **options):
     """Paint TARGET with random strokes or shapes fitted by gradient descent."""
-    from vecfit.paint_job import paint as run_paint
-    from vecfit.refine import Outputs
+    from vecfit.jobs.fit import Outputs
+    from vecfit.jobs.paint import run as run_paint
 
     config = _resolve_config("paint", preset, config_file, options,
                              extra={"paint": {"paths": paths, "kind": kind}})

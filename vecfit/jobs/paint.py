@@ -1,15 +1,17 @@
-"""The paint job: random strokes or shapes (vecfit.painterly) fitted to a target with the
+"""The paint job: random strokes or shapes (vecfit.initial.strokes) fitted to a target with the
 loop of `vecfit refine`, with re-seeding and optional frames."""
 from __future__ import annotations
 
 from pathlib import Path
 
+from vecfit.initial.strokes import PaintSettings, Reseeder, initial_svg
+from vecfit.io.frames import FrameSaver
+
 from .config import settings_of
-from .painterly import FrameSaver, PaintSettings, Reseeder, initial_svg
-from .refine import Outputs, fit, generated_source, load_target
+from .fit import Outputs, fit_and_write, generated_source, load_target
 
 
-def paint(target_path, config: dict, outputs: Outputs, progress=None, frames=None) -> dict:
+def run(target_path, config: dict, outputs: Outputs, progress=None, frames=None) -> dict:
     """`vecfit paint`: writes SVG, report and comparison (and frames into ``frames``)."""
     target_path = Path(target_path)
     outputs.check_against(target_path)
@@ -29,7 +31,7 @@ def paint(target_path, config: dict, outputs: Outputs, progress=None, frames=Non
             gif = saver.finish()
             return {"folder": str(frames), "count": len(saver.files), "gif": str(gif) if gif else None}
 
-        return fit(scene, source, target, config, outputs, progress, hooks=hooks,
+        return fit_and_write(scene, source, target, config, outputs, progress, hooks=hooks,
                    inputs={"command": "paint", "target": str(target_path),
                            "paint": lambda: {"kind": settings.kind, "paths": settings.paths,
                                              "reseeded": reseeder.reseeded,

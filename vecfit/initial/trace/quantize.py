@@ -21,7 +21,7 @@ def to_lab(rgb: np.ndarray) -> np.ndarray:
     return cv2.cvtColor(np.ascontiguousarray(rgb, dtype=np.float32), cv2.COLOR_RGB2Lab)
 
 
-def quantize(rgb: np.ndarray, opaque: np.ndarray, colors: int, seed: int,
+def quantize_colors(rgb: np.ndarray, opaque: np.ndarray, colors: int, seed: int,
              sample: int = 20_000, attempts: int = 1) -> np.ndarray:
     """Cluster label of each pixel, int32 [H, W]; -1 where the pixel is not opaque.
 

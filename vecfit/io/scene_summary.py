@@ -6,8 +6,8 @@ from collections import Counter
 import numpy as np
 import torch
 
-from .scene import (CUBIC, LINE, QUADRATIC, Circle, Ellipse, LinearGradient, Path,
-                    RadialGradient, Rect, Scene, Solid)
+from vecfit.renderer.scene import (CUBIC, LINE, QUADRATIC, Circle, Ellipse, LinearGradient, Path,
+                                   RadialGradient, Rect, Scene, Solid)
 
 _GEOMETRY = ((Path, "path"), (Rect, "rect"), (Circle, "circle"), (Ellipse, "ellipse"))
 _PAINTS = ((Solid, "solid"), (LinearGradient, "linear"), (RadialGradient, "radial"))
@@ -86,7 +86,7 @@ def _skipped(scene: Scene) -> list[str]:
     return lines
 
 
-def describe(scene: Scene) -> str:
+def summarize(scene: Scene) -> str:
     """Counts of shapes by geometry, segments by degree, paints by kind, groups and
     opacity layers, the canvas and view, and what the reader skipped."""
     kinds = Counter(_kind(s.geometry, _GEOMETRY) for s in scene.shapes)

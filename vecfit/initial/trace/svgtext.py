@@ -1,7 +1,7 @@
 """SVG text of the traced shapes."""
 from __future__ import annotations
 
-from ..svg.write import fmt
+from vecfit.svg.numbers import fmt
 
 
 def number(v: float) -> str:

@@ -12,7 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..scene import LinearGradient, RadialGradient, Solid, as_tensor
+from vecfit.renderer.scene import LinearGradient, RadialGradient, Solid, as_tensor
+
 from .color import RGBA, parse_color
 from .dom import href_id, local_name
 from .units import clamp, clamp_array, parse_fraction, parse_length, parse_transform

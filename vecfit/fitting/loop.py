@@ -3,9 +3,9 @@
 This is the loop that `vecfit refine`, `vecfit trace` and `vecfit paint` share; they
 differ only in where the initial Scene comes from.
 
-Each parameter kind's tensors are aliased into one flat tensor (the Scene's tensors
-become views of its storage), so the Adam step, the bounds, the NaN checks and the
-best-so-far snapshot are a few vector operations per kind however many shapes there are.
+Each parameter kind's tensors are aliased into one flat tensor (adam.py), with its
+learning rate in pixels (rates.py); this module runs the iterations: render, loss,
+gradient, step, the checks for non-finite values, the best-so-far snapshot, hooks.
 """
 from __future__ import annotations
 
@@ -16,18 +16,17 @@ from typing import Callable, Optional
 
 import torch
 
-from . import device as devices
-from . import losses
-from .errors import NonFiniteScene, VecfitError
-from .pack import local_bbox_size, shape_pixel_scales
-from .render import MODES, render
-from .scene import LinearGradient, RadialGradient, Scene
+from vecfit.errors import NonFiniteScene, VecfitError
+from vecfit.renderer import device as devices
+from vecfit.renderer.raster import MODES, render
+from vecfit.renderer.scene import Scene
 
-KINDS = ("points", "colors", "stroke_widths", "opacities", "radii", "gradient_points",
-         "gradient_radii", "stop_offsets", "transforms")
-# Kinds measured in lengths: their learning rates are given in pixels of the optimised
-# image and converted into each tensor's own units.
-LENGTH_KINDS = ("points", "stroke_widths", "radii", "gradient_points", "gradient_radii")
+from . import losses
+from .adam import Adam
+from .rates import parameter_kinds
+
+PARAMETER_KINDS = ("points", "colors", "stroke_widths", "opacities", "radii", "gradient_points",
+                   "gradient_radii", "stop_offsets", "transforms")
 
 
 def _default_rates() -> dict:
@@ -76,8 +75,8 @@ class Settings:
             raise VecfitError("lr_warmup must be 0 or more")
         devices.resolve(self.device)
         for kind, value in self.lr.items():
-            if kind not in KINDS:
-                raise VecfitError(f"unknown parameter kind {kind!r} (known: {', '.join(KINDS)})")
+            if kind not in PARAMETER_KINDS:
+                raise VecfitError(f"unknown parameter kind {kind!r} (known: {', '.join(PARAMETER_KINDS)})")
             if not (math.isfinite(value) and value >= 0):
                 raise VecfitError(f"learning rate of {kind} must be a number >= 0, not {value}")
 
@@ -137,140 +136,6 @@ class Result:
     parameters: dict = field(default_factory=dict)  # kind -> number of floats optimised
 
 
-class _Kind:
-    """One parameter kind: the Scene's tensors as views of one flat leaf tensor."""
-
-    def __init__(self, name: str, tensors: list, scales: list, lr: float):
-        self.name, self.lr = name, lr
-        self.tensors = tensors
-        self.flat = torch.cat([t.detach().reshape(-1).float() for t in tensors]).contiguous()
-        self.scale = torch.cat([torch.full((t.numel(),), s, dtype=torch.float32)
-                                for t, s in zip(tensors, scales)])
-        offset = 0
-        for t in tensors:
-            n = t.numel()
-            t.data = self.flat[offset:offset + n].view(t.shape)  # alias: steps update the Scene
-            t.requires_grad_(True)
-            t.grad = None
-            offset += n
-        self.m = torch.zeros_like(self.flat)
-        self.v = torch.zeros_like(self.flat)
-        self.steps = torch.zeros_like(self.flat)
-
-    def gradient(self) -> torch.Tensor:
-        return torch.cat([(t.grad if t.grad is not None else torch.zeros_like(t)).reshape(-1)
-                          for t in self.tensors])
-
-    def zero_grad(self) -> None:
-        for t in self.tensors:
-            t.grad = None
-
-    def release(self) -> None:
-        for t in self.tensors:
-            t.requires_grad_(False)
-            t.grad = None
-
-    def project(self) -> None:
-        """Keep values where they mean something: colours and opacities in [0, 1], widths
-        and radii >= 0, stop offsets in [0, 1] and non-decreasing."""
-        f = self.flat
-        if self.name in ("colors", "opacities"):
-            f.clamp_(0.0, 1.0)
-        elif self.name in ("stroke_widths", "radii", "gradient_radii"):
-            f.clamp_(min=0.0)
-        elif self.name == "stop_offsets":
-            f.clamp_(0.0, 1.0)
-            for t in self.tensors:
-                if t.numel() > 1:
-                    t.data.copy_(torch.cummax(t.data.reshape(-1), 0).values.view(t.shape))
-
-
-class Adam:
-    """Adam (Kingma & Ba) over the flat kinds, with a per-element scale of the learning
-    rate (lengths in each tensor's own units) and a cosine fall of the rates."""
-
-    def __init__(self, kinds: list[_Kind], iterations: int, decay: float, warmup: int = 0,
-                 betas=(0.9, 0.999), eps: float = 1e-8):
-        self.kinds, self.iterations, self.decay, self.warmup = kinds, max(iterations, 1), decay, warmup
-        self.b1, self.b2, self.eps = betas[0], betas[1], eps
-        self.t = 0
-        self.rate = 1.0  # lowered after a step that produced non-finite values
-
-    def factor(self) -> float:
-        """Linear warm-up, then a cosine fall to ``decay``. The warm-up matters: Adam's
-        first steps move every coordinate by the full rate whatever its gradient, which
-        throws a good initial trace out of place before the moments have settled."""
-        frac = min(self.t / self.iterations, 1.0)
-        warm = min(1.0, (self.t + 1) / self.warmup) if self.warmup > 0 else 1.0
-        return self.rate * warm * (self.decay + (1 - self.decay) * 0.5 * (1 + math.cos(math.pi * frac)))
-
-    def step(self, grads: list[torch.Tensor]) -> None:
-        factor = self.factor()
-        self.t += 1
-        for kind, g in zip(self.kinds, grads):
-            kind.steps += 1  # per element: a re-seeded element starts its bias correction anew
-            c1, c2 = 1 - self.b1 ** kind.steps, 1 - self.b2 ** kind.steps
-            kind.m.mul_(self.b1).add_(g, alpha=1 - self.b1)
-            kind.v.mul_(self.b2).addcmul_(g, g, value=1 - self.b2)
-            step = (kind.m / c1) / (torch.sqrt(kind.v / c2) + self.eps)
-            kind.flat.sub_(step * kind.scale, alpha=kind.lr * factor)
-            kind.project()
-
-
-def _learning_rate_scales(scene: Scene, width: int, height: int) -> dict[int, float]:
-    """Units of each length tensor per pixel of the rendered image, keyed by id(tensor)."""
-    pixels_per_unit = shape_pixel_scales(scene, width, height)
-    out: dict[int, float] = {}
-
-    def put(t, ppu):
-        if t is not None and id(t) not in out and ppu > 0 and math.isfinite(ppu):
-            out[id(t)] = 1.0 / ppu
-
-    for shape, ppu in zip(scene.shapes, pixels_per_unit):
-        g = shape.geometry
-        for name in ("points", "widths", "center", "radius", "radii", "p_min", "p_max", "corner_radii"):
-            put(getattr(g, name, None), ppu)
-        put(shape.stroke_width, ppu)
-        for paint in (shape.fill, shape.stroke):
-            if isinstance(paint, (LinearGradient, RadialGradient)):
-                gppu = ppu * math.sqrt(abs(float(torch.linalg.det(paint.transform[:2, :2].double()))))
-                if paint.units == "objectBoundingBox":
-                    gppu *= local_bbox_size(g) or 0.0
-                for name in ("start", "end", "center", "focal", "radius"):
-                    put(getattr(paint, name, None), gppu)
-    return out
-
-
-def _kinds(scene: Scene, lr: dict, width: int, height: int, fixed_alpha: bool = False,
-           keep_alpha=()) -> list[_Kind]:
-    scales = _learning_rate_scales(scene, width, height)
-    kinds = []
-    for name, tensors in scene.parameters().items():
-        rate = float(lr.get(name, 0.0))
-        if rate <= 0 or not tensors:
-            continue
-        per_tensor = []
-        for t in tensors:
-            if name in LENGTH_KINDS:
-                per_tensor.append(scales.get(id(t), 1.0))
-            else:
-                per_tensor.append(1.0)
-        kind = _Kind(name, tensors, per_tensor, rate)
-        if name == "transforms":  # the last row of an affine matrix stays 0 0 1
-            kind.scale.view(-1, 3, 3)[:, 2, :] = 0.0
-        if name == "colors":  # colours are RGBA rows: keep the A of all, or of some
-            if fixed_alpha:
-                kind.scale.view(-1, 4)[:, 3] = 0.0
-            kept = {id(t) for t in keep_alpha}
-            offset = 0
-            for t in tensors:
-                if id(t) in kept:
-                    kind.scale[offset:offset + t.numel()].view(-1, 4)[:, 3] = 0.0
-                offset += t.numel()
-        kinds.append(kind)
-    return kinds
-
-
 def optimize(scene: Scene, target: Target, settings: Settings,
              progress: Callable[[Progress], None] | None = None,
              hooks: tuple[Callable[[Step], None], ...] = (), keep_alpha=()) -> Result:
@@ -283,8 +148,8 @@ def optimize(scene: Scene, target: Target, settings: Settings,
     loss_fn = losses.get(settings.loss)
     height, width = target.image.shape[:2]
     goal = target.compared(target.image.float())
-    device = devices.describe(devices.resolve(settings.device))  # "auto" settled once
-    kinds = _kinds(scene, settings.lr, width, height, settings.fixed_alpha, keep_alpha)
+    device = devices.device_name(devices.resolve(settings.device))  # "auto" settled once
+    kinds = parameter_kinds(scene, settings.lr, width, height, settings.fixed_alpha, keep_alpha)
     if not kinds:
         raise VecfitError("nothing to optimise: the scene has no parameters with a learning rate above 0")
     adam = Adam(kinds, settings.iterations, settings.lr_decay, settings.lr_warmup)

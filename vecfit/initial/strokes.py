@@ -14,19 +14,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import cv2
 import numpy as np
 import torch
-from PIL import Image
 
-from .errors import VecfitError
-from .imageio import atomic_write, to_uint8
-from .metrics import to_rgb
-from .scene import Path as PathGeometry
+from vecfit.errors import VecfitError
+from vecfit.renderer.scene import Path as PathGeometry
 
-KINDS = ("strokes", "shapes")
+PRIMITIVE_KINDS = ("strokes", "shapes")
 
 
 @dataclass
@@ -46,8 +42,8 @@ class PaintSettings:
     seed: int = 0
 
     def check(self) -> None:
-        if self.kind not in KINDS:
-            raise VecfitError(f"kind must be one of {', '.join(KINDS)}, not {self.kind!r}")
+        if self.kind not in PRIMITIVE_KINDS:
+            raise VecfitError(f"kind must be one of {', '.join(PRIMITIVE_KINDS)}, not {self.kind!r}")
         if self.paths < 1:
             raise VecfitError("paths must be at least 1")
         if self.stroke_segments < 1 or not 1 <= self.shape_segments_min <= self.shape_segments_max:
@@ -118,7 +114,7 @@ def initial_svg(target: np.ndarray, settings: PaintSettings) -> str:
 
 @dataclass
 class Reseeder:
-    """An optimisation hook (vecfit.optimize.Step) that re-seeds wasted primitives."""
+    """An optimisation hook (vecfit.fitting.loop.Step) that re-seeds wasted primitives."""
     settings: PaintSettings
     iterations: int
     reseeded: int = 0
@@ -188,37 +184,3 @@ class Reseeder:
         shape.opacity.fill_(1.0)
         g.points.copy_(torch.as_tensor(pts[:n], dtype=torch.float32))
         reset(g.points)
-
-
-# ------------------------------------------------------------------------- frames
-
-class FrameSaver:
-    """An optimisation hook that saves every ``every``-th render as a PNG and, at the end
-    (``finish``), an animated GIF of them."""
-
-    GIF_MAX = 256  # longest side of the GIF's frames
-
-    def __init__(self, folder, every: int):
-        self.folder, self.every = Path(folder), max(1, every)
-        self.files: list[Path] = []
-
-    def __call__(self, step) -> None:
-        if step.iteration % self.every:
-            return
-        rgb = to_uint8(to_rgb(step.image.numpy(), step.target.background))
-        path = self.folder / f"frame_{step.iteration:05d}.png"
-        atomic_write(path, lambda tmp: Image.fromarray(rgb, "RGB").save(tmp, format="PNG"))
-        self.files.append(path)
-
-    def finish(self) -> Path | None:
-        if not self.files:
-            return None
-        frames = []
-        for f in self.files:
-            with Image.open(f) as im:
-                im.thumbnail((self.GIF_MAX, self.GIF_MAX))
-                frames.append(im.convert("P", palette=Image.ADAPTIVE))
-        gif = self.folder / "optimization.gif"
-        atomic_write(gif, lambda tmp: frames[0].save(tmp, format="GIF", save_all=True,
-                                                     append_images=frames[1:], duration=60, loop=0))
-        return gif

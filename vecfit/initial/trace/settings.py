@@ -5,7 +5,7 @@ import math
 import numbers
 from dataclasses import dataclass, fields
 
-from ..errors import VecfitError
+from vecfit.errors import VecfitError
 
 
 @dataclass

@@ -12,14 +12,15 @@ import time
 
 import numpy as np
 
-from ..errors import VecfitError
+from vecfit.errors import VecfitError
+from vecfit.svg.numbers import hex_color
+
 from .bezier import fit_outlines
 from .outlines import drawing_order, grown_mask, region_boxes, shape_outlines
-from .quantize import OPAQUE, prefilter, quantize
+from .quantize import OPAQUE, prefilter, quantize_colors
 from .regions import build_regions, palette_colors
 from .settings import TraceResult, TraceSettings, check_settings
 from .subpixel import refine_outlines
-from ..svg.write import hex_color
 from .svgtext import path_data, path_element, rect_element, svg_document
 
 
@@ -49,7 +50,7 @@ def trace_image(image: np.ndarray, settings: TraceSettings = TraceSettings(),
                 progress=None) -> TraceResult:
     """Trace an image into SVG text.
 
-    image: float32 RGBA [H, W, 4], straight alpha in [0, 1] (what vecfit.imageio.load_rgba
+    image: float32 RGBA [H, W, 4], straight alpha in [0, 1] (what vecfit.io.images.load_rgba
     returns). Pixels with alpha >= 0.5 are traced as opaque shapes; the others get no shape,
     so a transparent background stays transparent. Raises VecfitError for a bad image or
     settings.
@@ -69,7 +70,7 @@ def trace_image(image: np.ndarray, settings: TraceSettings = TraceSettings(),
     opaque = alpha >= OPAQUE
 
     report("quantise", 0.0)
-    classes = quantize(prefilter(rgb, s.blur), opaque, int(s.colors), int(s.seed))
+    classes = quantize_colors(prefilter(rgb, s.blur), opaque, int(s.colors), int(s.seed))
     report("regions", 0.15)
     regions = build_regions(classes, rgb, int(s.paths), s.min_area, s.merge_thin)
     report("order", 0.35)

@@ -4,7 +4,7 @@ from __future__ import annotations
 import torch
 import torch.nn.functional as F
 
-from .errors import VecfitError
+from vecfit.errors import VecfitError
 
 LOSSES = ("l2", "l1", "ssim", "pyramid")
 

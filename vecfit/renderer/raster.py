@@ -9,9 +9,10 @@ import math
 
 import torch
 
-from . import _core
+from vecfit import _core
+from vecfit.errors import NonFiniteScene, VecfitError
+
 from . import device as devices
-from .errors import NonFiniteScene, VecfitError
 from .pack import pack_scene
 from .scene import Scene
 
@@ -46,12 +47,12 @@ def _core_render(settings: dict, structure: dict, floats, brute_force: bool = Fa
     except ValueError as e:  # the core refused the scene (e.g. layers nested too deeply)
         raise VecfitError(str(e)) from None
     except RuntimeError as e:  # the GPU failed (out of memory, driver)
-        raise VecfitError(f"rendering on {devices.describe(settings['device'])} failed: {e}") from None
+        raise VecfitError(f"rendering on {devices.device_name(settings['device'])} failed: {e}") from None
 
 
 class _Render(torch.autograd.Function):
     """The core's forward pass; its backward returns the gradients of the float arrays
-    (the autograd graph of vecfit.pack carries them on to the Scene's tensors)."""
+    (the autograd graph of vecfit.renderer.pack carries them on to the Scene's tensors)."""
 
     @staticmethod
     def forward(ctx, settings, boundary_density, emulate_gpu_lists, structure, *floats):
@@ -70,7 +71,7 @@ class _Render(torch.autograd.Function):
                                       s["filter_radius"], s["seed"], s["threads"], s["background"],
                                       ctx.boundary_density, s["device"], ctx.emulate_gpu_lists)
         except RuntimeError as e:  # the GPU failed (out of memory, driver)
-            raise VecfitError(f"gradients on {devices.describe(s['device'])} failed: {e}") from None
+            raise VecfitError(f"gradients on {devices.device_name(s['device'])} failed: {e}") from None
         out = [torch.from_numpy(grads[name]).reshape(shape) for name, shape in zip(FLOAT_INPUTS, ctx.shapes)]
         return (None, None, None, None, *out)
 

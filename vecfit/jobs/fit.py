@@ -1,6 +1,6 @@
-"""The refine job: an SVG fitted to a target image, with its SVG, report and comparison
-picture written next to each other. `vecfit trace` and `vecfit paint` end in the same job
-with an initial SVG of their own making."""
+"""The job every optimising command ends in: a Scene fitted to a target image, then its
+SVG, report and comparison picture written next to each other. `vecfit refine` starts it
+from the user's SVG, `vecfit trace` and `vecfit paint` from SVGs of their own making."""
 from __future__ import annotations
 
 import contextlib
@@ -15,18 +15,19 @@ import cv2
 import numpy as np
 import torch
 
-from . import __version__
-from . import device as devices
-from .colors import fitting_background
-from .errors import VecfitError
-from .imageio import load_rgba
-from .metrics import compare, to_rgb
-from .optimize import Settings, Target, optimize
-from .render import render
-from .report import save_comparison, save_report
-from .scene import Scene
-from .svg.read import load_svg
-from .svg.write import hex_color, write_svg
+from vecfit import __version__
+from vecfit.errors import VecfitError
+from vecfit.fitting.loop import Settings, Target, optimize
+from vecfit.fitting.metrics import compare, to_rgb
+from vecfit.io.colors import fitting_background
+from vecfit.io.images import load_rgba
+from vecfit.io.report import save_comparison, save_report
+from vecfit.renderer import device as devices
+from vecfit.renderer.raster import render
+from vecfit.renderer.scene import Scene
+from vecfit.svg.numbers import hex_color
+from vecfit.svg.read import load_svg
+from vecfit.svg.write import write_svg
 
 OPAQUE = 0.999  # a target whose every alpha is at least this is treated as opaque
 ASPECT_TOLERANCE = 0.01
@@ -71,7 +72,7 @@ def same_path(a: Path, b: Path) -> bool:
 # ------------------------------------------------------------------------- target
 
 def load_target(path) -> np.ndarray:
-    """The target image (vecfit.imageio.load_rgba), big enough to be measured: SSIM's
+    """The target image (vecfit.io.images.load_rgba), big enough to be measured: SSIM's
     Gaussian window is 11 x 11 pixels."""
     a = load_rgba(path)
     if min(a.shape[:2]) < MIN_SIDE:
@@ -143,8 +144,8 @@ def _render_full(scene, w, h, config) -> torch.Tensor:
                       threads=config["threads"], device=config["device"])
 
 
-def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Outputs,
-        progress=None, inputs: dict | None = None, hooks=(), keep_alpha=()) -> dict:
+def fit_and_write(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Outputs,
+                  progress=None, inputs: dict | None = None, hooks=(), keep_alpha=()) -> dict:
     """Optimise ``scene`` (read from ``source_svg``) against ``target`` with the
     ``[optimize]`` settings of ``config``; writes the SVG, the comparison picture and the
     report (last, so a report means a finished run). Returns the report. ``inputs`` are
@@ -155,7 +156,7 @@ def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Out
     # run dies before it writes its own.
     outputs.report.unlink(missing_ok=True)
     # "auto" settled once, for the loop, the full-size renders and the report alike
-    opt = {**config["optimize"], "device": devices.describe(devices.resolve(config["optimize"]["device"]))}
+    opt = {**config["optimize"], "device": devices.device_name(devices.resolve(config["optimize"]["device"]))}
     settings = Settings.from_config(opt)
     background = background_for(target, opt["background"])
     h, w = target.shape[:2]
@@ -211,18 +212,3 @@ def fit(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Out
     }
     save_report(outputs.report, report)
     return report
-
-
-def refine(target_path, svg_path, config: dict, outputs: Outputs, progress=None) -> dict:
-    """`vecfit refine`: load, check and fit; see ``fit``."""
-    target_path, svg_path = Path(target_path), Path(svg_path)
-    outputs.check_against(target_path, svg_path)
-    target = load_target(target_path)
-    with warnings.catch_warnings():
-        warnings.simplefilter("always")
-        scene = load_svg(svg_path)
-    if not scene.shapes:
-        raise VecfitError(f"{svg_path}: the SVG has no shapes to optimise")
-    check_sizes(scene, target, svg_path, target_path)
-    return fit(scene, svg_path, target, config, outputs, progress,
-               inputs={"command": "refine", "target": str(target_path), "init": str(svg_path)})

@@ -378,7 +378,7 @@ def fit_closed(points: np.ndarray, tolerance: float, corner_angle: float,
     return fit_outlines([points], tolerance, corner_angle, smoothing, corner_window)[0]
 
 
-def bezier(ctrl: np.ndarray, u: np.ndarray) -> np.ndarray:
+def bezier_at(ctrl: np.ndarray, u: np.ndarray) -> np.ndarray:
     """Points of the cubic with control points ctrl [4, 2] at parameters u."""
     b0, b1, b2, b3 = _basis(np.asarray(u, float))
     return np.outer(b0, ctrl[0]) + np.outer(b1, ctrl[1]) + np.outer(b2, ctrl[2]) + np.outer(b3, ctrl[3])

@@ -13,9 +13,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import torch
 
-from .errors import VecfitError
-from .scene import (Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect, Scene,
-                    Shape, Solid)
+from vecfit.errors import VecfitError
+
+from .geometry import affine_apply, local_bbox, rect_as_path, value
+from .scene import Circle, LinearGradient, Path, RadialGradient, Rect, Scene, Shape, Solid
 
 SHAPE_PATH, SHAPE_ELLIPSE = 0, 1
 DRAW_FILL, DRAW_STROKE = 0, 1
@@ -23,7 +24,6 @@ FILL_RULES = {"nonzero": 0, "evenodd": 1}
 CAPS = {"butt": 0, "round": 1, "square": 2}
 JOINS = {"miter": 0, "round": 1, "bevel": 2}
 PAINT_SOLID, PAINT_LINEAR, PAINT_RADIAL = 0, 1, 2
-KAPPA = 0.5522847498307936  # cubic approximation of a quarter ellipse
 
 
 @dataclass
@@ -76,79 +76,6 @@ class Packed:
         }
 
 
-def _value(t) -> float:
-    """A tensor's value as a float, outside the autograd graph (for decisions only)."""
-    return float(t.detach()) if isinstance(t, torch.Tensor) else float(t)
-
-
-def _affine_apply(m: torch.Tensor, p: torch.Tensor) -> torch.Tensor:
-    """Apply a 3x3 affine matrix to points [n, 2]."""
-    return p @ m[:2, :2].T + m[:2, 2]
-
-
-def _rect_path(rect: Rect) -> tuple[torch.Tensor, list[int]]:
-    """A rect as a closed path: four lines, with quarter-ellipse cubics for round corners."""
-    x0, y0 = rect.p_min[0], rect.p_min[1]
-    x1, y1 = rect.p_max[0], rect.p_max[1]
-    rx, ry = rect.corner_radii[0], rect.corner_radii[1]
-    if _value(rx) <= 0 or _value(ry) <= 0:
-        pts = torch.stack([torch.stack([x0, y0]), torch.stack([x1, y0]),
-                           torch.stack([x1, y1]), torch.stack([x0, y1])])
-        return pts, [1, 1, 1, 1]
-    kx, ky = KAPPA * rx, KAPPA * ry
-    P = lambda x, y: torch.stack([x, y])  # noqa: E731
-    pts = [
-        P(x0 + rx, y0), P(x1 - rx, y0),
-        P(x1 - rx + kx, y0), P(x1, y0 + ry - ky), P(x1, y0 + ry),
-        P(x1, y1 - ry),
-        P(x1, y1 - ry + ky), P(x1 - rx + kx, y1), P(x1 - rx, y1),
-        P(x0 + rx, y1),
-        P(x0 + rx - kx, y1), P(x0, y1 - ry + ky), P(x0, y1 - ry),
-        P(x0, y0 + ry),
-        P(x0, y0 + ry - ky), P(x0 + rx - kx, y0),  # closing cubic ends at the start point
-    ]
-    return torch.stack(pts), [1, 3, 1, 3, 1, 3, 1, 3]
-
-
-def _local_bbox(geometry) -> tuple[torch.Tensor, torch.Tensor] | None:
-    """Tight bounds (min, max) of the geometry in its local space, for bounding-box units."""
-    if isinstance(geometry, (Circle, Ellipse)):
-        r = geometry.radius.expand(2) if isinstance(geometry, Circle) else geometry.radii
-        return geometry.center - r, geometry.center + r
-    if isinstance(geometry, Rect):
-        return geometry.p_min, geometry.p_max
-    samples = []
-    t = torch.linspace(0, 1, 33, dtype=torch.float32)[:, None]
-    for pts, degrees in _path_segments(geometry):
-        for deg, ctrl in zip(degrees, pts):
-            if deg == 1:
-                samples.append(ctrl)
-            elif deg == 2:
-                u = 1 - t
-                samples.append(u * u * ctrl[0] + 2 * u * t * ctrl[1] + t * t * ctrl[2])
-            else:
-                u = 1 - t
-                samples.append(u ** 3 * ctrl[0] + 3 * u * u * t * ctrl[1] + 3 * u * t * t * ctrl[2]
-                               + t ** 3 * ctrl[3])
-    if not samples:
-        return None
-    allp = torch.cat(samples)
-    return allp.min(dim=0).values, allp.max(dim=0).values
-
-
-def _path_segments(path: Path):
-    """Per subpath: (list of control-point tensors per segment, degrees)."""
-    for (first, count, closed), (p0, n) in zip(path.subpaths, path.subpath_point_ranges()):
-        pts = path.points[p0:p0 + n]
-        degrees = [int(d) for d in path.degrees[first:first + count]]
-        ctrl, k = [], 0
-        for d in degrees:
-            idx = [(k + i) % n if closed else k + i for i in range(d + 1)]
-            ctrl.append(pts[idx])
-            k += d
-        yield ctrl, degrees
-
-
 class Packer:
     def __init__(self, scene: Scene, width: int, height: int):
         self.scene = scene
@@ -190,7 +117,7 @@ class Packer:
             parent_m = self.canvas if group.parent < 0 else self.group_matrix[group.parent]
             parent_layer = 0 if group.parent < 0 else self.group_layer[group.parent]
             self.group_matrix.append(parent_m @ group.transform.float())
-            if _value(group.opacity) < 1 and self._group_draw_counts[i] > 1:
+            if value(group.opacity) < 1 and self._group_draw_counts[i] > 1:
                 self.group_layer.append(self._new_layer(parent_layer, group.opacity))
             else:
                 self.group_layer.append(parent_layer)
@@ -201,7 +128,7 @@ class Packer:
         g = shape.group
         while g >= 0:
             group = self.scene.groups[g]
-            if _value(group.opacity) < 1 and self._group_draw_counts[g] <= 1:
+            if value(group.opacity) < 1 and self._group_draw_counts[g] <= 1:
                 out.append(group.opacity)
             g = group.parent
         return out
@@ -212,18 +139,18 @@ class Packer:
         out = self.out
         g = m
         if paint.units == "objectBoundingBox":
-            box = _local_bbox(geometry)
+            box = local_bbox(geometry)
             if box is None:
                 return None
             lo, hi = box
             size = hi - lo
-            if _value(size.min()) <= 0:
+            if value(size.min()) <= 0:
                 return None  # SVG: a zero-size bounding box disables the gradient
             bbox = torch.zeros(3, 3)
             bbox[0, 0], bbox[1, 1], bbox[0, 2], bbox[1, 2], bbox[2, 2] = size[0], size[1], lo[0], lo[1], 1
             g = g @ bbox
         g = g @ paint.transform.float()
-        if abs(_value(torch.linalg.det(g[:2, :2]))) < 1e-30:
+        if abs(value(torch.linalg.det(g[:2, :2]))) < 1e-30:
             return None
         to_paint = torch.linalg.inv(g)[:2].reshape(6)
         if isinstance(paint, LinearGradient):
@@ -248,6 +175,11 @@ class Packer:
         return self._n_gradients - 1
 
     # ------------------------------------------------------------------- draws
+
+    def shape_matrices(self) -> torch.Tensor:
+        """[n_shapes, 3, 3]: each shape's map from its own space to pixels."""
+        self._prepare_groups()
+        return self._shape_matrices()
 
     def _shape_matrices(self) -> torch.Tensor:
         """Each shape's local -> pixel matrix, [S, 3, 3], in one batched product."""
@@ -298,13 +230,13 @@ class Packer:
             layer = 0 if shape.group < 0 else self.group_layer[shape.group]
             # Alpha factors of this shape's paints (multiplied out in one go later).
             factors = self._folded_opacities(shape) if shape.group >= 0 else []
-            if has_fill and has_stroke and _value(shape.opacity) < 1:
+            if has_fill and has_stroke and value(shape.opacity) < 1:
                 layer = self._new_layer(layer, shape.opacity)
             else:
                 factors.append(shape.opacity)
             geometry = shape.geometry
             if isinstance(geometry, Rect):
-                geometry = _rect_as_path(geometry)
+                geometry = rect_as_path(geometry)
                 if geometry is None:
                     continue
             if isinstance(geometry, Path):
@@ -334,9 +266,9 @@ class Packer:
 
     def _add_ellipse(self, geometry, m: torch.Tensor) -> int | None:
         r = geometry.radius.reshape(1).expand(2) if isinstance(geometry, Circle) else geometry.radii
-        if _value(r.min()) <= 0:
+        if value(r.min()) <= 0:
             return None
-        c = _affine_apply(m, geometry.center.reshape(1, 2).float())[0]
+        c = affine_apply(m, geometry.center.reshape(1, 2).float())[0]
         axes = m[:2, :2] @ torch.diag(r.float())
         self.out.ellipses.append(torch.cat([c, axes.reshape(4)]))
         self.out.shapes.append([SHAPE_ELLIPSE, 0, 0, len(self.out.ellipses) - 1])
@@ -474,8 +406,8 @@ def _stroke_width_positive(shape: Shape) -> bool:
     """Whether the stroke has any width (per-point widths replace stroke_width)."""
     g = shape.geometry
     if isinstance(g, Path) and g.widths is not None:
-        return g.widths.numel() > 0 and _value(g.widths.detach().max()) > 0
-    return _value(shape.stroke_width) > 0
+        return g.widths.numel() > 0 and value(g.widths.detach().max()) > 0
+    return value(shape.stroke_width) > 0
 
 
 def _stack(tensors: list) -> torch.Tensor:
@@ -487,32 +419,5 @@ def _stack(tensors: list) -> torch.Tensor:
                             for t in tensors])
 
 
-def _rect_as_path(rect: Rect) -> Path | None:
-    if _value(rect.p_max[0] - rect.p_min[0]) <= 0 or _value(rect.p_max[1] - rect.p_min[1]) <= 0:
-        return None
-    pts, degrees = _rect_path(rect)
-    return Path(points=pts, degrees=np.array(degrees), subpaths=[(0, len(degrees), True)])
-
-
 def pack_scene(scene: Scene, width: int, height: int) -> Packed:
     return Packer(scene, width, height).pack()
-
-
-def shape_pixel_scales(scene: Scene, width: int, height: int) -> np.ndarray:
-    """Pixels per unit of each shape's own space (sqrt |det| of its map to the canvas)."""
-    packer = Packer(scene, width, height)
-    with torch.no_grad():
-        packer._prepare_groups()
-        lin = packer._shape_matrices()[:, :2, :2]
-        det = lin[:, 0, 0] * lin[:, 1, 1] - lin[:, 0, 1] * lin[:, 1, 0]
-    return torch.sqrt(torch.abs(det)).numpy().astype(np.float64)
-
-
-def local_bbox_size(geometry) -> float | None:
-    """Geometric mean of the geometry's bounding-box sides (for bounding-box units)."""
-    with torch.no_grad():
-        box = _local_bbox(geometry)
-    if box is None:
-        return None
-    size = (box[1] - box[0]).double()
-    return float(torch.sqrt(torch.clamp(size[0], min=0) * torch.clamp(size[1], min=0)))

@@ -1,17 +1,18 @@
-"""The trace job: a raster image traced into an SVG (vecfit.trace), then refined against
-it with the same loop as `vecfit refine` (vecfit.refine.fit)."""
+"""The trace job: a raster image traced into an SVG (vecfit.initial.trace), then refined against
+it with the same loop as `vecfit refine` (vecfit.jobs.fit.fit_and_write)."""
 from __future__ import annotations
 
 from pathlib import Path
 
+from vecfit.errors import VecfitError
+from vecfit.initial.trace import TraceSettings, trace_image
+from vecfit.renderer.scene import Rect, Solid
+
 from .config import settings_of
-from .errors import VecfitError
-from .refine import Outputs, fit, generated_source, load_target
-from .scene import Rect, Solid
-from .trace import TraceSettings, trace_image
+from .fit import Outputs, fit_and_write, generated_source, load_target
 
 
-def trace(target_path, config: dict, outputs: Outputs, progress=None, refine: bool = True,
+def run(target_path, config: dict, outputs: Outputs, progress=None, refine: bool = True,
           status=None) -> dict:
     """`vecfit trace`: trace TARGET, refine the trace (unless ``refine`` is False, which
     writes the trace as it is, with its report), write SVG, report and comparison."""
@@ -35,7 +36,7 @@ def trace(target_path, config: dict, outputs: Outputs, progress=None, refine: bo
         # neighbours is worth ~2 dB on photos).
         backdrop = [s.fill.color for s in scene.shapes[:1]
                     if isinstance(s.geometry, Rect) and isinstance(s.fill, Solid)]
-        return fit(scene, source, target, config, outputs, progress, keep_alpha=backdrop,
+        return fit_and_write(scene, source, target, config, outputs, progress, keep_alpha=backdrop,
                    inputs={"command": "trace", "target": str(target_path),
                            "trace": {"paths": traced.paths, "segments": traced.segments,
                                      "colors": traced.colors, "seconds": traced.seconds}})

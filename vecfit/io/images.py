@@ -10,7 +10,7 @@ import numpy as np
 import torch
 from PIL import Image, UnidentifiedImageError
 
-from .errors import VecfitError
+from vecfit.errors import VecfitError
 
 
 def to_uint8(image: torch.Tensor | np.ndarray) -> np.ndarray:

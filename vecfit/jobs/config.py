@@ -12,9 +12,8 @@ import copy
 import dataclasses
 import importlib.resources
 import tomllib
-from pathlib import Path
 
-from .errors import VecfitError
+from vecfit.errors import VecfitError
 
 
 def configs_dir():
@@ -110,19 +109,19 @@ def resolve(command: str, *, preset: str | None = None, config_file=None,
 def validate(settings: dict) -> None:
     """Checks the values, not just the keys and types: a bad background, loss, rate, trace
     or paint setting is refused here, before any work starts (VecfitError)."""
-    from .colors import fitting_background
-    from .optimize import Settings
+    from vecfit.fitting.loop import Settings
+    from vecfit.io.colors import fitting_background
 
     if settings["optimize"]["background"].strip().lower() != "auto":
         fitting_background(settings["optimize"]["background"])
     Settings.from_config(settings["optimize"])
     seed = settings["optimize"]["seed"]
     if "trace" in settings:
-        from .trace import TraceSettings
-        from .trace.settings import check_settings
+        from vecfit.initial.trace import TraceSettings
+        from vecfit.initial.trace.settings import check_settings
         check_settings(settings_of(TraceSettings, settings["trace"], seed=seed))
     if "paint" in settings:
-        from .painterly import PaintSettings
+        from vecfit.initial.strokes import PaintSettings
         settings_of(PaintSettings, settings["paint"], seed=seed).check()
 
 

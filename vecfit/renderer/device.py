@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import torch
 
-from . import _core
-from .errors import VecfitError
+from vecfit import _core
+from vecfit.errors import VecfitError
 
 CHOICES = ("auto", "cpu", "cuda")
 CPU = -1  # the core's device index for "no GPU"
@@ -48,7 +48,7 @@ def resolve(device) -> int:
     return n
 
 
-def describe(index: int) -> str:
+def device_name(index: int) -> str:
     return "cpu" if index == CPU else f"cuda:{index}"
 
 
@@ -62,12 +62,12 @@ def core_build() -> str:
 
 def build_summary() -> str:
     """What this build of the core has, one fact a line (`vecfit info --build`)."""
-    from . import __version__
+    from vecfit import __version__
     info = _core.build_info()
     return "\n".join([
         f"vecfit {__version__}",
         f"core compiled by: {info['compiler']}",
         f"CPU threads: {info['hardware_threads']}",
         info["cuda"],
-        f"device auto resolves to: {describe(resolve('auto'))}",
+        f"device auto resolves to: {device_name(resolve('auto'))}",
     ])

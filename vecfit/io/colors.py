@@ -1,7 +1,7 @@
 """Colour options given on the command line."""
 from __future__ import annotations
 
-from .errors import VecfitError
+from vecfit.errors import VecfitError
 
 NAMED = {"white": "#ffffff", "black": "#000000"}
 

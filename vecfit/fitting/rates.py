@@ -1,0 +1,84 @@
+"""Learning rates in pixels: each length parameter's rate is scaled into its tensor's own
+units (pixels per unit of its shape's space, and of its gradient's space), so that
+`points = 2` moves a point about two pixels a step whatever the SVG's units."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import torch
+
+from vecfit.renderer.geometry import local_bbox_size
+from vecfit.renderer.pack import Packer
+from vecfit.renderer.scene import LinearGradient, RadialGradient, Scene
+
+from .adam import ParameterKind
+
+# Kinds measured in lengths: their learning rates are given in pixels of the optimised
+# image and converted into each tensor's own units.
+LENGTH_KINDS = ("points", "stroke_widths", "radii", "gradient_points", "gradient_radii")
+
+
+def shape_pixel_scales(scene: Scene, width: int, height: int) -> np.ndarray:
+    """Pixels per unit of each shape's own space (sqrt |det| of its map to the canvas)."""
+    with torch.no_grad():
+        lin = Packer(scene, width, height).shape_matrices()[:, :2, :2]
+        det = lin[:, 0, 0] * lin[:, 1, 1] - lin[:, 0, 1] * lin[:, 1, 0]
+    return torch.sqrt(torch.abs(det)).numpy().astype(np.float64)
+
+
+def learning_rate_scales(scene: Scene, width: int, height: int) -> dict[int, float]:
+    """Units of each length tensor per pixel of the rendered image, keyed by id(tensor)."""
+    pixels_per_unit = shape_pixel_scales(scene, width, height)
+    out: dict[int, float] = {}
+
+    def put(t, ppu):
+        if t is not None and id(t) not in out and ppu > 0 and math.isfinite(ppu):
+            out[id(t)] = 1.0 / ppu
+
+    for shape, ppu in zip(scene.shapes, pixels_per_unit):
+        g = shape.geometry
+        for name in ("points", "widths", "center", "radius", "radii", "p_min", "p_max", "corner_radii"):
+            put(getattr(g, name, None), ppu)
+        put(shape.stroke_width, ppu)
+        for paint in (shape.fill, shape.stroke):
+            if isinstance(paint, (LinearGradient, RadialGradient)):
+                gppu = ppu * math.sqrt(abs(float(torch.linalg.det(paint.transform[:2, :2].double()))))
+                if paint.units == "objectBoundingBox":
+                    gppu *= local_bbox_size(g) or 0.0
+                for name in ("start", "end", "center", "focal", "radius"):
+                    put(getattr(paint, name, None), gppu)
+    return out
+
+
+def parameter_kinds(scene: Scene, lr: dict, width: int, height: int, fixed_alpha: bool = False,
+                    keep_alpha=()) -> list[ParameterKind]:
+    """The kinds with a positive rate, each with its per-element scale of the rate: lengths
+    in each tensor's own units, zero for what stays fixed (the last row of a transform,
+    alphas kept)."""
+    scales = learning_rate_scales(scene, width, height)
+    kinds = []
+    for name, tensors in scene.parameters().items():
+        rate = float(lr.get(name, 0.0))
+        if rate <= 0 or not tensors:
+            continue
+        per_tensor = []
+        for t in tensors:
+            if name in LENGTH_KINDS:
+                per_tensor.append(scales.get(id(t), 1.0))
+            else:
+                per_tensor.append(1.0)
+        kind = ParameterKind(name, tensors, per_tensor, rate)
+        if name == "transforms":  # the last row of an affine matrix stays 0 0 1
+            kind.scale.view(-1, 3, 3)[:, 2, :] = 0.0
+        if name == "colors":  # colours are RGBA rows: keep the A of all, or of some
+            if fixed_alpha:
+                kind.scale.view(-1, 4)[:, 3] = 0.0
+            kept = {id(t) for t in keep_alpha}
+            offset = 0
+            for t in tensors:
+                if id(t) in kept:
+                    kind.scale[offset:offset + t.numel()].view(-1, 4)[:, 3] = 0.0
+                offset += t.numel()
+        kinds.append(kind)
+    return kinds

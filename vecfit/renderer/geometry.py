@@ -1,0 +1,102 @@
+"""Shape geometry in torch, in a shape's own space: rects as paths, bounding boxes, the
+control points of a path's segments. Differentiable where the renderer needs it (rect
+corners and radii reach the core as path points)."""
+from __future__ import annotations
+
+import numpy as np
+import torch
+
+from .scene import Circle, Ellipse, Path, Rect
+
+KAPPA = 0.5522847498307936  # cubic approximation of a quarter ellipse
+
+
+def value(t) -> float:
+    """A tensor's value as a float, outside the autograd graph (for decisions only)."""
+    return float(t.detach()) if isinstance(t, torch.Tensor) else float(t)
+
+
+def affine_apply(m: torch.Tensor, p: torch.Tensor) -> torch.Tensor:
+    """Apply a 3x3 affine matrix to points [n, 2]."""
+    return p @ m[:2, :2].T + m[:2, 2]
+
+
+def rect_path(rect: Rect) -> tuple[torch.Tensor, list[int]]:
+    """A rect as a closed path: four lines, with quarter-ellipse cubics for round corners."""
+    x0, y0 = rect.p_min[0], rect.p_min[1]
+    x1, y1 = rect.p_max[0], rect.p_max[1]
+    rx, ry = rect.corner_radii[0], rect.corner_radii[1]
+    if value(rx) <= 0 or value(ry) <= 0:
+        pts = torch.stack([torch.stack([x0, y0]), torch.stack([x1, y0]),
+                           torch.stack([x1, y1]), torch.stack([x0, y1])])
+        return pts, [1, 1, 1, 1]
+    kx, ky = KAPPA * rx, KAPPA * ry
+    P = lambda x, y: torch.stack([x, y])  # noqa: E731
+    pts = [
+        P(x0 + rx, y0), P(x1 - rx, y0),
+        P(x1 - rx + kx, y0), P(x1, y0 + ry - ky), P(x1, y0 + ry),
+        P(x1, y1 - ry),
+        P(x1, y1 - ry + ky), P(x1 - rx + kx, y1), P(x1 - rx, y1),
+        P(x0 + rx, y1),
+        P(x0 + rx - kx, y1), P(x0, y1 - ry + ky), P(x0, y1 - ry),
+        P(x0, y0 + ry),
+        P(x0, y0 + ry - ky), P(x0 + rx - kx, y0),  # closing cubic ends at the start point
+    ]
+    return torch.stack(pts), [1, 3, 1, 3, 1, 3, 1, 3]
+
+
+def local_bbox(geometry) -> tuple[torch.Tensor, torch.Tensor] | None:
+    """Tight bounds (min, max) of the geometry in its local space, for bounding-box units."""
+    if isinstance(geometry, (Circle, Ellipse)):
+        r = geometry.radius.expand(2) if isinstance(geometry, Circle) else geometry.radii
+        return geometry.center - r, geometry.center + r
+    if isinstance(geometry, Rect):
+        return geometry.p_min, geometry.p_max
+    samples = []
+    t = torch.linspace(0, 1, 33, dtype=torch.float32)[:, None]
+    for pts, degrees in path_segments(geometry):
+        for deg, ctrl in zip(degrees, pts):
+            if deg == 1:
+                samples.append(ctrl)
+            elif deg == 2:
+                u = 1 - t
+                samples.append(u * u * ctrl[0] + 2 * u * t * ctrl[1] + t * t * ctrl[2])
+            else:
+                u = 1 - t
+                samples.append(u ** 3 * ctrl[0] + 3 * u * u * t * ctrl[1] + 3 * u * t * t * ctrl[2]
+                               + t ** 3 * ctrl[3])
+    if not samples:
+        return None
+    allp = torch.cat(samples)
+    return allp.min(dim=0).values, allp.max(dim=0).values
+
+
+def path_segments(path: Path):
+    """Per subpath: (list of control-point tensors per segment, degrees)."""
+    for (first, count, closed), (p0, n) in zip(path.subpaths, path.subpath_point_ranges()):
+        pts = path.points[p0:p0 + n]
+        degrees = [int(d) for d in path.degrees[first:first + count]]
+        ctrl, k = [], 0
+        for d in degrees:
+            idx = [(k + i) % n if closed else k + i for i in range(d + 1)]
+            ctrl.append(pts[idx])
+            k += d
+        yield ctrl, degrees
+
+
+def rect_as_path(rect: Rect) -> Path | None:
+    if value(rect.p_max[0] - rect.p_min[0]) <= 0 or value(rect.p_max[1] - rect.p_min[1]) <= 0:
+        return None
+    pts, degrees = rect_path(rect)
+    return Path(points=pts, degrees=np.array(degrees), subpaths=[(0, len(degrees), True)])
+
+
+
+def local_bbox_size(geometry) -> float | None:
+    """Geometric mean of the geometry's bounding-box sides (for bounding-box units)."""
+    with torch.no_grad():
+        box = local_bbox(geometry)
+    if box is None:
+        return None
+    size = (box[1] - box[0]).double()
+    return float(torch.sqrt(torch.clamp(size[0], min=0) * torch.clamp(size[1], min=0)))

@@ -1,0 +1,39 @@
+"""Numbers and colours as SVG text: compact, and never NaN or infinity (a non-finite value
+is an error, not a broken file). Shared by the SVG writer, the tracer and the reports."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import torch
+
+from vecfit.errors import VecfitError
+
+
+def fmt(value, decimals: int = 4) -> str:
+    """A finite number, compact: at most ``decimals`` decimals, no trailing zeros."""
+    v = float(value)
+    if not math.isfinite(v):
+        raise VecfitError(f"cannot write a non-finite value ({v}) to SVG")
+    s = f"{v:.{decimals}f}"
+    if "." in s:
+        s = s.rstrip("0").rstrip(".")
+    return "0" if s in ("-0", "") else s
+
+
+def hex_color(rgba) -> str:
+    r, g, b = (min(max(float(c), 0.0), 1.0) for c in finite(rgba)[:3])
+    return "#{:02x}{:02x}{:02x}".format(*(int(round(c * 255)) for c in (r, g, b)))
+
+
+def matrix(m) -> str:
+    a = finite(m)
+    return "matrix({})".format(" ".join(fmt(v, 6) for v in
+                                        (a[0, 0], a[1, 0], a[0, 1], a[1, 1], a[0, 2], a[1, 2])))
+
+
+def finite(t) -> np.ndarray:
+    a = t.detach().cpu().double().numpy() if isinstance(t, torch.Tensor) else np.asarray(t, float)
+    if not np.isfinite(a).all():
+        raise VecfitError("cannot write non-finite values (NaN or infinity) to SVG")
+    return a
