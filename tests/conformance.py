@@ -2,7 +2,8 @@
 
 A case passes when vecfit's render (Monte Carlo, 4x4 samples, box filter, at the case's
 size) matches the reference PNG at PSNR >= 35 dB both composited over white and on the
-alpha channel alone.
+alpha channel alone. test_golden.py scores the golden images kept in the repository with
+the same helpers.
 """
 from __future__ import annotations
 
@@ -61,11 +62,19 @@ def over_white(rgba: np.ndarray) -> np.ndarray:
     return rgba[..., :3] * a + (1 - a)
 
 
-def run_case(case: Case) -> tuple[Result, np.ndarray | None, np.ndarray]:
-    import vecfit
-    from vecfit.io.images import load_rgba, to_uint8
+def load_png(path: Path) -> np.ndarray:
+    """A PNG as float32 straight RGBA in [0, 1], [H, W, 4]."""
+    from PIL import Image
 
-    expected = load_rgba(case.png)
+    with Image.open(path) as im:
+        return np.asarray(im.convert("RGBA"), dtype=np.float32) / 255.0
+
+
+def run_case(case: Case) -> tuple[Result, np.ndarray | None, np.ndarray]:
+    """Renders the case with vecfit's public API only (load_svg, render) and scores it."""
+    import vecfit
+
+    expected = load_png(case.png)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -74,21 +83,23 @@ def run_case(case: Case) -> tuple[Result, np.ndarray | None, np.ndarray]:
     except Exception as e:  # recorded as a failure of this case
         return Result(case, 0.0, 0.0, f"{type(e).__name__}: {e}"), None, expected
     # Compare what a PNG would hold: 8-bit straight RGBA.
-    actual = to_uint8(image).astype(np.float32) / 255.0
+    levels = np.floor(np.clip(image.detach().cpu().numpy(), 0, 1) * 255 + 0.5)
+    actual = levels.astype(np.float32) / 255.0
     return Result(case, psnr(over_white(actual), over_white(expected)),
                   psnr(actual[..., 3], expected[..., 3])), actual, expected
 
 
-def save_failure(result: Result, actual: np.ndarray | None, expected: np.ndarray) -> Path:
-    """expected | difference | actual, composited over white."""
+def save_failure(result: Result, actual: np.ndarray | None, expected: np.ndarray,
+                 folder: Path = FAILURES) -> Path:
+    """expected | difference | actual, composited over white, saved in folder."""
     from PIL import Image
 
-    FAILURES.mkdir(parents=True, exist_ok=True)
+    folder.mkdir(parents=True, exist_ok=True)
     e = over_white(expected)
     a = over_white(actual) if actual is not None else np.zeros_like(e)
     d = 1 - np.clip(np.abs(a - e) * 4, 0, 1)  # amplified, dark where they differ
     strip = np.concatenate([e, d, a], axis=1)
-    path = FAILURES / f"{result.case.name}.png"
+    path = folder / f"{result.case.name}.png"
     Image.fromarray((strip * 255 + 0.5).astype(np.uint8)).save(path)
     return path
 
