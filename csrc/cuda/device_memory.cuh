@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "../gpu.h"
-#include "../scene.h"
-#include "../tiles.h"
+#include "gpu/gpu.h"
+#include "scene/scene.h"
+#include "scene/tiles.h"
 
 namespace vf {
 namespace gpu {

@@ -1,4 +1,4 @@
-// The CUDA forward pass: the launch and memory code around shade_pixel (shade.h), the
+// The CUDA forward pass: the launch and memory code around shade_pixel (forward/pixel.h), the
 // per-pixel function the CPU build runs too. One thread per pixel, one block per tile, so
 // a block's threads walk the same tile entries.
 #include <cuda_runtime.h>
@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "../gpu.h"
-#include "../shade.h"
-#include "device_memory.cuh"
+#include "cuda/device_memory.cuh"
+#include "forward/pixel.h"
+#include "gpu/gpu.h"
 
 namespace vf {
 namespace gpu {

@@ -3,12 +3,12 @@
 // opaque), with nested layers for group opacity, and filter the samples into a pixel.
 #pragma once
 
-#include "coverage.h"
-#include "layers.h"
-#include "paint.h"
-#include "render.h"
-#include "sampling.h"
-#include "tiles.h"
+#include "common/sampling.h"
+#include "forward/forward.h"
+#include "scene/coverage.h"
+#include "scene/layers.h"
+#include "scene/paint.h"
+#include "scene/tiles.h"
 
 namespace vf {
 

@@ -1,13 +1,13 @@
 // The CUDA build's entry points, declared for every build: a CPU-only build defines them
-// in gpu_absent.cpp (they report that CUDA was not compiled in), a CUDA build in
+// in gpu/absent.cpp (they report that CUDA was not compiled in), a CUDA build in
 // csrc/cuda/. Nothing here needs CUDA's headers, so the bindings stay plain C++.
 #pragma once
 
 #include <string>
 
-#include "grads.h"
-#include "render.h"
-#include "scene.h"
+#include "backward/grads.h"
+#include "forward/forward.h"
+#include "scene/scene.h"
 
 namespace vf {
 namespace gpu {

@@ -2,9 +2,9 @@
 // premultiplied.
 #pragma once
 
-#include "geometry.h"
-#include "grads.h"
-#include "scene.h"
+#include "backward/grads.h"
+#include "common/geometry.h"
+#include "scene/scene.h"
 
 namespace vf {
 

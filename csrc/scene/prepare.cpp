@@ -4,9 +4,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "layers.h"
-#include "scene.h"
-#include "stroke.h"
+#include "scene/layers.h"
+#include "scene/scene.h"
+#include "scene/stroke.h"
 
 namespace vf {
 namespace {

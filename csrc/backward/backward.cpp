@@ -1,12 +1,12 @@
 // Backward pass on the CPU: the plan (tiles, pixel adjoints, boundary pieces) and the
-// lanes that run the per-sample work of backward_sample.h over it.
-#include "backward.h"
+// lanes that run the per-sample work of backward/backward_sample.h over it.
+#include "backward/backward.h"
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
-#include "thread_pool.h"
+#include "common/thread_pool.h"
 
 namespace vf {
 namespace {

@@ -7,12 +7,12 @@
 #include <stdexcept>
 #include <string>
 
-#include "backward.h"
-#include "coverage.h"
-#include "gpu.h"
-#include "render.h"
-#include "scene.h"
-#include "thread_pool.h"
+#include "backward/backward.h"
+#include "common/thread_pool.h"
+#include "forward/forward.h"
+#include "gpu/gpu.h"
+#include "scene/coverage.h"
+#include "scene/scene.h"
 
 namespace py = pybind11;
 using namespace vf;

@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "device.h"
-#include "geometry.h"
+#include "common/geometry.h"
+#include "common/portable.h"
 
 namespace vf {
 

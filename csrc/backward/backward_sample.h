@@ -21,14 +21,14 @@
 
 #include <cmath>
 
-#include "coverage.h"
-#include "grads.h"
-#include "layers.h"
-#include "paint.h"
-#include "render.h"
-#include "sampling.h"
-#include "stroke.h"
-#include "tiles.h"
+#include "backward/grads.h"
+#include "common/sampling.h"
+#include "forward/forward.h"
+#include "scene/coverage.h"
+#include "scene/layers.h"
+#include "scene/paint.h"
+#include "scene/stroke.h"
+#include "scene/tiles.h"
 
 namespace vf {
 

@@ -3,8 +3,8 @@
 
 #include <cstdint>
 
-#include "scene.h"
-#include "tiles.h"
+#include "scene/scene.h"
+#include "scene/tiles.h"
 
 namespace vf {
 

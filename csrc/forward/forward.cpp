@@ -1,10 +1,10 @@
 // Forward pass on the CPU: the tiles are shared out between threads; each pixel is
-// shaded by shade_pixel (shade.h), which a CUDA build runs on the GPU as well.
+// shaded by shade_pixel (forward/pixel.h), which a CUDA build runs on the GPU as well.
 #include <algorithm>
 
-#include "render.h"
-#include "shade.h"
-#include "thread_pool.h"
+#include "common/thread_pool.h"
+#include "forward/forward.h"
+#include "forward/pixel.h"
 
 namespace vf {
 

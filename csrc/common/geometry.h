@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "device.h"
+#include "common/portable.h"
 
 namespace vf {
 
