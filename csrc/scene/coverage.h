@@ -45,7 +45,8 @@
 // with the vertex's half width (StrokeEnd::hw) instead of the draw's.
 #pragma once
 
-#include "common/geometry.h"
+#include "common/bezier.h"
+#include "common/ellipse.h"
 #include "scene/scene.h"
 
 namespace vf {

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "backward/grads.h"
-#include "common/geometry.h"
+#include "common/vec.h"
 #include "scene/scene.h"
 
 namespace vf {

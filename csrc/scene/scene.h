@@ -6,7 +6,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "common/geometry.h"
+#include "common/bezier.h"
+#include "common/ellipse.h"
 #include "common/portable.h"
 
 namespace vf {

@@ -3,7 +3,7 @@
 // rebuilds them under small changes of the tangents and the width).
 #pragma once
 
-#include "common/geometry.h"
+#include "common/bezier.h"
 #include "scene/scene.h"
 
 namespace vf {
