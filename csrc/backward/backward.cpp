@@ -1,5 +1,5 @@
 // Backward pass on the CPU: the plan (tiles, pixel adjoints, boundary pieces) and the
-// lanes that run the per-sample work of backward/backward_sample.h over it.
+// lanes that run the per-sample work of backward/pixel.h over it.
 #include "backward/backward.h"
 
 #include <algorithm>

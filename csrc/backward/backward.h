@@ -4,8 +4,9 @@
 
 #include <vector>
 
-#include "backward/backward_sample.h"
+#include "backward/boundary.h"
 #include "backward/grads.h"
+#include "backward/pixel.h"
 #include "forward/forward.h"
 #include "scene/scene.h"
 #include "scene/tiles.h"

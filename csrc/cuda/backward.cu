@@ -1,5 +1,5 @@
 // The CUDA backward pass: the launch and memory code around interior_pixel and
-// boundary_sample (backward/backward_sample.h), the per-sample functions the CPU lanes run too.
+// boundary_sample (backward/pixel.h), the per-sample functions the CPU lanes run too.
 // The plan (tiles, pixel adjoints, boundary pieces) is made on the host; the interior
 // term runs one thread per pixel, one block per tile; the boundary term one thread per
 // boundary sample. Threads add into shared gradient arrays atomically.
