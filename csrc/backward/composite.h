@@ -1,7 +1,10 @@
 // Compositing in the backward pass: the hits at a point composited with a tape
-// (composite) and that tape run in reverse (composite_backward), with layers for group
-// opacity; and, for the boundary term of scenes without layers, the jump of the composite
-// when one draw comes to cover a point.
+// (composite_forward) and that tape run in reverse (composite_backward), with layers for
+// group opacity; and, for the boundary term of scenes without layers, the jump of the
+// composite when one draw comes to cover a point. composite_forward computes what the
+// forward pass's FrontToBackCompositor (forward/composite.h) does, to rounding: that one
+// streams the draws front to back and stops once a sample is opaque, this one needs the
+// whole list and evaluates it back to front, which is what the tape records.
 #pragma once
 
 #include "backward/grads.h"
@@ -14,8 +17,7 @@
 
 namespace vf {
 
-// Compositing of hits (given front to back) evaluated back to front, with the tape needed
-// to run it in reverse.
+// One step of composite_forward, with what composite_backward needs to undo it.
 struct TapeOp {
     enum Kind { OVER, PUSH, POP } kind;
     int ref;           // hit index (OVER) or layer (PUSH/POP)
@@ -36,7 +38,9 @@ struct Quad {
     VF_HD double operator[](int i) const { return v[i]; }
 };
 
-VF_HD void composite(const SceneView& sc, const Buffer<Hit>& hits, Tape* tape, double out[4]) {
+// Compositing of hits (given front to back) evaluated back to front, recording the tape
+// when one is given; out: the premultiplied result.
+VF_HD void composite_forward(const SceneView& sc, const Buffer<Hit>& hits, Tape* tape, double out[4]) {
     LayerFrame stack[MAX_LAYER_DEPTH];
     int top = 0;
     stack[0].layer = 0;
@@ -72,10 +76,10 @@ VF_HD void composite(const SceneView& sc, const Buffer<Hit>& hits, Tape* tape, d
     for (int i = 0; i < 4; ++i) out[i] = stack[0].c[i];
 }
 
-// Reverse of composite: g is dL/d(result); adds dL/d(hit colour) into g_hits and
-// dL/d(layer opacity) into grads.
+// Adjoint of composite_forward, walking its tape backwards: g is dL/d(result); adds
+// dL/d(hit colour) into g_hits and dL/d(layer opacity) into grads.
 VF_HD void composite_backward(const SceneView& sc, const Buffer<Hit>& hits, const Tape& tape, const double g[4],
-                        Buffer<Quad>& g_hits, const GradView& grads) {
+                              Buffer<Quad>& g_hits, const GradView& grads) {
     g_hits.clear();
     for (int k = 0; k < hits.size(); ++k) g_hits.push_back(Quad{{0, 0, 0, 0}});
     double adj[MAX_LAYER_DEPTH][4];

@@ -1,7 +1,8 @@
 // The backward pass's per-sample work, shared by the CPU lanes (backward.cpp) and the
 // CUDA kernels (cuda/backward.cu), after Li et al. 2020, section 5: here the drivers, one
-// pixel (interior_pixel) and one boundary sample (boundary_sample); the parts they run
-// are in hits.h, composite.h, paint.h, boundary.h and prefilter.h. Monte Carlo mode:
+// pixel (pixel_backward, the adjoint of forward/pixel.h's pixel_forward, by way of
+// sample_backward) and one boundary sample (boundary_sample); the parts they run are in
+// hits.h, composite.h, paint.h, boundary.h and prefilter.h. Monte Carlo mode:
 //   * interior term: per pixel sample, reverse-mode through front-to-back compositing
 //     (with layers) into paint parameters, stop offsets / colours and layer opacities;
 //   * boundary term (Reynolds transport): stratified samples on every boundary of every
@@ -12,7 +13,7 @@
 //     once, an occluded one gives zero, and a boundary piece that lies inside another
 //     piece of the same stroke changes nothing.
 // Analytical prefilter: the chain rule through the kernel K(sd / r) and the signed
-// distance, whose derivative needs no derivative of the root solver (sdf_backward).
+// distance, whose derivative needs no derivative of the root solver (entry_sdf_backward).
 // On the CPU, gradients accumulate in one buffer per lane (a fixed slice of the work),
 // summed in lane order: the result is deterministic for a given seed and thread count. On
 // a GPU the threads add atomically, in no fixed order: sums agree to rounding.
@@ -37,24 +38,56 @@
 
 namespace vf {
 
-// Work space of one interior pixel: the hits at a sample, the compositing tape, and the
-// hits' adjoints.
-struct InteriorScratch {
+// Work space of pixel_backward, reused from sample to sample: the hits at a sample, the
+// compositing tape, and the hits' adjoints.
+struct SampleScratch {
     Buffer<Hit> hits;
     Tape tape;
     Buffer<Quad> g_hits;
     VF_HD bool overflow() const { return hits.overflow || tape.ops.overflow || g_hits.overflow; }
 };
 
-// Interior term of pixel (x, y) (and, for the analytical prefilter, all of it: coverage
-// is a smooth function of the geometry there, so there is no boundary term). o: the
-// plan's options (filter radius settled); gp: dL/d(the pixel's premultiplied colour).
-VF_HD void interior_pixel(const SceneView& sc, const TileView& bins, const RenderOptions& o, const double* gp,
-                          int x, int y, InteriorScratch& w, const GradView& g) {
+// Adjoint of sample_forward (forward/pixel.h), the premultiplied colour of the scene at
+// p: g_c is dL/d(that colour); adds dL/d(brush parameters, stops, layer opacities) and,
+// for the analytical prefilter, dL/d(geometry) through the signed distances. Returns
+// false where a list overflowed (a GPU thread's fixed lists): past a list's end the tape
+// may have lost the POP of a PUSH it kept, which composite_backward cannot walk back, so
+// nothing is added and the pass is to be redone with longer lists.
+VF_HD bool sample_backward(const SceneView& sc, const TileView& bins, Vec2 p, const RenderOptions& o,
+                           const double g_c[4], SampleScratch& w, const GradView& g) {
+    const double R = o.filter_radius;
+    const bool analytic = o.mode == MODE_ANALYTIC;
+    if (analytic) collect_hits_analytic(sc, bins, p, R, w.hits);
+    else collect_hits(sc, bins, p, -1, w.hits);
+    if (w.hits.empty()) return true;
+    double c[4];
+    composite_forward(sc, w.hits, &w.tape, c);
+    if (w.overflow()) return false;
+    composite_backward(sc, w.hits, w.tape, g_c, w.g_hits, g);
+    for (int k = 0; k < w.hits.size(); ++k) {
+        const Hit& h = w.hits[k];
+        double gpaint[4];
+        for (int i = 0; i < 4; ++i) gpaint[i] = h.cov * w.g_hits[k][i];
+        paint_color_backward(sc, sc.draws[h.draw].paint, p, gpaint, g);
+        if (!analytic) continue;
+        double g_cov = 0;
+        for (int i = 0; i < 4; ++i) g_cov += w.g_hits[k][i] * h.paint[i];
+        double g_sd = g_cov * kernel_slope(h.sd / R) / R;
+        if (g_sd != 0) entry_sdf_backward(sc, h, p, g_sd, g);
+    }
+    return true;
+}
+
+// Adjoint of pixel_forward (forward/pixel.h) at pixel (x, y): the interior term of the
+// Monte Carlo mode, and for the analytical prefilter all of it (coverage is a smooth
+// function of the geometry there, so there is no boundary term). o: the plan's options
+// (filter radius settled); gp: dL/d(the pixel's premultiplied colour), background
+// excluded (see pixel_adjoints in backward.cpp).
+VF_HD void pixel_backward(const SceneView& sc, const TileView& bins, const RenderOptions& o, const double* gp,
+                          int x, int y, SampleScratch& w, const GradView& g) {
     if (gp[0] == 0 && gp[1] == 0 && gp[2] == 0 && gp[3] == 0) return;
     const int N = o.samples;
     const double R = o.filter_radius;
-    const bool analytic = o.mode == MODE_ANALYTIC;
     uint64_t pixel = (uint64_t)y * o.width + x;
     double wsum = 0;
     for (int s = 0; s < N * N; ++s) {
@@ -69,29 +102,9 @@ VF_HD void interior_pixel(const SceneView& sc, const TileView& bins, const Rende
         double dx = R * (2 * fx - 1), dy = R * (2 * fy - 1);
         double wt = filter_weight(o.filter, R, dx, dy) / wsum;
         if (wt <= 0) continue;
-        Vec2 p{x + 0.5 + dx, y + 0.5 + dy};
-        if (analytic) collect_hits_analytic(sc, bins, p, R, w.hits);
-        else collect_hits(sc, bins, p, -1, w.hits);
-        if (w.hits.empty()) continue;
-        double c[4], gs[4];
-        composite(sc, w.hits, &w.tape, c);
-        // Past a list's end (a GPU thread's fixed lists) the tape may have lost the POP
-        // of a PUSH it kept, which composite_backward cannot walk back. The pass will be
-        // redone with longer lists anyway: stop here.
-        if (w.overflow()) return;
-        for (int i = 0; i < 4; ++i) gs[i] = wt * gp[i];
-        composite_backward(sc, w.hits, w.tape, gs, w.g_hits, g);
-        for (int k = 0; k < w.hits.size(); ++k) {
-            const Hit& h = w.hits[k];
-            double gpaint[4];
-            for (int i = 0; i < 4; ++i) gpaint[i] = h.cov * w.g_hits[k][i];
-            paint_color_backward(sc, sc.draws[h.draw].paint, p, gpaint, g);
-            if (!analytic) continue;
-            double g_cov = 0;
-            for (int i = 0; i < 4; ++i) g_cov += w.g_hits[k][i] * h.paint[i];
-            double g_sd = g_cov * kernel_slope(h.sd / R) / R;
-            if (g_sd != 0) sdf_backward(sc, h, p, g_sd, g);
-        }
+        double g_c[4];  // the sample's share of the pixel's adjoint
+        for (int i = 0; i < 4; ++i) g_c[i] = wt * gp[i];
+        if (!sample_backward(sc, bins, {x + 0.5 + dx, y + 0.5 + dy}, o, g_c, w, g)) return;
     }
 }
 
@@ -134,9 +147,9 @@ VF_HD void boundary_sample(const SceneView& sc, const TileView& bins, const Boun
     } else {
         double c_in[4], c_out[4];
         collect_hits(sc, bins, outside, bs.draw, hits);
-        composite(sc, hits, nullptr, c_in);
+        composite_forward(sc, hits, nullptr, c_in);
         collect_hits(sc, bins, outside, -1, hits);
-        composite(sc, hits, nullptr, c_out);
+        composite_forward(sc, hits, nullptr, c_out);
         for (int i = 0; i < 4; ++i) delta[i] = c_in[i] - c_out[i];
     }
     if (delta[0] == 0 && delta[1] == 0 && delta[2] == 0 && delta[3] == 0) return;

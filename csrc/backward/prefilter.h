@@ -21,7 +21,7 @@ namespace vf {
 // point the first-order condition holds, so the solver's t* drops out (implicit
 // function theorem): d|B(t*) - p| / dP_i = basis_i(t*) (B(t*) - p) / |B(t*) - p|.
 // Joins, caps and butt ends: central differences of their construction in the vertex,
-// the tangents' angles and the width. sdf_backward at the end dispatches to the pieces.
+// the tangents' angles and the width. entry_sdf_backward at the end dispatches to the pieces.
 
 // v = d sd / d(pixel-space point idx); idx < 0: a point no input holds.
 VF_HD void add_point_grad(const GradView& g, int32_t idx, Vec2 v) {
@@ -230,9 +230,9 @@ VF_HD void end_sdf_backward(const StrokeChain& c, const Hit& h) {
     }
 }
 
-// The chain rule of one hit: dL/d(sd) = g_sd, to every parameter the closest piece was
-// built from.
-VF_HD void sdf_backward(const SceneView& sc, const Hit& h, Vec2 p, double g_sd, const GradView& g) {
+// Adjoint of entry_sdf (scene/tiles.h) for one hit of the analytical prefilter: dL/d(sd)
+// = g_sd, to every parameter the closest piece (h.arg) was built from.
+VF_HD void entry_sdf_backward(const SceneView& sc, const Hit& h, Vec2 p, double g_sd, const GradView& g) {
     const PreparedDraw& d = sc.draws[h.draw];
     if (d.kind == DRAW_FILL) {
         fill_sdf_backward(sc, d, h, p, g_sd, g);
