@@ -2,9 +2,9 @@
 // CUDA kernels (cuda/backward.cu), after Li et al. 2020, section 5: here the drivers, one
 // pixel (pixel_backward, the adjoint of forward/pixel.h's pixel_forward, by way of
 // sample_backward) and one boundary sample (boundary_sample); the parts they run are in
-// hits.h, composite.h, paint.h, boundary.h and prefilter.h. Monte Carlo mode:
+// hits.h, composite.h, brush.h, boundary.h and prefilter.h. Monte Carlo mode:
 //   * interior term: per pixel sample, reverse-mode through front-to-back compositing
-//     (with layers) into paint parameters, stop offsets / colours and layer opacities;
+//     (with layers) into brush parameters, stop offsets / colours and layer opacities;
 //   * boundary term (Reynolds transport): stratified samples on every boundary of every
 //     draw (fill segments, ellipses, stroke offset curves, caps, joins, butt ends), each
 //     weighted by its length element; at p+ = p + eps n (just outside) the scene is
@@ -28,7 +28,7 @@
 #include "backward/composite.h"
 #include "backward/grads.h"
 #include "backward/hits.h"
-#include "backward/paint.h"
+#include "backward/brush.h"
 #include "backward/prefilter.h"
 #include "common/portable.h"
 #include "common/sampling.h"
@@ -66,12 +66,12 @@ VF_HD bool sample_backward(const SceneView& sc, const TileView& bins, Vec2 p, co
     composite_backward(sc, w.hits, w.tape, g_c, w.g_hits, g);
     for (int k = 0; k < w.hits.size(); ++k) {
         const Hit& h = w.hits[k];
-        double gpaint[4];
-        for (int i = 0; i < 4; ++i) gpaint[i] = h.cov * w.g_hits[k][i];
-        paint_color_backward(sc, sc.draws[h.draw].paint, p, gpaint, g);
+        double gbrush[4];
+        for (int i = 0; i < 4; ++i) gbrush[i] = h.cov * w.g_hits[k][i];
+        brush_color_backward(sc, sc.draws[h.draw].brush, p, gbrush, g);
         if (!analytic) continue;
         double g_cov = 0;
-        for (int i = 0; i < 4; ++i) g_cov += w.g_hits[k][i] * h.paint[i];
+        for (int i = 0; i < 4; ++i) g_cov += w.g_hits[k][i] * h.brush[i];
         double g_sd = g_cov * kernel_slope(h.sd / R) / R;
         if (g_sd != 0) entry_sdf_backward(sc, h, p, g_sd, g);
     }

@@ -1,6 +1,12 @@
 // The scene as the core sees it: flat arrays in (structure of arrays, filled by the
 // Python side, all geometry already in pixel space), and the prepared form the samplers
-// read (segments with their control points, bounds, joins, paints).
+// read (segments with their control points, bounds, joins, brushes).
+//
+// Names: a fill or stroke's colour source (solid, linear or radial gradient) is a brush
+// inside the core (as vello calls it: "paint" is the painterly command elsewhere in
+// vecfit). The input tables keep the names Python gives them ("paints", "paint_params",
+// their PAINT_COLS / PAINT_FCOLS widths, the draws table's paint column): they are the
+// Python-facing contract, read by python/bindings.cpp and exported by _core.layout().
 #pragma once
 
 #include <cstdint>
@@ -17,7 +23,7 @@ enum DrawKind : int32_t { DRAW_FILL = 0, DRAW_STROKE = 1 };
 enum FillRule : int32_t { NONZERO = 0, EVENODD = 1 };
 enum Cap : int32_t { CAP_BUTT = 0, CAP_ROUND = 1, CAP_SQUARE = 2 };
 enum Join : int32_t { JOIN_MITER = 0, JOIN_ROUND = 1, JOIN_BEVEL = 2 };
-enum PaintKind : int32_t { PAINT_SOLID = 0, PAINT_LINEAR = 1, PAINT_RADIAL = 2 };
+enum BrushKind : int32_t { BRUSH_SOLID = 0, BRUSH_LINEAR = 1, BRUSH_RADIAL = 2 };
 
 // Column layouts of the input tables (row-major, one row per item).
 constexpr int SEGMENT_COLS = 5;   // degree, point index of each control point (-1 unused)
@@ -100,7 +106,7 @@ struct StrokeSegment {
 };
 
 struct PreparedDraw {
-    int32_t shape = 0, kind = DRAW_FILL, fill_rule = NONZERO, paint = 0, layer = 0;
+    int32_t shape = 0, kind = DRAW_FILL, fill_rule = NONZERO, brush = 0, layer = 0;
     int32_t cap = CAP_BUTT, join = JOIN_MITER;
     double half_width = 0, miter_limit = 4;  // per-point widths: the largest half width
     bool varying = false;       // stroke with per-point widths (StrokeSegment::hw, StrokeEnd::hw)
@@ -117,9 +123,9 @@ struct PreparedDraw {
     Box box;                            // pixel-space bounds of what the draw can cover
 };
 
-struct PreparedPaint {
-    int32_t kind = PAINT_SOLID;
-    Affine to_paint;            // pixel -> paint space
+struct PreparedBrush {
+    int32_t kind = BRUSH_SOLID;
+    Affine to_brush;            // pixel -> brush space
     double rgba[4] = {0, 0, 0, 0};
     double g[5] = {0, 0, 0, 0, 0};
     int first_stop = 0, n_stops = 0;
@@ -131,7 +137,7 @@ struct PreparedScene {
     std::vector<PreparedSegment> fill_items; // per fill draw: its segments and closing lines
     std::vector<StrokeSegment> stroke_items; // per stroke draw
     std::vector<PreparedDraw> draws;
-    std::vector<PreparedPaint> paints;
+    std::vector<PreparedBrush> brushes;
     std::vector<double> stop_offsets;
     std::vector<double> stop_colors;          // straight RGBA
     std::vector<int32_t> layer_parent;
@@ -148,7 +154,7 @@ struct SceneView {
     Span<PreparedSegment> fill_items;
     Span<StrokeSegment> stroke_items;
     Span<PreparedDraw> draws;
-    Span<PreparedPaint> paints;
+    Span<PreparedBrush> brushes;
     Span<double> stop_offsets, stop_colors;
     Span<int32_t> layer_parent;
     Span<double> layer_opacity;
@@ -157,7 +163,7 @@ struct SceneView {
 
 inline SceneView PreparedScene::view() const {
     return {span_of(segments),     span_of(point_hw),     span_of(fill_items),   span_of(stroke_items),
-            span_of(draws),        span_of(paints),       span_of(stop_offsets), span_of(stop_colors),
+            span_of(draws),        span_of(brushes),       span_of(stop_offsets), span_of(stop_colors),
             span_of(layer_parent), span_of(layer_opacity), span_of(layer_depth)};
 }
 
