@@ -5,8 +5,10 @@
 #include <pybind11/stl.h>
 
 #include <atomic>
+#include <initializer_list>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "backward/backward.h"
 #include "common/thread_pool.h"
@@ -23,13 +25,20 @@ namespace {
 template <typename T>
 using Array = py::array_t<T, py::array::c_style | py::array::forcecast>;
 
+// A table of rows `cols` wide: its row count n and data. A table of two or more dimensions
+// must have rows of that width; a flat one must hold whole rows.
 template <typename T>
 const T* rows(const Array<T>& a, int cols, int& n, const char* name) {
     if (a.size() == 0) {
         n = 0;
         return nullptr;
     }
-    if (a.size() % cols != 0) throw std::invalid_argument(std::string("vecfit core: ") + name + " has the wrong shape");
+    if ((a.ndim() >= 2 && a.shape(a.ndim() - 1) != cols) || a.size() % cols != 0) {
+        std::string shape;
+        for (py::ssize_t i = 0; i < a.ndim(); ++i) shape += (i ? ", " : "") + std::to_string(a.shape(i));
+        throw std::invalid_argument(std::string("vecfit core: ") + name + " has the wrong shape: rows of " +
+                                    std::to_string(cols) + " expected, not [" + shape + "]");
+    }
     n = (int)(a.size() / cols);
     return a.data();
 }
@@ -54,7 +63,7 @@ struct SceneInput {
 
     SceneArrays arrays() const {
         SceneArrays a;
-        a.points = rows(points, 2, a.n_points, "points");
+        a.points = rows(points, POINT_COLS, a.n_points, "points");
         a.point_widths = rows(point_widths, 1, a.n_point_widths, "point_widths");
         a.segments = rows(segments, SEGMENT_COLS, a.n_segments, "segments");
         a.subpaths = rows(subpaths, SUBPATH_COLS, a.n_subpaths, "subpaths");
@@ -68,7 +77,7 @@ struct SceneInput {
         a.paint_params = rows(paint_params, PAINT_FCOLS, n, "paint_params");
         if (n != a.n_paints) throw std::invalid_argument("vecfit core: paint_params does not match paints");
         a.stop_offsets = rows(stop_offsets, 1, a.n_stops, "stop_offsets");
-        a.stop_colors = rows(stop_colors, 4, n, "stop_colors");
+        a.stop_colors = rows(stop_colors, STOP_COLOR_COLS, n, "stop_colors");
         if (n != a.n_stops) throw std::invalid_argument("vecfit core: stop_colors does not match stop_offsets");
         a.layer_parents = rows(layer_parents, 1, a.n_layers, "layer_parents");
         a.layer_opacity = rows(layer_opacity, 1, n, "layer_opacity");
@@ -171,15 +180,48 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
         return arr;
     };
     py::dict r;
-    r["points"] = out(g.points, 2);
+    r["points"] = out(g.points, POINT_COLS);
     r["point_widths"] = out(g.point_widths, 1);
     r["ellipses"] = out(g.ellipses, ELLIPSE_COLS);
     r["draw_params"] = out(g.draw_params, DRAW_FCOLS);
     r["paint_params"] = out(g.paint_params, PAINT_FCOLS);
     r["stop_offsets"] = out(g.stop_offsets, 1);
-    r["stop_colors"] = out(g.stop_colors, 4);
+    r["stop_colors"] = out(g.stop_colors, STOP_COLOR_COLS);
     r["layer_opacity"] = out(g.layer_opacity, 1);
     return r;
+}
+
+// The array layout of scene.h for Python (vecfit/renderer/layout.py reads it, so that
+// Python keeps no copy): the enums of the integer tables, by the names Python uses, and
+// the row width of every table a scene dict holds (the keys SceneInput reads).
+py::dict layout() {
+    auto named = [](std::initializer_list<std::pair<const char*, int>> items) {
+        py::dict d;
+        for (const auto& [name, value] : items) d[name] = value;
+        return d;
+    };
+    py::dict l;
+    l["shape_kinds"] = named({{"path", SHAPE_PATH}, {"ellipse", SHAPE_ELLIPSE}});
+    l["draw_kinds"] = named({{"fill", DRAW_FILL}, {"stroke", DRAW_STROKE}});
+    l["fill_rules"] = named({{"nonzero", NONZERO}, {"evenodd", EVENODD}});
+    l["caps"] = named({{"butt", CAP_BUTT}, {"round", CAP_ROUND}, {"square", CAP_SQUARE}});
+    l["joins"] = named({{"miter", JOIN_MITER}, {"round", JOIN_ROUND}, {"bevel", JOIN_BEVEL}});
+    l["paint_kinds"] = named({{"solid", BRUSH_SOLID}, {"linear", BRUSH_LINEAR}, {"radial", BRUSH_RADIAL}});
+    l["columns"] = named({{"points", POINT_COLS},
+                          {"point_widths", 1},
+                          {"segments", SEGMENT_COLS},
+                          {"subpaths", SUBPATH_COLS},
+                          {"shapes", SHAPE_COLS},
+                          {"ellipses", ELLIPSE_COLS},
+                          {"draws", DRAW_COLS},
+                          {"draw_params", DRAW_FCOLS},
+                          {"paints", PAINT_COLS},
+                          {"paint_params", PAINT_FCOLS},
+                          {"stop_offsets", 1},
+                          {"stop_colors", STOP_COLOR_COLS},
+                          {"layer_parents", 1},
+                          {"layer_opacity", 1}});
+    return l;
 }
 
 }  // namespace
@@ -196,6 +238,9 @@ PYBIND11_MODULE(_core, m) {
           py::arg("samples"), py::arg("mode"), py::arg("filter"), py::arg("filter_radius"), py::arg("seed"),
           py::arg("threads"), py::arg("background"), py::arg("boundary_density"), py::arg("device") = -1,
           py::arg("emulate_gpu_lists") = false);
+    m.def("layout", &layout,
+          "The scene arrays' layout: enums (shape_kinds, draw_kinds, fill_rules, caps, joins, paint_kinds) "
+          "and each table's row width (columns)");
     m.def("backward_fallbacks", [] { return backward_fallbacks.load(); },
           "Backward passes redone on the CPU so far because a sample needed longer lists than a GPU thread has");
     m.def("hardware_threads", &ThreadPool::hardware_threads);

@@ -25,7 +25,9 @@ enum Cap : int32_t { CAP_BUTT = 0, CAP_ROUND = 1, CAP_SQUARE = 2 };
 enum Join : int32_t { JOIN_MITER = 0, JOIN_ROUND = 1, JOIN_BEVEL = 2 };
 enum BrushKind : int32_t { BRUSH_SOLID = 0, BRUSH_LINEAR = 1, BRUSH_RADIAL = 2 };
 
-// Column layouts of the input tables (row-major, one row per item).
+// Column layouts of the input tables (row-major, one row per item). These, the enums above
+// and the tables' keys are what _core.layout() exports to Python (python/bindings.cpp).
+constexpr int POINT_COLS = 2;     // x, y
 constexpr int SEGMENT_COLS = 5;   // degree, point index of each control point (-1 unused)
 constexpr int SUBPATH_COLS = 3;   // first segment, segment count, closed (0/1)
 constexpr int SHAPE_COLS = 4;     // kind, first subpath, subpath count, ellipse index
@@ -34,6 +36,8 @@ constexpr int DRAW_COLS = 8;      // shape, kind, fill rule, paint, layer, cap, 
 constexpr int DRAW_FCOLS = 6;     // stroke width (unused with per-point widths), miter limit, metric (a b c d)
 constexpr int PAINT_COLS = 3;     // kind, first stop, stop count
 constexpr int PAINT_FCOLS = 11;   // pixel->paint affine (6), then solid rgba | x1 y1 x2 y2 | cx cy r fx fy
+constexpr int STOP_COLOR_COLS = 4;  // straight RGBA
+// point_widths, stop_offsets, layer_parents and layer_opacity: one value per row.
 
 struct SceneArrays {
     const float* points = nullptr;       int n_points = 0;     // [P, 2]
