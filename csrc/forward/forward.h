@@ -1,4 +1,5 @@
-// Forward rendering of a prepared scene into a straight-RGBA float image.
+// Forward rendering of a prepared scene into a straight-RGBA float image; and the render
+// options, which the backward pass takes too.
 #pragma once
 
 #include <cstdint>
