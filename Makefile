@@ -10,7 +10,11 @@ TORCH := torch==2.13.0
 
 install: $(STAMP)
 
-$(STAMP): pyproject.toml CMakeLists.txt $(wildcard csrc/*)
+# Everything under csrc/, subfolders included (a folder too: adding, removing or renaming
+# a file in it changes its time).
+CSRC := $(shell find csrc)
+
+$(STAMP): pyproject.toml CMakeLists.txt $(CSRC)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q $(TORCH)

@@ -1,5 +1,5 @@
-// The CUDA backward pass: the launch and memory code around interior_pixel and
-// boundary_sample (backward_sample.h), the per-sample functions the CPU lanes run too.
+// The CUDA backward pass: the launch and memory code around pixel_backward and
+// boundary_sample (backward/pixel.h), the per-sample functions the CPU lanes run too.
 // The plan (tiles, pixel adjoints, boundary pieces) is made on the host; the interior
 // term runs one thread per pixel, one block per tile; the boundary term one thread per
 // boundary sample. Threads add into shared gradient arrays atomically.
@@ -7,9 +7,9 @@
 
 #include <vector>
 
-#include "../backward.h"
-#include "../gpu.h"
-#include "device_memory.cuh"
+#include "backward/backward.h"
+#include "cuda/device_memory.cuh"
+#include "gpu/gpu.h"
 
 namespace vf {
 namespace gpu {
@@ -18,12 +18,12 @@ namespace {
 // Per-thread list sizes (backward.h): past them a thread flags an overflow and the host
 // redoes the pass on the CPU, whose lists are sized to the scene.
 constexpr int GPU_HITS = GPU_LISTS.hits, GPU_OPS = GPU_LISTS.ops;
-// Per-thread stack: the interior kernel's frame (17.3 KB on sm_80/90: those lists and the
+// Per-thread stack: pixel_backward_kernel's frame (17.3 KB on sm_80/90: those lists and the
 // compositor's layer stacks; the boundary kernel's is 8.6 KB) and the root finder's
 // recursion.
 constexpr size_t STACK_BYTES = 20480 + RECURSION_STACK;
 
-__global__ void interior_kernel(SceneView sc, TileView bins, RenderOptions o, const double* gpix, GradView g,
+__global__ void pixel_backward_kernel(SceneView sc, TileView bins, RenderOptions o, const double* gpix, GradView g,
                                 int* overflow) {
     int x, y;
     tile_pixel(bins, x, y);
@@ -31,8 +31,8 @@ __global__ void interior_kernel(SceneView sc, TileView bins, RenderOptions o, co
     Hit hits[GPU_HITS];
     TapeOp ops[GPU_OPS];
     Quad g_hits[GPU_HITS];
-    InteriorScratch w{{hits, GPU_HITS}, {{ops, GPU_OPS}}, {g_hits, GPU_HITS}};
-    interior_pixel(sc, bins, o, gpix + 4 * ((size_t)y * o.width + x), x, y, w, g);
+    SampleScratch w{{hits, GPU_HITS}, {{ops, GPU_OPS}}, {g_hits, GPU_HITS}};
+    pixel_backward(sc, bins, o, gpix + 4 * ((size_t)y * o.width + x), x, y, w, g);
     if (w.overflow()) *overflow = 1;
 }
 
@@ -103,8 +103,8 @@ bool render_backward(const PreparedScene& scene, const SceneArrays& arrays, cons
     int* overflow = static_cast<int*>(overflow_flag.get());
     check(cudaMemset(overflow, 0, sizeof(int)), "cudaMemset");
 
-    interior_kernel<<<tile_blocks(bins), dim3(TILE, TILE)>>>(sc, bins, plan.options, gpix, grads.view, overflow);
-    check(cudaGetLastError(), "interior_kernel launch");
+    pixel_backward_kernel<<<tile_blocks(bins), dim3(TILE, TILE)>>>(sc, bins, plan.options, gpix, grads.view, overflow);
+    check(cudaGetLastError(), "pixel_backward_kernel launch");
 
     if (!plan.pieces.empty()) {
         std::vector<long long> first(plan.pieces.size() + 1, 0);

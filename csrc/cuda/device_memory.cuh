@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "../gpu.h"
-#include "../scene.h"
-#include "../tiles.h"
+#include "gpu/gpu.h"
+#include "scene/scene.h"
+#include "scene/tiles.h"
 
 namespace vf {
 namespace gpu {
@@ -56,7 +56,7 @@ inline SceneView upload_scene(Uploads& up, const PreparedScene& sc) {
     v.fill_items = up.put(sc.fill_items);
     v.stroke_items = up.put(sc.stroke_items);
     v.draws = up.put(sc.draws);
-    v.paints = up.put(sc.paints);
+    v.brushes = up.put(sc.brushes);
     v.stop_offsets = up.put(sc.stop_offsets);
     v.stop_colors = up.put(sc.stop_colors);
     v.layer_parent = up.put(sc.layer_parent);

@@ -1,15 +1,15 @@
-// The CUDA forward pass: the launch and memory code around shade_pixel (shade.h), the
-// per-pixel function the CPU build runs too. One thread per pixel, one block per tile, so
-// a block's threads walk the same tile entries.
+// The CUDA forward pass: the launch and memory code around pixel_forward
+// (forward/pixel.h), the per-pixel function the CPU build runs too. One thread per pixel,
+// one block per tile, so a block's threads walk the same tile entries.
 #include <cuda_runtime.h>
 
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "../gpu.h"
-#include "../shade.h"
-#include "device_memory.cuh"
+#include "cuda/device_memory.cuh"
+#include "forward/pixel.h"
+#include "gpu/gpu.h"
 
 namespace vf {
 namespace gpu {
@@ -19,11 +19,11 @@ struct Background {
     double c[4];
 };
 
-__global__ void shade_kernel(SceneView sc, TileView bins, RenderOptions o, Background bg, float* out) {
+__global__ void pixel_forward_kernel(SceneView sc, TileView bins, RenderOptions o, Background bg, float* out) {
     int x, y;
     tile_pixel(bins, x, y);
     if (x >= o.width || y >= o.height) return;
-    shade_pixel(sc, bins, o, bg.c, x, y, out + 4 * ((size_t)y * o.width + x));
+    pixel_forward(sc, bins, o, bg.c, x, y, out + 4 * ((size_t)y * o.width + x));
 }
 
 // Per-thread stack: the kernel's frame (3.3 KB on sm_80/90, mostly the compositor's layer
@@ -75,8 +75,8 @@ void render_forward(const PreparedScene& scene, const RenderOptions& options, in
     size_t bytes = (size_t)options.width * options.height * 4 * sizeof(float);
     DeviceBuffer image(bytes);
     Background bg{{plan.background[0], plan.background[1], plan.background[2], plan.background[3]}};
-    shade_kernel<<<tile_blocks(bins), dim3(TILE, TILE)>>>(sc, bins, plan.options, bg, static_cast<float*>(image.get()));
-    check(cudaGetLastError(), "shade_kernel launch");
+    pixel_forward_kernel<<<tile_blocks(bins), dim3(TILE, TILE)>>>(sc, bins, plan.options, bg, static_cast<float*>(image.get()));
+    check(cudaGetLastError(), "pixel_forward_kernel launch");
     check(cudaMemcpy(out, image.get(), bytes, cudaMemcpyDeviceToHost), "cudaMemcpy (image)");
 }
 

@@ -45,8 +45,9 @@
 // with the vertex's half width (StrokeEnd::hw) instead of the draw's.
 #pragma once
 
-#include "geometry.h"
-#include "scene.h"
+#include "common/bezier.h"
+#include "common/ellipse.h"
+#include "scene/scene.h"
 
 namespace vf {
 
@@ -319,7 +320,7 @@ VF_HD double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double limit, SdfAr
 
 // ----------------------------------------------------------------- whole draws
 // The queries below take the draw's items to look at: all of them (AllItems), or those
-// a tile lists (see tiles.h). Fill winding numbers are computed by the caller.
+// a tile lists (see scene/tiles.h). Fill winding numbers are computed by the caller.
 
 struct AllItems {
     int n;

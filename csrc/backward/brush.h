@@ -1,79 +1,14 @@
-// Paint evaluation: solid colours and linear / radial gradients (pad spread), returned
-// premultiplied.
+// The adjoint of brush evaluation (scene/brush.h): dL/d(premultiplied colour) at a point
+// to dL/d(brush parameters (the paint_params table), stop offsets, stop colours).
 #pragma once
 
-#include "geometry.h"
-#include "grads.h"
-#include "scene.h"
+#include <cmath>
 
-namespace vf {
-
-// Colour of the stops at t (straight RGBA interpolated, as SVG does), premultiplied.
-VF_HD void stop_color(const SceneView& sc, const PreparedPaint& p, double t, double out[4]) {
-    const double* off = sc.stop_offsets.data() + p.first_stop;
-    const double* col = sc.stop_colors.data() + 4 * p.first_stop;
-    int n = p.n_stops;
-    double c[4];
-    if (!(t > off[0])) {  // also catches NaN
-        for (int i = 0; i < 4; ++i) c[i] = col[i];
-    } else if (t >= off[n - 1]) {
-        for (int i = 0; i < 4; ++i) c[i] = col[4 * (n - 1) + i];
-    } else {
-        int k = 0;
-        while (k + 2 < n && t >= off[k + 1]) ++k;
-        double span = off[k + 1] - off[k];
-        double u = span > 0 ? (t - off[k]) / span : 1.0;
-        for (int i = 0; i < 4; ++i) c[i] = (1 - u) * col[4 * k + i] + u * col[4 * (k + 1) + i];
-    }
-    double a = vclamp(c[3], 0.0, 1.0);
-    for (int i = 0; i < 3; ++i) out[i] = vclamp(c[i], 0.0, 1.0) * a;
-    out[3] = a;
-}
-
-// Gradient parameter of a radial gradient with focal point f and circle (c, r), as SVG 2
-// defines it (a two-point cone from a circle of radius 0 at f to the circle (c, r)): the
-// largest t with t r >= 0 for which q lies on the circle of centre f + t (c - f) and
-// radius t r. Returns false where no such t exists: outside the cone, when the focal
-// point lies outside the circle; that area is not painted.
-VF_HD bool radial_t(Vec2 q, Vec2 c, double r, Vec2 f, double& t) {
-    Vec2 d = c - f, e = q - f;
-    double a = dot(d, d) - r * r, b = dot(e, d), cc = dot(e, e);
-    if (std::fabs(a) <= 1e-9 * r * r) {  // focal point on the circle: a linear equation
-        if (b <= 0) return false;
-        t = cc / (2 * b);
-        return true;
-    }
-    double disc = b * b - a * cc;
-    if (disc < 0) return false;
-    t = a < 0 ? (b - std::sqrt(disc)) / a : (b + std::sqrt(disc)) / a;
-    return t >= 0;
-}
-
-VF_HD void paint_color(const SceneView& sc, const PreparedPaint& p, Vec2 pixel, double out[4]) {
-    if (p.kind == PAINT_SOLID) {
-        double a = vclamp(p.rgba[3], 0.0, 1.0);
-        for (int i = 0; i < 3; ++i) out[i] = vclamp(p.rgba[i], 0.0, 1.0) * a;
-        out[3] = a;
-        return;
-    }
-    Vec2 q = apply(p.to_paint, pixel);
-    double t;
-    if (p.kind == PAINT_LINEAR) {
-        Vec2 a{p.g[0], p.g[1]}, d = Vec2{p.g[2], p.g[3]} - a;
-        double l2 = dot(d, d);
-        t = l2 > 0 ? dot(q - a, d) / l2 : 1.0;  // degenerate: the last stop's colour
-    } else {
-        double r = p.g[2];
-        t = 1.0;  // a zero radius paints with the last stop
-        if (r > 0 && !radial_t(q, {p.g[0], p.g[1]}, r, {p.g[3], p.g[4]}, t)) {
-            out[0] = out[1] = out[2] = out[3] = 0;
-            return;
-        }
-    }
-    stop_color(sc, p, t, out);
-}
-
-}  // namespace vf
+#include "backward/grads.h"
+#include "common/portable.h"
+#include "common/vec.h"
+#include "scene/brush.h"
+#include "scene/scene.h"
 
 namespace vf {
 
@@ -88,23 +23,23 @@ VF_HD void premultiply_backward(const double c[4], const double g[4], double gc[
     gc[3] = (c[3] >= 0 && c[3] <= 1) ? ga : 0.0;
 }
 
-// Adjoint of paint_color: g is dL/d(premultiplied colour at `pixel`); adds dL/d(paint
+// Adjoint of brush_color: g is dL/d(premultiplied colour at `pixel`); adds dL/d(brush
 // parameters, stop offsets, stop colours) into grads.
-VF_HD void paint_color_backward(const SceneView& sc, int paint_index, Vec2 pixel, const double g[4],
+VF_HD void brush_color_backward(const SceneView& sc, int brush_index, Vec2 pixel, const double g[4],
                                 const GradView& grads) {
-    const PreparedPaint& p = sc.paints[paint_index];
-    GradPtr gp = grads.paint_params + PAINT_FCOLS * paint_index;
-    if (p.kind == PAINT_SOLID) {
+    const PreparedBrush& p = sc.brushes[brush_index];
+    GradPtr gp = grads.paint_params + PAINT_FCOLS * brush_index;
+    if (p.kind == BRUSH_SOLID) {
         double gc[4];
         premultiply_backward(p.rgba, g, gc);
         for (int i = 0; i < 4; ++i) gp[6 + i] += gc[i];
         return;
     }
-    Vec2 q = apply(p.to_paint, pixel);
+    Vec2 q = apply(p.to_brush, pixel);
     double t;
     Vec2 dt_dq{0, 0};
     double gg[5] = {0, 0, 0, 0, 0};  // dt / d(gradient geometry g[0..4])
-    if (p.kind == PAINT_LINEAR) {
+    if (p.kind == BRUSH_LINEAR) {
         Vec2 a{p.g[0], p.g[1]}, d = Vec2{p.g[2], p.g[3]} - a, e = q - a;
         double D = dot(d, d);
         if (D <= 0) return;  // constant colour: the last stop

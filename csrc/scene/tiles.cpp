@@ -1,9 +1,9 @@
-#include "tiles.h"
+#include "scene/tiles.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "coverage.h"
+#include "scene/coverage.h"
 
 namespace vf {
 namespace {

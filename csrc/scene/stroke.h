@@ -3,8 +3,8 @@
 // rebuilds them under small changes of the tangents and the width).
 #pragma once
 
-#include "geometry.h"
-#include "scene.h"
+#include "common/bezier.h"
+#include "scene/scene.h"
 
 namespace vf {
 

@@ -1,13 +1,20 @@
 // The scene as the core sees it: flat arrays in (structure of arrays, filled by the
 // Python side, all geometry already in pixel space), and the prepared form the samplers
-// read (segments with their control points, bounds, joins, paints).
+// read (segments with their control points, bounds, joins, brushes).
+//
+// Names: a fill or stroke's colour source (solid, linear or radial gradient) is a brush
+// inside the core (as vello calls it: "paint" is the painterly command elsewhere in
+// vecfit). The input tables keep the names Python gives them ("paints", "paint_params",
+// their PAINT_COLS / PAINT_FCOLS widths, the draws table's paint column): they are the
+// Python-facing contract, read by python/bindings.cpp and exported by _core.layout().
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
-#include "device.h"
-#include "geometry.h"
+#include "common/bezier.h"
+#include "common/ellipse.h"
+#include "common/portable.h"
 
 namespace vf {
 
@@ -16,9 +23,11 @@ enum DrawKind : int32_t { DRAW_FILL = 0, DRAW_STROKE = 1 };
 enum FillRule : int32_t { NONZERO = 0, EVENODD = 1 };
 enum Cap : int32_t { CAP_BUTT = 0, CAP_ROUND = 1, CAP_SQUARE = 2 };
 enum Join : int32_t { JOIN_MITER = 0, JOIN_ROUND = 1, JOIN_BEVEL = 2 };
-enum PaintKind : int32_t { PAINT_SOLID = 0, PAINT_LINEAR = 1, PAINT_RADIAL = 2 };
+enum BrushKind : int32_t { BRUSH_SOLID = 0, BRUSH_LINEAR = 1, BRUSH_RADIAL = 2 };
 
-// Column layouts of the input tables (row-major, one row per item).
+// Column layouts of the input tables (row-major, one row per item). These, the enums above
+// and the tables' keys are what _core.layout() exports to Python (python/bindings.cpp).
+constexpr int POINT_COLS = 2;     // x, y
 constexpr int SEGMENT_COLS = 5;   // degree, point index of each control point (-1 unused)
 constexpr int SUBPATH_COLS = 3;   // first segment, segment count, closed (0/1)
 constexpr int SHAPE_COLS = 4;     // kind, first subpath, subpath count, ellipse index
@@ -27,6 +36,8 @@ constexpr int DRAW_COLS = 8;      // shape, kind, fill rule, paint, layer, cap, 
 constexpr int DRAW_FCOLS = 6;     // stroke width (unused with per-point widths), miter limit, metric (a b c d)
 constexpr int PAINT_COLS = 3;     // kind, first stop, stop count
 constexpr int PAINT_FCOLS = 11;   // pixel->paint affine (6), then solid rgba | x1 y1 x2 y2 | cx cy r fx fy
+constexpr int STOP_COLOR_COLS = 4;  // straight RGBA
+// point_widths, stop_offsets, layer_parents and layer_opacity: one value per row.
 
 struct SceneArrays {
     const float* points = nullptr;       int n_points = 0;     // [P, 2]
@@ -99,7 +110,7 @@ struct StrokeSegment {
 };
 
 struct PreparedDraw {
-    int32_t shape = 0, kind = DRAW_FILL, fill_rule = NONZERO, paint = 0, layer = 0;
+    int32_t shape = 0, kind = DRAW_FILL, fill_rule = NONZERO, brush = 0, layer = 0;
     int32_t cap = CAP_BUTT, join = JOIN_MITER;
     double half_width = 0, miter_limit = 4;  // per-point widths: the largest half width
     bool varying = false;       // stroke with per-point widths (StrokeSegment::hw, StrokeEnd::hw)
@@ -116,9 +127,9 @@ struct PreparedDraw {
     Box box;                            // pixel-space bounds of what the draw can cover
 };
 
-struct PreparedPaint {
-    int32_t kind = PAINT_SOLID;
-    Affine to_paint;            // pixel -> paint space
+struct PreparedBrush {
+    int32_t kind = BRUSH_SOLID;
+    Affine to_brush;            // pixel -> brush space
     double rgba[4] = {0, 0, 0, 0};
     double g[5] = {0, 0, 0, 0, 0};
     int first_stop = 0, n_stops = 0;
@@ -130,7 +141,7 @@ struct PreparedScene {
     std::vector<PreparedSegment> fill_items; // per fill draw: its segments and closing lines
     std::vector<StrokeSegment> stroke_items; // per stroke draw
     std::vector<PreparedDraw> draws;
-    std::vector<PreparedPaint> paints;
+    std::vector<PreparedBrush> brushes;
     std::vector<double> stop_offsets;
     std::vector<double> stop_colors;          // straight RGBA
     std::vector<int32_t> layer_parent;
@@ -147,7 +158,7 @@ struct SceneView {
     Span<PreparedSegment> fill_items;
     Span<StrokeSegment> stroke_items;
     Span<PreparedDraw> draws;
-    Span<PreparedPaint> paints;
+    Span<PreparedBrush> brushes;
     Span<double> stop_offsets, stop_colors;
     Span<int32_t> layer_parent;
     Span<double> layer_opacity;
@@ -156,7 +167,7 @@ struct SceneView {
 
 inline SceneView PreparedScene::view() const {
     return {span_of(segments),     span_of(point_hw),     span_of(fill_items),   span_of(stroke_items),
-            span_of(draws),        span_of(paints),       span_of(stop_offsets), span_of(stop_colors),
+            span_of(draws),        span_of(brushes),       span_of(stop_offsets), span_of(stop_colors),
             span_of(layer_parent), span_of(layer_opacity), span_of(layer_depth)};
 }
 

@@ -1,10 +1,10 @@
 // Forward pass on the CPU: the tiles are shared out between threads; each pixel is
-// shaded by shade_pixel (shade.h), which a CUDA build runs on the GPU as well.
+// shaded by pixel_forward (forward/pixel.h), which a CUDA build runs on the GPU as well.
 #include <algorithm>
 
-#include "render.h"
-#include "shade.h"
-#include "thread_pool.h"
+#include "common/thread_pool.h"
+#include "forward/forward.h"
+#include "forward/pixel.h"
 
 namespace vf {
 
@@ -42,7 +42,7 @@ void render_forward(const PreparedScene& prepared, const RenderOptions& o, float
         int tx = tile % bins.nx, ty = tile / bins.nx;
         for (int y = ty * TILE; y < std::min(H, (ty + 1) * TILE); ++y)
             for (int x = tx * TILE; x < std::min(W, (tx + 1) * TILE); ++x)
-                shade_pixel(sc, bins, plan.options, plan.background, x, y, out + 4 * ((size_t)y * W + x));
+                pixel_forward(sc, bins, plan.options, plan.background, x, y, out + 4 * ((size_t)y * W + x));
     });
 }
 

@@ -6,8 +6,8 @@
 
 #include <vector>
 
-#include "device.h"
-#include "scene.h"
+#include "common/portable.h"
+#include "scene/scene.h"
 
 namespace vf {
 

@@ -1,18 +1,21 @@
-// Python bindings: numpy buffers in and out, the GIL released while the core works.
+// Python bindings of the core's API: numpy buffers in and out, the GIL released while
+// the core works. The hooks only the tests call are in test_hooks.cpp.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <atomic>
+#include <initializer_list>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
-#include "backward.h"
-#include "coverage.h"
-#include "gpu.h"
-#include "render.h"
-#include "scene.h"
-#include "thread_pool.h"
+#include "backward/backward.h"
+#include "common/thread_pool.h"
+#include "forward/forward.h"
+#include "gpu/gpu.h"
+#include "python/test_hooks.h"
+#include "scene/scene.h"
 
 namespace py = pybind11;
 using namespace vf;
@@ -22,13 +25,20 @@ namespace {
 template <typename T>
 using Array = py::array_t<T, py::array::c_style | py::array::forcecast>;
 
+// A table of rows `cols` wide: its row count n and data. A table of two or more dimensions
+// must have rows of that width; a flat one must hold whole rows.
 template <typename T>
 const T* rows(const Array<T>& a, int cols, int& n, const char* name) {
     if (a.size() == 0) {
         n = 0;
         return nullptr;
     }
-    if (a.size() % cols != 0) throw std::invalid_argument(std::string("vecfit core: ") + name + " has the wrong shape");
+    if ((a.ndim() >= 2 && a.shape(a.ndim() - 1) != cols) || a.size() % cols != 0) {
+        std::string shape;
+        for (py::ssize_t i = 0; i < a.ndim(); ++i) shape += (i ? ", " : "") + std::to_string(a.shape(i));
+        throw std::invalid_argument(std::string("vecfit core: ") + name + " has the wrong shape: rows of " +
+                                    std::to_string(cols) + " expected, not [" + shape + "]");
+    }
     n = (int)(a.size() / cols);
     return a.data();
 }
@@ -53,7 +63,7 @@ struct SceneInput {
 
     SceneArrays arrays() const {
         SceneArrays a;
-        a.points = rows(points, 2, a.n_points, "points");
+        a.points = rows(points, POINT_COLS, a.n_points, "points");
         a.point_widths = rows(point_widths, 1, a.n_point_widths, "point_widths");
         a.segments = rows(segments, SEGMENT_COLS, a.n_segments, "segments");
         a.subpaths = rows(subpaths, SUBPATH_COLS, a.n_subpaths, "subpaths");
@@ -67,7 +77,7 @@ struct SceneInput {
         a.paint_params = rows(paint_params, PAINT_FCOLS, n, "paint_params");
         if (n != a.n_paints) throw std::invalid_argument("vecfit core: paint_params does not match paints");
         a.stop_offsets = rows(stop_offsets, 1, a.n_stops, "stop_offsets");
-        a.stop_colors = rows(stop_colors, 4, n, "stop_colors");
+        a.stop_colors = rows(stop_colors, STOP_COLOR_COLS, n, "stop_colors");
         if (n != a.n_stops) throw std::invalid_argument("vecfit core: stop_colors does not match stop_offsets");
         a.layer_parents = rows(layer_parents, 1, a.n_layers, "layer_parents");
         a.layer_opacity = rows(layer_opacity, 1, n, "layer_opacity");
@@ -170,24 +180,48 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
         return arr;
     };
     py::dict r;
-    r["points"] = out(g.points, 2);
+    r["points"] = out(g.points, POINT_COLS);
     r["point_widths"] = out(g.point_widths, 1);
     r["ellipses"] = out(g.ellipses, ELLIPSE_COLS);
     r["draw_params"] = out(g.draw_params, DRAW_FCOLS);
     r["paint_params"] = out(g.paint_params, PAINT_FCOLS);
     r["stop_offsets"] = out(g.stop_offsets, 1);
-    r["stop_colors"] = out(g.stop_colors, 4);
+    r["stop_colors"] = out(g.stop_colors, STOP_COLOR_COLS);
     r["layer_opacity"] = out(g.layer_opacity, 1);
     return r;
 }
 
-Segment segment_from(const Array<double>& pts) {
-    if (pts.ndim() != 2 || pts.shape(1) != 2 || pts.shape(0) < 2 || pts.shape(0) > 4)
-        throw std::invalid_argument("points must be an [n, 2] array with n in 2..4");
-    Segment s;
-    s.degree = (int)pts.shape(0) - 1;
-    for (int i = 0; i <= s.degree; ++i) s.p[i] = {pts.at(i, 0), pts.at(i, 1)};
-    return s;
+// The array layout of scene.h for Python (vecfit/renderer/layout.py reads it, so that
+// Python keeps no copy): the enums of the integer tables, by the names Python uses, and
+// the row width of every table a scene dict holds (the keys SceneInput reads).
+py::dict layout() {
+    auto named = [](std::initializer_list<std::pair<const char*, int>> items) {
+        py::dict d;
+        for (const auto& [name, value] : items) d[name] = value;
+        return d;
+    };
+    py::dict l;
+    l["shape_kinds"] = named({{"path", SHAPE_PATH}, {"ellipse", SHAPE_ELLIPSE}});
+    l["draw_kinds"] = named({{"fill", DRAW_FILL}, {"stroke", DRAW_STROKE}});
+    l["fill_rules"] = named({{"nonzero", NONZERO}, {"evenodd", EVENODD}});
+    l["caps"] = named({{"butt", CAP_BUTT}, {"round", CAP_ROUND}, {"square", CAP_SQUARE}});
+    l["joins"] = named({{"miter", JOIN_MITER}, {"round", JOIN_ROUND}, {"bevel", JOIN_BEVEL}});
+    l["paint_kinds"] = named({{"solid", BRUSH_SOLID}, {"linear", BRUSH_LINEAR}, {"radial", BRUSH_RADIAL}});
+    l["columns"] = named({{"points", POINT_COLS},
+                          {"point_widths", 1},
+                          {"segments", SEGMENT_COLS},
+                          {"subpaths", SUBPATH_COLS},
+                          {"shapes", SHAPE_COLS},
+                          {"ellipses", ELLIPSE_COLS},
+                          {"draws", DRAW_COLS},
+                          {"draw_params", DRAW_FCOLS},
+                          {"paints", PAINT_COLS},
+                          {"paint_params", PAINT_FCOLS},
+                          {"stop_offsets", 1},
+                          {"stop_colors", STOP_COLOR_COLS},
+                          {"layer_parents", 1},
+                          {"layer_opacity", 1}});
+    return l;
 }
 
 }  // namespace
@@ -204,6 +238,9 @@ PYBIND11_MODULE(_core, m) {
           py::arg("samples"), py::arg("mode"), py::arg("filter"), py::arg("filter_radius"), py::arg("seed"),
           py::arg("threads"), py::arg("background"), py::arg("boundary_density"), py::arg("device") = -1,
           py::arg("emulate_gpu_lists") = false);
+    m.def("layout", &layout,
+          "The scene arrays' layout: enums (shape_kinds, draw_kinds, fill_rules, caps, joins, paint_kinds) "
+          "and each table's row width (columns)");
     m.def("backward_fallbacks", [] { return backward_fallbacks.load(); },
           "Backward passes redone on the CPU so far because a sample needed longer lists than a GPU thread has");
     m.def("hardware_threads", &ThreadPool::hardware_threads);
@@ -230,70 +267,5 @@ PYBIND11_MODULE(_core, m) {
         return info;
     });
 
-    m.def("polynomial_roots", [](std::vector<double> coeffs, double lo, double hi) {
-        if (coeffs.empty() || coeffs.size() > 6) throw std::invalid_argument("degree must be 0..5");
-        double roots[5];
-        int n = poly_roots(coeffs.data(), (int)coeffs.size() - 1, lo, hi, roots);
-        return std::vector<double>(roots, roots + n);
-    }, py::arg("coeffs"), py::arg("lo"), py::arg("hi"));
-
-    m.def("closest_point_on_segment", [](Array<double> pts, std::pair<double, double> p) {
-        Closest c = seg_closest(segment_from(pts), {p.first, p.second});
-        return py::make_tuple(c.t, c.dist);
-    }, py::arg("points"), py::arg("p"));
-
-    m.def("segment_bounds", [](Array<double> pts) {
-        Box b = seg_bbox(segment_from(pts));
-        return py::make_tuple(b.x0, b.y0, b.x1, b.y1);
-    }, py::arg("points"), "Bounds (x0, y0, x1, y1) of a segment's curve, as the tiles use them");
-
-    m.def("closest_point_on_ellipse", [](std::pair<double, double> center, Array<double> axes,
-                                         std::pair<double, double> p) {
-        if (axes.size() != 4) throw std::invalid_argument("axes must be a 2x2 matrix");
-        Mat2 A{axes.data()[0], axes.data()[1], axes.data()[2], axes.data()[3]};
-        EllipseFrame f = ellipse_frame({center.first, center.second}, A);
-        Vec2 q;
-        double d = ellipse_closest(f, {p.first, p.second}, q);
-        return py::make_tuple(py::make_tuple(q.x, q.y), d);
-    }, py::arg("center"), py::arg("axes"), py::arg("p"));
-
-    m.def("winding_number", [](Array<double> points, Array<int32_t> degrees, Array<int32_t> subpaths,
-                               std::pair<double, double> p) {
-        // Same layout as scene.Path; every subpath closed for filling.
-        const double* P = points.data();
-        int np = (int)(points.size() / 2);
-        int nb = (int)(subpaths.size() / 3);
-        const int32_t* sp = subpaths.data();
-        const int32_t* deg = degrees.data();
-        int w = 0, base = 0;
-        Vec2 q{p.first, p.second};
-        for (int b = 0; b < nb; ++b) {
-            int first = sp[3 * b], count = sp[3 * b + 1];
-            bool closed = sp[3 * b + 2] != 0;
-            int n_pts = closed ? 0 : 1;
-            for (int g = first; g < first + count; ++g) n_pts += deg[g];
-            int k = base;
-            auto pt = [&](int i) {
-                int j = i - base >= n_pts ? base : i;  // a closed subpath wraps to its start
-                if (j >= np) throw std::invalid_argument("points too short for the segments");
-                return Vec2{P[2 * j], P[2 * j + 1]};
-            };
-            for (int g = first; g < first + count; ++g) {
-                Segment s;
-                s.degree = deg[g];
-                for (int i = 0; i <= s.degree; ++i) s.p[i] = pt(k + i);
-                k += s.degree;
-                w += ray_crossings(prepare_segment(s, nullptr), q);
-            }
-            if (!closed && count > 0) {
-                Segment line;
-                line.degree = 1;
-                line.p[0] = pt(k);
-                line.p[1] = pt(base);
-                w += ray_crossings(prepare_segment(line, nullptr), q);
-            }
-            base += n_pts;
-        }
-        return w;
-    }, py::arg("points"), py::arg("degrees"), py::arg("subpaths"), py::arg("p"));
+    register_test_hooks(m);  // python/test_hooks.cpp: what only the tests call
 }

@@ -19,8 +19,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "coverage.h"
-#include "scene.h"
+#include "scene/coverage.h"
+#include "scene/scene.h"
 
 namespace vf {
 

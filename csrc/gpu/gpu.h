@@ -1,13 +1,13 @@
 // The CUDA build's entry points, declared for every build: a CPU-only build defines them
-// in gpu_absent.cpp (they report that CUDA was not compiled in), a CUDA build in
+// in gpu/absent.cpp (they report that CUDA was not compiled in), a CUDA build in
 // csrc/cuda/. Nothing here needs CUDA's headers, so the bindings stay plain C++.
 #pragma once
 
 #include <string>
 
-#include "grads.h"
-#include "render.h"
-#include "scene.h"
+#include "backward/grads.h"
+#include "forward/forward.h"
+#include "scene/scene.h"
 
 namespace vf {
 namespace gpu {
@@ -17,7 +17,7 @@ int device_count();         // CUDA devices this process can use (0 without CUDA
 std::string build_info();   // architectures and CUDA versions, for `vecfit info --build`
 
 // As render_forward, on CUDA device `device`: the scene is prepared and binned on the
-// host, uploaded, and every pixel shaded by the same shade_pixel as on the CPU.
+// host, uploaded, and every pixel shaded by the same pixel_forward as on the CPU.
 void render_forward(const PreparedScene& scene, const RenderOptions& options, int device, float* out);
 
 // As render_backward (backward.h), on CUDA device `device`. Returns false, with `out`

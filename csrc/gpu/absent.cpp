@@ -2,7 +2,7 @@
 #ifndef VECFIT_WITH_CUDA
 #include <stdexcept>
 
-#include "gpu.h"
+#include "gpu/gpu.h"
 
 namespace vf {
 namespace gpu {

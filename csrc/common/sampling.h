@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "common/portable.h"
+
 namespace vf {
 
 VF_HD uint64_t mix64(uint64_t z) {  // splitmix64 finaliser

@@ -2,7 +2,7 @@
 // backward pass's tape.
 #pragma once
 
-#include "scene.h"
+#include "scene/scene.h"
 
 namespace vf {
 

@@ -1,55 +1,19 @@
 // The forward pass's per-pixel work, shared by the CPU loop (forward.cpp) and the CUDA
 // kernel: composite the draws that cover each sample front to back (stopping once it is
 // opaque), with nested layers for group opacity, and filter the samples into a pixel.
+// pixel_forward and sample_forward have their adjoints in backward/pixel.h
+// (pixel_backward, sample_backward).
 #pragma once
 
-#include "coverage.h"
-#include "layers.h"
-#include "paint.h"
-#include "render.h"
-#include "sampling.h"
-#include "tiles.h"
+#include "common/sampling.h"
+#include "forward/composite.h"
+#include "forward/forward.h"
+#include "scene/coverage.h"
+#include "scene/layers.h"
+#include "scene/brush.h"
+#include "scene/tiles.h"
 
 namespace vf {
-
-// Front-to-back compositing with a stack of open layers. Each frame accumulates the
-// premultiplied colour of its layer; closing a layer scales it by the layer's opacity
-// and puts it under what its parent has so far.
-struct Compositor {
-    const SceneView& sc;
-    LayerFrame stack[MAX_LAYER_DEPTH];
-    int top = 0;
-
-    VF_HD explicit Compositor(const SceneView& s) : sc(s) {
-        stack[0].layer = 0;
-        for (int i = 0; i < 4; ++i) stack[0].c[i] = 0;
-    }
-
-    VF_HD void pop() {
-        LayerFrame& child = stack[top--];
-        LayerFrame& parent = stack[top];
-        double k = (1 - parent.c[3]) * sc.layer_opacity[child.layer];
-        for (int i = 0; i < 4; ++i) parent.c[i] += k * child.c[i];
-    }
-
-    VF_HD void enter(int layer) {
-        enter_layer(sc, stack, top, layer, [&] { pop(); }, [](int) {});
-    }
-
-    // Adds a premultiplied colour under what the current layer has.
-    VF_HD void under(const double c[4], double coverage) {
-        LayerFrame& f = stack[top];
-        double k = (1 - f.c[3]) * coverage;
-        for (int i = 0; i < 4; ++i) f.c[i] += k * c[i];
-    }
-
-    VF_HD bool opaque() const { return top == 0 && stack[0].c[3] >= 1 - 1e-12; }
-
-    VF_HD void finish(double out[4]) {
-        while (top > 0) pop();
-        for (int i = 0; i < 4; ++i) out[i] = stack[0].c[i];
-    }
-};
 
 // Coverage of one draw at p in [0, 1]: a step (Monte Carlo) or the prefiltered kernel,
 // from the tile's entry, or, brute force, from every item of the draw.
@@ -78,9 +42,9 @@ VF_HD double entry_coverage(const SceneView& sc, const TileView& bins, const Til
 }
 
 // Premultiplied colour of the scene at pixel-space point p, from the tile's entries.
-VF_HD void eval_point(const SceneView& sc, const TileView& bins, int tile, Vec2 p, const RenderOptions& o,
-                      double out[4]) {
-    Compositor comp(sc);
+VF_HD void sample_forward(const SceneView& sc, const TileView& bins, int tile, Vec2 p, const RenderOptions& o,
+                          double out[4]) {
+    FrontToBackCompositor comp(sc);
     const TileEntry* entries = bins.begin(tile);
     Box region = bins.region(tile);
     for (int k = bins.count(tile) - 1; k >= 0; --k) {
@@ -92,7 +56,7 @@ VF_HD void eval_point(const SceneView& sc, const TileView& bins, int tile, Vec2 
         double coverage = entry_coverage(sc, bins, e, region, p, o);
         if (coverage <= 0) continue;
         double c[4];
-        paint_color(sc, sc.paints[d.paint], p, c);
+        brush_color(sc, sc.brushes[d.brush], p, c);
         if (c[3] <= 0) continue;
         comp.enter(d.layer);
         comp.under(c, coverage);
@@ -103,8 +67,8 @@ VF_HD void eval_point(const SceneView& sc, const TileView& bins, int tile, Vec2 
 
 // One output pixel: its samples filtered, the background under them, as straight RGBA.
 // o is the plan's options (filter radius settled); bg the premultiplied background.
-VF_HD void shade_pixel(const SceneView& sc, const TileView& bins, const RenderOptions& o, const double bg[4], int x,
-                       int y, float* px) {
+VF_HD void pixel_forward(const SceneView& sc, const TileView& bins, const RenderOptions& o, const double bg[4], int x,
+                         int y, float* px) {
     const int N = o.samples;
     const double R = o.filter_radius;
     int tile = (y / TILE) * bins.nx + x / TILE;
@@ -118,7 +82,7 @@ VF_HD void shade_pixel(const SceneView& sc, const TileView& bins, const RenderOp
         double w = filter_weight(o.filter, R, dx, dy);
         if (w <= 0) continue;
         double c[4] = {0, 0, 0, 0};
-        if (any) eval_point(sc, bins, tile, {x + 0.5 + dx, y + 0.5 + dy}, o, c);
+        if (any) sample_forward(sc, bins, tile, {x + 0.5 + dx, y + 0.5 + dy}, o, c);
         for (int i = 0; i < 4; ++i) acc[i] += w * c[i];
         wsum += w;
     }

@@ -1,10 +1,11 @@
-// Forward rendering of a prepared scene into a straight-RGBA float image.
+// Forward rendering of a prepared scene into a straight-RGBA float image; and the render
+// options, which the backward pass takes too.
 #pragma once
 
 #include <cstdint>
 
-#include "scene.h"
-#include "tiles.h"
+#include "scene/scene.h"
+#include "scene/tiles.h"
 
 namespace vf {
 

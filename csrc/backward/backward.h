@@ -4,11 +4,12 @@
 
 #include <vector>
 
-#include "backward_sample.h"
-#include "grads.h"
-#include "render.h"
-#include "scene.h"
-#include "tiles.h"
+#include "backward/boundary.h"
+#include "backward/grads.h"
+#include "backward/pixel.h"
+#include "forward/forward.h"
+#include "scene/scene.h"
+#include "scene/tiles.h"
 
 namespace vf {
 

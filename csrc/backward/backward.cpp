@@ -1,12 +1,12 @@
 // Backward pass on the CPU: the plan (tiles, pixel adjoints, boundary pieces) and the
-// lanes that run the per-sample work of backward_sample.h over it.
-#include "backward.h"
+// lanes that run the per-sample work of backward/pixel.h over it.
+#include "backward/backward.h"
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
-#include "thread_pool.h"
+#include "common/thread_pool.h"
 
 namespace vf {
 namespace {
@@ -136,19 +136,19 @@ bool render_backward(const PreparedScene& prepared, const SceneArrays& a, const 
         std::vector<TapeOp> ops;
         std::vector<Quad> g_hits;
         explicit LaneLists(ListSizes n) : hits(n.hits), ops(n.ops), g_hits(n.hits) {}
-        InteriorScratch scratch() {
+        SampleScratch scratch() {
             return {{hits.data(), (int)hits.size()}, {{ops.data(), (int)ops.size()}}, {g_hits.data(), (int)g_hits.size()}};
         }
     };
     ThreadPool::instance().parallel_for(lanes, lanes, [&](int lane, int) {
         const GradView g = grads[lane].view();
         LaneLists lists(sizes);
-        InteriorScratch w = lists.scratch();
+        SampleScratch w = lists.scratch();
         for (int tile = lane; tile < n_tiles; tile += lanes) {
             int tx = tile % bins.nx, ty = tile / bins.nx;
             for (int y = ty * TILE; y < std::min(H, (ty + 1) * TILE); ++y)
                 for (int x = tx * TILE; x < std::min(W, (tx + 1) * TILE); ++x)
-                    interior_pixel(sc, bins, plan.options, plan.gpix.data() + 4 * ((size_t)y * W + x), x, y, w, g);
+                    pixel_backward(sc, bins, plan.options, plan.gpix.data() + 4 * ((size_t)y * W + x), x, y, w, g);
         }
         if (w.overflow()) overflowed[lane] = 1;  // (the flags stay set once raised)
     });

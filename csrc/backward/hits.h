@@ -1,0 +1,114 @@
+// The draws at a point, front to back, as both terms of the backward pass see them: the
+// Monte Carlo hits (a draw covers the point or not; one may be forced in) and the
+// analytical prefilter's (fractional coverage, with where the signed distance came from).
+#pragma once
+
+#include <cmath>
+
+#include "common/portable.h"
+#include "forward/forward.h"
+#include "scene/coverage.h"
+#include "scene/brush.h"
+#include "scene/scene.h"
+#include "scene/tiles.h"
+
+namespace vf {
+
+struct Hit {
+    int draw;
+    double c[4];  // premultiplied colour of the draw at the point (times its coverage)
+    // analytical prefilter only: coverage K(sd / r), the signed distance, the brush colour
+    // (premultiplied) and the piece the distance came from
+    double cov = 1, sd = 0, brush[4] = {0, 0, 0, 0};
+    SdfArg arg;
+};
+
+VF_HD int tile_of(const TileView& bins, Vec2 p) {
+    int tx = vclamp((int)std::floor(p.x / TILE), 0, bins.nx - 1);
+    int ty = vclamp((int)std::floor(p.y / TILE), 0, bins.ny - 1);
+    return ty * bins.nx + tx;
+}
+
+VF_HD bool covers(const SceneView& sc, const TileView& bins, const TileEntry& e, const Box& region, Vec2 p) {
+    const Box& b = sc.draws[e.draw].box;
+    return p.x >= b.x0 && p.x <= b.x1 && p.y >= b.y0 && p.y <= b.y1 && entry_covers(sc, bins, e, region, p);
+}
+
+// Does draw `draw` cover p? (p inside the tile grid's reach.)
+VF_HD bool draw_covers_at(const SceneView& sc, const TileView& bins, int draw, Vec2 p) {
+    int tile = tile_of(bins, p);
+    Box region = bins.region(tile);
+    if (p.x < region.x0 || p.x > region.x1 || p.y < region.y0 || p.y > region.y1) return false;
+    const TileEntry* es = bins.begin(tile);
+    int n = bins.count(tile);
+    int lo = 0, hi = n;  // entries are sorted by draw index (paint order)
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (es[mid].draw < draw) lo = mid + 1; else hi = mid;
+    }
+    if (lo >= n || es[lo].draw != draw) return false;
+    return covers(sc, bins, es[lo], region, p);
+}
+
+// Draws covering p, front to back, with their premultiplied colours; `forced` (if >= 0)
+// counts as covering. Returns the count.
+VF_HD int collect_hits(const SceneView& sc, const TileView& bins, Vec2 p, int forced, Buffer<Hit>& hits) {
+    hits.clear();
+    int tile = tile_of(bins, p);
+    Box region = bins.region(tile);
+    bool in_region = p.x >= region.x0 && p.x <= region.x1 && p.y >= region.y0 && p.y <= region.y1;
+    const TileEntry* es = bins.begin(tile);
+    int n = in_region ? bins.count(tile) : 0;
+    bool forced_done = forced < 0;
+    // Without layers, what lies behind a second opaque draw cannot matter: the first
+    // opaque one hides it, and that one's alpha derivative needs only the composite behind
+    // it, which the second one ends.
+    bool may_stop = forced < 0 && sc.layer_parent.size() <= 1;
+    int opaque = 0;
+    auto add = [&](int draw) {
+        Hit h;
+        h.draw = draw;
+        brush_color(sc, sc.brushes[sc.draws[draw].brush], p, h.c);
+        hits.push_back(h);
+        if (h.c[3] >= 1) ++opaque;
+    };
+    for (int k = n - 1; k >= 0 && !(may_stop && opaque >= 2); --k) {
+        int draw = es[k].draw;
+        if (!forced_done && forced > draw) {
+            add(forced);
+            forced_done = true;
+        }
+        if (draw == forced) {
+            add(forced);
+            forced_done = true;
+            continue;
+        }
+        if (covers(sc, bins, es[k], region, p)) add(draw);
+    }
+    if (!forced_done) add(forced);
+    return (int)hits.size();
+}
+
+// Analytical prefilter: the draws reaching p, front to back, with fractional coverage.
+VF_HD void collect_hits_analytic(const SceneView& sc, const TileView& bins, Vec2 p, double r, Buffer<Hit>& hits) {
+    hits.clear();
+    int tile = tile_of(bins, p);
+    Box region = bins.region(tile);
+    const TileEntry* es = bins.begin(tile);
+    for (int k = bins.count(tile) - 1; k >= 0; --k) {
+        const TileEntry& e = es[k];
+        const PreparedDraw& d = sc.draws[e.draw];
+        Box near = grown(d.box, r);
+        if (p.x < near.x0 || p.x > near.x1 || p.y < near.y0 || p.y > near.y1) continue;
+        Hit h;
+        h.draw = e.draw;
+        h.sd = entry_sdf(sc, bins, e, region, p, r, &h.arg);
+        h.cov = kernel_coverage(h.sd / r);
+        if (h.cov <= 0) continue;
+        brush_color(sc, sc.brushes[d.brush], p, h.brush);
+        for (int i = 0; i < 4; ++i) h.c[i] = h.cov * h.brush[i];
+        hits.push_back(h);
+    }
+}
+
+}  // namespace vf

@@ -1,0 +1,105 @@
+// Test hooks: the core's geometry called directly from the tests (tests/test_geometry.py),
+// which check it against brute force and a Python reference renderer. Registered on
+// vecfit._core by the module (bindings.cpp); nothing in vecfit/ calls them.
+#include "python/test_hooks.h"
+
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+#include "common/bezier.h"
+#include "common/ellipse.h"
+#include "common/roots.h"
+#include "scene/coverage.h"
+#include "scene/scene.h"
+
+namespace py = pybind11;
+using namespace vf;
+
+namespace {
+
+template <typename T>
+using Array = py::array_t<T, py::array::c_style | py::array::forcecast>;
+
+Segment segment_from(const Array<double>& pts) {
+    if (pts.ndim() != 2 || pts.shape(1) != 2 || pts.shape(0) < 2 || pts.shape(0) > 4)
+        throw std::invalid_argument("points must be an [n, 2] array with n in 2..4");
+    Segment s;
+    s.degree = (int)pts.shape(0) - 1;
+    for (int i = 0; i <= s.degree; ++i) s.p[i] = {pts.at(i, 0), pts.at(i, 1)};
+    return s;
+}
+
+}  // namespace
+
+void register_test_hooks(py::module_& m) {
+    m.def("polynomial_roots", [](std::vector<double> coeffs, double lo, double hi) {
+        if (coeffs.empty() || coeffs.size() > 6) throw std::invalid_argument("degree must be 0..5");
+        double roots[5];
+        int n = poly_roots(coeffs.data(), (int)coeffs.size() - 1, lo, hi, roots);
+        return std::vector<double>(roots, roots + n);
+    }, py::arg("coeffs"), py::arg("lo"), py::arg("hi"));
+
+    m.def("closest_point_on_segment", [](Array<double> pts, std::pair<double, double> p) {
+        Closest c = seg_closest(segment_from(pts), {p.first, p.second});
+        return py::make_tuple(c.t, c.dist);
+    }, py::arg("points"), py::arg("p"));
+
+    m.def("segment_bounds", [](Array<double> pts) {
+        Box b = seg_bbox(segment_from(pts));
+        return py::make_tuple(b.x0, b.y0, b.x1, b.y1);
+    }, py::arg("points"), "Bounds (x0, y0, x1, y1) of a segment's curve, as the tiles use them");
+
+    m.def("closest_point_on_ellipse", [](std::pair<double, double> center, Array<double> axes,
+                                         std::pair<double, double> p) {
+        if (axes.size() != 4) throw std::invalid_argument("axes must be a 2x2 matrix");
+        Mat2 A{axes.data()[0], axes.data()[1], axes.data()[2], axes.data()[3]};
+        EllipseFrame f = ellipse_frame({center.first, center.second}, A);
+        Vec2 q;
+        double d = ellipse_closest(f, {p.first, p.second}, q);
+        return py::make_tuple(py::make_tuple(q.x, q.y), d);
+    }, py::arg("center"), py::arg("axes"), py::arg("p"));
+
+    m.def("winding_number", [](Array<double> points, Array<int32_t> degrees, Array<int32_t> subpaths,
+                               std::pair<double, double> p) {
+        // Same layout as scene.Path; every subpath closed for filling.
+        const double* P = points.data();
+        int np = (int)(points.size() / 2);
+        int nb = (int)(subpaths.size() / 3);
+        const int32_t* sp = subpaths.data();
+        const int32_t* deg = degrees.data();
+        int w = 0, base = 0;
+        Vec2 q{p.first, p.second};
+        for (int b = 0; b < nb; ++b) {
+            int first = sp[3 * b], count = sp[3 * b + 1];
+            bool closed = sp[3 * b + 2] != 0;
+            int n_pts = closed ? 0 : 1;
+            for (int g = first; g < first + count; ++g) n_pts += deg[g];
+            int k = base;
+            auto pt = [&](int i) {
+                int j = i - base >= n_pts ? base : i;  // a closed subpath wraps to its start
+                if (j >= np) throw std::invalid_argument("points too short for the segments");
+                return Vec2{P[2 * j], P[2 * j + 1]};
+            };
+            for (int g = first; g < first + count; ++g) {
+                Segment s;
+                s.degree = deg[g];
+                for (int i = 0; i <= s.degree; ++i) s.p[i] = pt(k + i);
+                k += s.degree;
+                w += ray_crossings(prepare_segment(s, nullptr), q);
+            }
+            if (!closed && count > 0) {
+                Segment line;
+                line.degree = 1;
+                line.p[0] = pt(k);
+                line.p[1] = pt(base);
+                w += ray_crossings(prepare_segment(line, nullptr), q);
+            }
+            base += n_pts;
+        }
+        return w;
+    }, py::arg("points"), py::arg("degrees"), py::arg("subpaths"), py::arg("p"));
+}
