@@ -1,7 +1,8 @@
 """The core exports its array layout (_core.layout(), from csrc/scene/scene.h), and
-vecfit/renderer/layout.py exposes it under the names vecfit/pack.py uses: the values are
-the literals pack.py writes today, every table the bindings read is listed with its row
-width, and the bindings refuse a table whose rows have another width."""
+vecfit/renderer/layout.py exposes it under the names the packer uses (pack.py imports
+them instead of keeping copies): the values are the contract written out here, every
+table the bindings read is listed with its row width, and the bindings refuse a table
+whose rows have another width."""
 from __future__ import annotations
 
 import numpy as np
@@ -10,7 +11,7 @@ import pytest
 from vecfit import _core
 from vecfit.renderer import layout
 
-# As vecfit/pack.py spells them (its literals, and the widths of Packed.arrays()).
+# The contract, as pack.py copied it before the core exported it.
 PACK_LITERALS = {
     "SHAPE_PATH": 0, "SHAPE_ELLIPSE": 1,
     "DRAW_FILL": 0, "DRAW_STROKE": 1,

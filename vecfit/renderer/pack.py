@@ -4,7 +4,8 @@ Geometry is mapped to pixel space here, with torch operations, so that gradients
 transforms, rect corners, circle radii and gradient geometry follow from autograd once
 the core returns gradients of the flat float arrays. Integer tables (structure) are numpy.
 
-Layout of every table: see csrc/scene.h.
+The layout of every table (enums, row widths) is the core's own (layout.py, from
+csrc/scene/scene.h).
 """
 from __future__ import annotations
 
@@ -16,14 +17,10 @@ import torch
 from vecfit.errors import VecfitError
 
 from .geometry import affine_apply, local_bbox, rect_as_path, value
+from .layout import (CAPS, COLUMNS, DRAW_FILL, DRAW_STROKE, FILL_RULES, JOINS, PAINT_LINEAR,
+                     PAINT_RADIAL, PAINT_SOLID, SHAPE_ELLIPSE, SHAPE_PATH)
 from .scene import Circle, LinearGradient, Path, RadialGradient, Rect, Scene, Shape, Solid
 
-SHAPE_PATH, SHAPE_ELLIPSE = 0, 1
-DRAW_FILL, DRAW_STROKE = 0, 1
-FILL_RULES = {"nonzero": 0, "evenodd": 1}
-CAPS = {"butt": 0, "round": 1, "square": 2}
-JOINS = {"miter": 0, "round": 1, "bevel": 2}
-PAINT_SOLID, PAINT_LINEAR, PAINT_RADIAL = 0, 1, 2
 
 
 @dataclass
@@ -57,19 +54,19 @@ class Packed:
             return np.asarray(rows, dtype=np.int32).reshape(-1, width)
 
         return {
-            "points": cat(self.points, 2),
-            "point_widths": cat(self.point_widths, 1).reshape(-1),
+            "points": cat(self.points, COLUMNS["points"]),
+            "point_widths": cat(self.point_widths, COLUMNS["point_widths"]).reshape(-1),
             "segments": (np.concatenate(self.segments).astype(np.int32) if self.segments
-                         else np.zeros((0, 5), dtype=np.int32)),
-            "subpaths": ints(self.subpaths, 3),
-            "shapes": ints(self.shapes, 4),
-            "ellipses": cat(self.ellipses, 6),
-            "draws": ints(self.draws, 8),
-            "draw_params": cat(self.draw_params, 6),
-            "paints": ints(self.paints, 3),
-            "paint_params": cat(self.paint_params, 11),
-            "stop_offsets": cat(self.stop_offsets, 1).reshape(-1),
-            "stop_colors": cat(self.stop_colors, 4),
+                         else np.zeros((0, COLUMNS["segments"]), dtype=np.int32)),
+            "subpaths": ints(self.subpaths, COLUMNS["subpaths"]),
+            "shapes": ints(self.shapes, COLUMNS["shapes"]),
+            "ellipses": cat(self.ellipses, COLUMNS["ellipses"]),
+            "draws": ints(self.draws, COLUMNS["draws"]),
+            "draw_params": cat(self.draw_params, COLUMNS["draw_params"]),
+            "paints": ints(self.paints, COLUMNS["paints"]),
+            "paint_params": cat(self.paint_params, COLUMNS["paint_params"]),
+            "stop_offsets": cat(self.stop_offsets, COLUMNS["stop_offsets"]).reshape(-1),
+            "stop_colors": cat(self.stop_colors, COLUMNS["stop_colors"]),
             "layer_parents": np.asarray(self.layer_parents, dtype=np.int32),
             "layer_opacity": torch.stack([torch.as_tensor(o, dtype=torch.float32).reshape(())
                                           for o in self.layer_opacity]),
