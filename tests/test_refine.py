@@ -13,12 +13,13 @@ from PIL import Image
 
 import vecfit
 from vecfit.fitting import losses
-from helpers import need, quiet_load, run
+from helpers import need, photo_png, quiet_load, run
 from vecfit.io.colors import parse_background
 from vecfit.jobs.config import resolve
 from vecfit.errors import VecfitError
 from vecfit.fitting.metrics import compare
 from vecfit.fitting.loop import Settings, Target, optimize
+from vecfit.jobs.fit import load_target
 from vecfit.renderer.scene import Circle, LinearGradient, Scene, Shape, Solid
 
 from shared_data import SHARED
@@ -416,3 +417,91 @@ def test_settings_defaults_are_the_config_defaults():
     """The Python API's Settings() starts where `vecfit refine` does."""
     from vecfit.jobs.config import configs_dir, read_toml
     assert Settings() == Settings.from_config(read_toml(configs_dir() / "refine.toml")["optimize"])
+
+
+# ------------------------------------------------------------------ coarse to fine, timings
+
+@pytest.fixture(scope="module")
+def small_trace(tmp_path_factory):
+    """skimage's chelsea at 160 x 106 and a 40-path trace of it (vecfit's tracer)."""
+    from vecfit.initial.trace import TraceSettings, trace_image
+    png = photo_png(tmp_path_factory, "chelsea", (160, 106))
+    image = load_target(png)
+    return image, trace_image(image, TraceSettings(paths=40)).svg
+
+
+def test_coarse_to_fine_gains_like_full_size(small_trace, tmp_path):
+    """Half the iterations at half size, then full size: a small trace gains within 0.5 dB
+    of a full-size run of the same length, and the coarse iterations cost less (a quarter
+    of the pixels)."""
+    image, svg = small_trace
+    (tmp_path / "t.svg").write_text(svg)
+    target = Target(torch.from_numpy(image), (1.0, 1.0, 1.0, 1.0))
+    gains, times, initial = {}, {}, None
+    for coarse in (0.0, 0.5):
+        scene = quiet_load(tmp_path / "t.svg")
+        result = optimize(scene, target, Settings(iterations=60, threads=2, seed=3, coarse=coarse))
+        assert len(result.losses) == len(result.iteration_seconds) == 60
+        assert result.coarse_iterations == (30 if coarse else 0)
+        initial = initial or result.losses[0]  # at full size (the first run has no coarse part)
+        gains[coarse] = 10 * math.log10(initial / result.best_loss)
+        times[coarse] = result.iteration_seconds
+    assert gains[0.5] > gains[0.0] - 0.5, gains
+    assert gains[0.5] > 1.5, gains  # (measured: 2.11 dB at full size, 1.96 coarse to fine)
+    assert np.median(times[0.5][2:28]) < 0.8 * np.median(times[0.0][2:28]), times
+
+
+def test_coarse_needs_pixels_for_every_shape(small_peppers):
+    """The 128-px peppers trace has 705 shapes: at 64 px they would get 6 pixels each, so
+    it is fitted at full size throughout."""
+    scene = quiet_load(small_peppers / "peppers.svg")
+    target = Target(torch.from_numpy(load_target(small_peppers / "peppers.png")), (1.0, 1.0, 1.0, 1.0))
+    assert optimize(scene, target, Settings(iterations=2, threads=2, coarse=0.5)).coarse_iterations == 0
+
+
+def test_coarse_best_is_taken_at_full_size():
+    """The best parameters are chosen among full-size iterations only: a coarse loss is
+    measured on a blurrier target and would otherwise win by being smaller."""
+    scene = _circle_scene()
+    scene.width, scene.height = 160, 128
+    scene.view = torch.diag(torch.tensor([4.0, 4.0, 1.0]))  # the same picture, 4x larger
+    big = torch.nn.functional.interpolate(_disc_target().image.permute(2, 0, 1)[None], scale_factor=4)
+    target = Target(big[0].permute(1, 2, 0).contiguous(), (1.0, 1.0, 1.0, 1.0))
+    result = optimize(scene, target, Settings(iterations=20, lr_warmup=0, threads=1, coarse=0.5,
+                                              lr={"points": 1.0}))
+    assert result.coarse_iterations == 10
+    fine = result.losses[10:]
+    assert result.best_loss <= min(fine) + 1e-12
+    assert result.best_loss >= min(fine) - 1e-3  # (or the final, unrecorded evaluation)
+
+
+def test_small_targets_are_fitted_at_full_size():
+    result = optimize(_circle_scene(), _disc_target(), Settings(iterations=4, threads=1, coarse=0.5))
+    assert result.coarse_iterations == 0
+
+
+def test_coarse_setting_is_checked():
+    with pytest.raises(VecfitError, match="coarse"):
+        Settings(coarse=1.5).check()
+
+
+def test_stopwatch_laps_every_iteration_with_the_cores_phases():
+    from vecfit import _core
+    from vecfit.renderer.stopwatch import Stopwatch
+    _core.phase_seconds()
+    with Stopwatch() as watch:
+        result = optimize(_circle_scene(), _disc_target(), Settings(iterations=5, lr_warmup=0, threads=1,
+                                                                     lr={"points": 1.0}))
+    assert len(watch.laps) == 5
+    for lap, seconds in zip(watch.laps, result.iteration_seconds):
+        assert lap["iteration"] == seconds
+        for phase in ("pack", "call forward", "call backward", "forward", "backward", "adam",
+                      "core prepare", "core plan", "core forward", "core backward interior"):
+            assert lap[phase] > 0, phase
+        # the core's parts lie inside the calls, the calls inside the loop's phases
+        core = lap["core prepare"] + lap["core plan"] + lap["core forward"] + lap["core backward interior"] \
+            + lap["core backward boundary"]
+        assert core <= lap["call forward"] + lap["call backward"]
+        assert lap["call forward"] <= lap["forward"] and lap["forward"] + lap["backward"] <= seconds
+    # every core call inside the Stopwatch was read (reading resets the core's clocks)
+    assert all(v == 0.0 for v in _core.phase_seconds().values())

@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <vector>
 
+#include "common/phase_clock.h"
 #include "common/thread_pool.h"
 
 namespace vf {
@@ -85,6 +87,7 @@ std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_) {
 
 BackwardPlan plan_backward(const PreparedScene& prepared, const RenderOptions& o, const float* image,
                            const float* d_image, double boundary_density) {
+    PhaseTimer timer(PHASE_PLAN);
     BackwardPlan plan;
     plan.options = settled(o);
     const double R = plan.options.filter_radius;
@@ -140,6 +143,7 @@ bool render_backward(const PreparedScene& prepared, const SceneArrays& a, const 
             return {{hits.data(), (int)hits.size()}, {{ops.data(), (int)ops.size()}}, {g_hits.data(), (int)g_hits.size()}};
         }
     };
+    std::optional<PhaseTimer> timer(PHASE_BACKWARD_INTERIOR);
     ThreadPool::instance().parallel_for(lanes, lanes, [&](int lane, int) {
         const GradView g = grads[lane].view();
         LaneLists lists(sizes);
@@ -153,6 +157,7 @@ bool render_backward(const PreparedScene& prepared, const SceneArrays& a, const 
         if (w.overflow()) overflowed[lane] = 1;  // (the flags stay set once raised)
     });
 
+    timer.emplace(PHASE_BACKWARD_BOUNDARY);
     if (!plan.pieces.empty()) {
         BoundarySampler pass{sc, o.seed};
         ThreadPool::instance().parallel_for(lanes, lanes, [&](int lane, int) {
@@ -167,6 +172,7 @@ bool render_backward(const PreparedScene& prepared, const SceneArrays& a, const 
         });
     }
 
+    timer.reset();
     for (char f : overflowed)
         if (f) return false;
     out = grads[0];

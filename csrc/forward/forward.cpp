@@ -2,6 +2,7 @@
 // shaded by pixel_forward (forward/pixel.h), which a CUDA build runs on the GPU as well.
 #include <algorithm>
 
+#include "common/phase_clock.h"
 #include "common/thread_pool.h"
 #include "forward/forward.h"
 #include "forward/pixel.h"
@@ -28,6 +29,7 @@ ForwardPlan plan_forward(const PreparedScene& sc, const RenderOptions& o) {
     plan.options = settled(o);
     const double R = plan.options.filter_radius;
     double margin = std::max(0.0, R - 0.5) + (o.mode == MODE_ANALYTIC ? R : 0.0);
+    PhaseTimer timer(PHASE_PLAN);
     plan.bins = bin_draws(sc, o.width, o.height, margin + 1e-6, o.brute_force);
     premultiplied_background(o, plan.background);
     return plan;
@@ -38,6 +40,7 @@ void render_forward(const PreparedScene& prepared, const RenderOptions& o, float
     const SceneView sc = prepared.view();
     const TileView bins = plan.bins.view();
     const int W = o.width, H = o.height;
+    PhaseTimer timer(PHASE_FORWARD);
     ThreadPool::instance().parallel_for(bins.nx * bins.ny, o.threads, [&](int tile, int) {
         int tx = tile % bins.nx, ty = tile / bins.nx;
         for (int y = ty * TILE; y < std::min(H, (ty + 1) * TILE); ++y)

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "backward/backward.h"
+#include "common/phase_clock.h"
 #include "common/thread_pool.h"
 #include "forward/forward.h"
 #include "gpu/gpu.h"
@@ -128,6 +129,11 @@ RenderOptions render_options(int width, int height, int samples, const std::stri
     return o;
 }
 
+PreparedScene timed_prepare(const SceneArrays& a) {
+    PhaseTimer timer(PHASE_PREPARE);
+    return prepare_scene(a);
+}
+
 py::array_t<float> render(const py::dict& scene, int width, int height, int samples, const std::string& mode,
                           const std::string& filter, double filter_radius, uint64_t seed, int threads,
                           py::object background, bool brute_force, int device) {
@@ -139,7 +145,7 @@ py::array_t<float> render(const py::dict& scene, int width, int height, int samp
     float* out = image.mutable_data();
     {
         py::gil_scoped_release release;
-        PreparedScene prepared = prepare_scene(a);
+        PreparedScene prepared = timed_prepare(a);
         if (device >= 0) gpu::render_forward(prepared, o, device, out);
         else render_forward(prepared, o, out);
     }
@@ -161,7 +167,7 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
     SceneGrads g;
     {
         py::gil_scoped_release release;
-        PreparedScene prepared = prepare_scene(a);
+        PreparedScene prepared = timed_prepare(a);
         // On the GPU when asked, unless a sample there needs longer lists than a thread
         // holds: then on the CPU. emulate_gpu_lists runs the CPU lanes with a GPU thread's
         // lists first, to see on the CPU what a GPU run would do.
@@ -243,6 +249,12 @@ PYBIND11_MODULE(_core, m) {
           "and each table's row width (columns)");
     m.def("backward_fallbacks", [] { return backward_fallbacks.load(); },
           "Backward passes redone on the CPU so far because a sample needed longer lists than a GPU thread has");
+    m.def("phase_seconds", [] {
+        py::dict out;
+        for (int p = 0; p < PHASE_COUNT; ++p)
+            out[phase_name(p)] = phase_nanoseconds()[p].exchange(0) * 1e-9;
+        return out;
+    }, "Seconds spent in each of the core's phases since the last call (and resets them)");
     m.def("hardware_threads", &ThreadPool::hardware_threads);
     m.def("has_cuda", &gpu::compiled, "Whether this build has the CUDA kernels");
     m.def("cuda_device_count", &gpu::device_count, "CUDA devices usable now (0 without a CUDA build)");

@@ -6,6 +6,7 @@ import os
 import tempfile
 from pathlib import Path
 
+import cv2
 import numpy as np
 import torch
 from PIL import Image, UnidentifiedImageError
@@ -68,3 +69,17 @@ def load_rgba(path: str | os.PathLike) -> np.ndarray:
     except (OSError, ValueError, Image.DecompressionBombError) as e:
         raise VecfitError(f"{path}: cannot read the image ({e})") from None
     return np.asarray(rgba, dtype=np.float32) / 255.0
+
+
+def downscaled(image: np.ndarray, max_size: int) -> np.ndarray:
+    """The image with its longest side at most max_size (area-averaged, premultiplied)."""
+    h, w = image.shape[:2]
+    if max_size <= 0 or max(h, w) <= max_size:
+        return image
+    scale = max_size / max(h, w)
+    size = (max(1, round(w * scale)), max(1, round(h * scale)))
+    pre = np.concatenate([image[..., :3] * image[..., 3:], image[..., 3:]], axis=2)
+    small = cv2.resize(pre, size, interpolation=cv2.INTER_AREA)
+    a = small[..., 3:]
+    rgb = np.where(a > 0, small[..., :3] / np.maximum(a, 1e-12), 0)
+    return np.concatenate([np.clip(rgb, 0, 1), np.clip(a, 0, 1)], axis=2).astype(np.float32)

@@ -11,7 +11,6 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
-import cv2
 import numpy as np
 import torch
 
@@ -20,7 +19,7 @@ from vecfit.errors import VecfitError
 from vecfit.fitting.loop import Settings, Target, optimize
 from vecfit.fitting.metrics import compare, to_rgb
 from vecfit.io.colors import fitting_background
-from vecfit.io.images import load_rgba
+from vecfit.io.images import downscaled, load_rgba
 from vecfit.io.report import save_comparison, save_report
 from vecfit.renderer import device as devices
 from vecfit.renderer.raster import render
@@ -95,20 +94,6 @@ def background_for(image: np.ndarray, setting: str) -> tuple | None:
     if setting.strip().lower() == "auto":
         return None if float(image[..., 3].min()) < OPAQUE else corner_color(image)
     return fitting_background(setting)
-
-
-def downscaled(image: np.ndarray, max_size: int) -> np.ndarray:
-    """The image with its longest side at most max_size (area-averaged, premultiplied)."""
-    h, w = image.shape[:2]
-    if max_size <= 0 or max(h, w) <= max_size:
-        return image
-    scale = max_size / max(h, w)
-    size = (max(1, round(w * scale)), max(1, round(h * scale)))
-    pre = np.concatenate([image[..., :3] * image[..., 3:], image[..., 3:]], axis=2)
-    small = cv2.resize(pre, size, interpolation=cv2.INTER_AREA)
-    a = small[..., 3:]
-    rgb = np.where(a > 0, small[..., :3] / np.maximum(a, 1e-12), 0)
-    return np.concatenate([np.clip(rgb, 0, 1), np.clip(a, 0, 1)], axis=2).astype(np.float32)
 
 
 def check_sizes(scene: Scene, target: np.ndarray, svg_path, target_path) -> None:
@@ -198,10 +183,12 @@ def fit_and_write(scene: Scene, source_svg, target: np.ndarray, config: dict, ou
         "psnr_gain_db": final["psnr"] - initial["psnr"],
         "mse_ratio": initial["mse"] / final["mse"] if final["mse"] > 0 else None,
         "iterations": result.iterations,
+        "coarse_iterations": result.coarse_iterations,  # their losses are at half the size
         "interrupted": result.interrupted,
         "skipped_steps": result.skipped_steps,
         "seconds": {"total": seconds, "optimize": result.seconds,
-                    "per_iteration": result.seconds / max(result.iterations, 1)},
+                    "per_iteration": result.seconds / max(result.iterations, 1),
+                    "iterations": [round(t, 4) for t in result.iteration_seconds]},
         "shapes": len(scene.shapes),
         "parameters": {**result.parameters, "total": sum(result.parameters.values())},
         "loss": settings.loss,

@@ -15,6 +15,8 @@ from vecfit.errors import NonFiniteScene, VecfitError
 from . import device as devices
 from .pack import pack_scene
 from .scene import Scene
+from . import stopwatch
+from .stopwatch import phase
 
 MODES = ("mc", "analytic")
 FILTERS = ("box", "tent", "gaussian")
@@ -43,11 +45,21 @@ def _core_render(settings: dict, structure: dict, floats, brute_force: bool = Fa
     for name, t in zip(FLOAT_INPUTS, floats):
         scene[name] = t.detach().cpu().numpy()
     try:
-        return scene, _core.render(scene, **settings, brute_force=brute_force)
+        with phase("call forward"):
+            image = _core.render(scene, **settings, brute_force=brute_force)
+        _add_core_phases()
+        return scene, image
     except ValueError as e:  # the core refused the scene (e.g. layers nested too deeply)
         raise VecfitError(str(e)) from None
     except RuntimeError as e:  # the GPU failed (out of memory, driver)
         raise VecfitError(f"rendering on {devices.device_name(settings['device'])} failed: {e}") from None
+
+
+def _add_core_phases() -> None:
+    """The core's phases of the call just made, into the running Stopwatch (if any)."""
+    if stopwatch.running():
+        for name, seconds in _core.phase_seconds().items():
+            stopwatch.add(f"core {name}", seconds)
 
 
 class _Render(torch.autograd.Function):
@@ -66,10 +78,12 @@ class _Render(torch.autograd.Function):
     def backward(ctx, grad_image):
         s = ctx.settings
         try:
-            grads = _core.render_grad(ctx.scene, ctx.image, grad_image.detach().cpu().contiguous().numpy(),
-                                      s["width"], s["height"], s["samples"], s["mode"], s["filter"],
-                                      s["filter_radius"], s["seed"], s["threads"], s["background"],
-                                      ctx.boundary_density, s["device"], ctx.emulate_gpu_lists)
+            with phase("call backward"):
+                grads = _core.render_grad(ctx.scene, ctx.image, grad_image.detach().cpu().contiguous().numpy(),
+                                          s["width"], s["height"], s["samples"], s["mode"], s["filter"],
+                                          s["filter_radius"], s["seed"], s["threads"], s["background"],
+                                          ctx.boundary_density, s["device"], ctx.emulate_gpu_lists)
+            _add_core_phases()
         except RuntimeError as e:  # the GPU failed (out of memory, driver)
             raise VecfitError(f"gradients on {devices.device_name(s['device'])} failed: {e}") from None
         out = [torch.from_numpy(grads[name]).reshape(shape) for name, shape in zip(FLOAT_INPUTS, ctx.shapes)]
@@ -119,7 +133,8 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
         if len(bg) != 4:
             raise VecfitError("background must have 3 or 4 components")
         background = bg
-    arrays = pack_scene(scene, width, height).arrays()
+    with phase("pack"):
+        arrays = pack_scene(scene, width, height).arrays()
     floats = [arrays[name].to(torch.float32) for name in FLOAT_INPUTS]
     for name, value in zip(FLOAT_INPUTS, floats):
         if not torch.isfinite(value.detach()).all():
