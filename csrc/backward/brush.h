@@ -1,5 +1,5 @@
 // The adjoint of brush evaluation (scene/brush.h): dL/d(premultiplied colour) at a point
-// to dL/d(brush parameters (the paint_params table), stop offsets, stop colours).
+// to dL/d(brush parameters (the brush_params table), stop offsets, stop colours).
 #pragma once
 
 #include <cmath>
@@ -28,7 +28,7 @@ VF_HD void premultiply_backward(const double c[4], const double g[4], double gc[
 VF_HD void brush_color_backward(const SceneView& sc, int brush_index, Vec2 pixel, const double g[4],
                                 const GradView& grads) {
     const PreparedBrush& p = sc.brushes[brush_index];
-    GradPtr gp = grads.paint_params + PAINT_FCOLS * brush_index;
+    GradPtr gp = grads.brush_params + BRUSH_FCOLS * brush_index;
     if (p.kind == BRUSH_SOLID) {
         double gc[4];
         premultiply_backward(p.rgba, g, gc);

@@ -59,8 +59,8 @@ int parse_filter(const std::string& f) {
 
 // The scene's arrays, kept alive for the duration of a call.
 struct SceneInput {
-    Array<float> points, point_widths, ellipses, draw_params, paint_params, stop_offsets, stop_colors, layer_opacity;
-    Array<int32_t> segments, subpaths, shapes, draws, paints, layer_parents;
+    Array<float> points, point_widths, ellipses, draw_params, brush_params, stop_offsets, stop_colors, layer_opacity;
+    Array<int32_t> segments, subpaths, shapes, draws, brushes, layer_parents;
 
     SceneArrays arrays() const {
         SceneArrays a;
@@ -74,9 +74,9 @@ struct SceneInput {
         int n;
         a.draw_params = rows(draw_params, DRAW_FCOLS, n, "draw_params");
         if (n != a.n_draws) throw std::invalid_argument("vecfit core: draw_params does not match draws");
-        a.paints = rows(paints, PAINT_COLS, a.n_paints, "paints");
-        a.paint_params = rows(paint_params, PAINT_FCOLS, n, "paint_params");
-        if (n != a.n_paints) throw std::invalid_argument("vecfit core: paint_params does not match paints");
+        a.brushes = rows(brushes, BRUSH_COLS, a.n_brushes, "brushes");
+        a.brush_params = rows(brush_params, BRUSH_FCOLS, n, "brush_params");
+        if (n != a.n_brushes) throw std::invalid_argument("vecfit core: brush_params does not match brushes");
         a.stop_offsets = rows(stop_offsets, 1, a.n_stops, "stop_offsets");
         a.stop_colors = rows(stop_colors, STOP_COLOR_COLS, n, "stop_colors");
         if (n != a.n_stops) throw std::invalid_argument("vecfit core: stop_colors does not match stop_offsets");
@@ -98,8 +98,8 @@ SceneInput scene_input(const py::dict& s) {
     in.ellipses = s["ellipses"].cast<Array<float>>();
     in.draws = s["draws"].cast<Array<int32_t>>();
     in.draw_params = s["draw_params"].cast<Array<float>>();
-    in.paints = s["paints"].cast<Array<int32_t>>();
-    in.paint_params = s["paint_params"].cast<Array<float>>();
+    in.brushes = s["brushes"].cast<Array<int32_t>>();
+    in.brush_params = s["brush_params"].cast<Array<float>>();
     in.stop_offsets = s["stop_offsets"].cast<Array<float>>();
     in.stop_colors = s["stop_colors"].cast<Array<float>>();
     in.layer_parents = s["layer_parents"].cast<Array<int32_t>>();
@@ -190,7 +190,7 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
     r["point_widths"] = out(g.point_widths, 1);
     r["ellipses"] = out(g.ellipses, ELLIPSE_COLS);
     r["draw_params"] = out(g.draw_params, DRAW_FCOLS);
-    r["paint_params"] = out(g.paint_params, PAINT_FCOLS);
+    r["brush_params"] = out(g.brush_params, BRUSH_FCOLS);
     r["stop_offsets"] = out(g.stop_offsets, 1);
     r["stop_colors"] = out(g.stop_colors, STOP_COLOR_COLS);
     r["layer_opacity"] = out(g.layer_opacity, 1);
@@ -212,7 +212,7 @@ py::dict layout() {
     l["fill_rules"] = named({{"nonzero", NONZERO}, {"evenodd", EVENODD}});
     l["caps"] = named({{"butt", CAP_BUTT}, {"round", CAP_ROUND}, {"square", CAP_SQUARE}});
     l["joins"] = named({{"miter", JOIN_MITER}, {"round", JOIN_ROUND}, {"bevel", JOIN_BEVEL}});
-    l["paint_kinds"] = named({{"solid", BRUSH_SOLID}, {"linear", BRUSH_LINEAR}, {"radial", BRUSH_RADIAL}});
+    l["brush_kinds"] = named({{"solid", BRUSH_SOLID}, {"linear", BRUSH_LINEAR}, {"radial", BRUSH_RADIAL}});
     l["columns"] = named({{"points", POINT_COLS},
                           {"point_widths", 1},
                           {"segments", SEGMENT_COLS},
@@ -221,8 +221,8 @@ py::dict layout() {
                           {"ellipses", ELLIPSE_COLS},
                           {"draws", DRAW_COLS},
                           {"draw_params", DRAW_FCOLS},
-                          {"paints", PAINT_COLS},
-                          {"paint_params", PAINT_FCOLS},
+                          {"brushes", BRUSH_COLS},
+                          {"brush_params", BRUSH_FCOLS},
                           {"stop_offsets", 1},
                           {"stop_colors", STOP_COLOR_COLS},
                           {"layer_parents", 1},
@@ -245,7 +245,7 @@ PYBIND11_MODULE(_core, m) {
           py::arg("threads"), py::arg("background"), py::arg("boundary_density"), py::arg("device") = -1,
           py::arg("emulate_gpu_lists") = false);
     m.def("layout", &layout,
-          "The scene arrays' layout: enums (shape_kinds, draw_kinds, fill_rules, caps, joins, paint_kinds) "
+          "The scene arrays' layout: enums (shape_kinds, draw_kinds, fill_rules, caps, joins, brush_kinds) "
           "and each table's row width (columns)");
     m.def("backward_fallbacks", [] { return backward_fallbacks.load(); },
           "Backward passes redone on the CPU so far because a sample needed longer lists than a GPU thread has");

@@ -1,6 +1,6 @@
 // Builds the PreparedScene from the flat arrays: control points per segment, bounds,
 // y-monotone pieces for ray crossings, stroke pieces (joins and caps), brushes (from the
-// paints table), layers.
+// brushes table), layers.
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -256,10 +256,10 @@ PreparedScene prepare_scene(const SceneArrays& a) {
 
     sc.stop_offsets.assign(a.stop_offsets, a.stop_offsets + a.n_stops);
     sc.stop_colors.assign(a.stop_colors, a.stop_colors + 4 * a.n_stops);
-    for (int q = 0; q < a.n_paints; ++q) {
-        const int32_t* row = a.paints + PAINT_COLS * q;
-        const float* f = a.paint_params + PAINT_FCOLS * q;
-        PreparedBrush p;  // a row of the paints table
+    for (int q = 0; q < a.n_brushes; ++q) {
+        const int32_t* row = a.brushes + BRUSH_COLS * q;
+        const float* f = a.brush_params + BRUSH_FCOLS * q;
+        PreparedBrush p;  // a row of the brushes table
         p.kind = row[0];
         p.first_stop = row[1];
         p.n_stops = row[2];
@@ -297,7 +297,7 @@ PreparedScene prepare_scene(const SceneArrays& a) {
         d.join = row[6];
         d.varying = row[7] != 0;
         check(d.shape >= 0 && d.shape < a.n_shapes, "draw shape out of range");
-        check(d.brush >= 0 && d.brush < a.n_paints, "draw paint out of range");
+        check(d.brush >= 0 && d.brush < a.n_brushes, "draw paint out of range");
         check(d.layer >= 0 && d.layer < a.n_layers, "draw layer out of range");
         d.half_width = 0.5 * std::max(0.0f, f[0]);
         d.miter_limit = std::max(1.0f, f[1]);

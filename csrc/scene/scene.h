@@ -3,10 +3,9 @@
 // read (segments with their control points, bounds, joins, brushes).
 //
 // Names: a fill or stroke's colour source (solid, linear or radial gradient) is a brush
-// inside the core (as vello calls it: "paint" is the painterly command elsewhere in
-// vecfit). The input tables keep the names Python gives them ("paints", "paint_params",
-// their PAINT_COLS / PAINT_FCOLS widths, the draws table's paint column): they are the
-// Python-facing contract, read by python/bindings.cpp and exported by _core.layout().
+// in the core and in the arrays Python hands it (the "brushes" and "brush_params" tables,
+// as vello calls them): "paint" is the painterly command elsewhere in vecfit, and the
+// SVG's word for a fill or stroke value in the Scene and the SVG reader.
 #pragma once
 
 #include <cstdint>
@@ -32,10 +31,10 @@ constexpr int SEGMENT_COLS = 5;   // degree, point index of each control point (
 constexpr int SUBPATH_COLS = 3;   // first segment, segment count, closed (0/1)
 constexpr int SHAPE_COLS = 4;     // kind, first subpath, subpath count, ellipse index
 constexpr int ELLIPSE_COLS = 6;   // cx, cy, a, b, c, d: ellipse {c + (a b; c d)(cos, sin)}
-constexpr int DRAW_COLS = 8;      // shape, kind, fill rule, paint, layer, cap, join, per-point widths (0/1)
+constexpr int DRAW_COLS = 8;      // shape, kind, fill rule, brush, layer, cap, join, per-point widths (0/1)
 constexpr int DRAW_FCOLS = 6;     // stroke width (unused with per-point widths), miter limit, metric (a b c d)
-constexpr int PAINT_COLS = 3;     // kind, first stop, stop count
-constexpr int PAINT_FCOLS = 11;   // pixel->paint affine (6), then solid rgba | x1 y1 x2 y2 | cx cy r fx fy
+constexpr int BRUSH_COLS = 3;     // kind, first stop, stop count
+constexpr int BRUSH_FCOLS = 11;   // pixel->brush affine (6), then solid rgba | x1 y1 x2 y2 | cx cy r fx fy
 constexpr int STOP_COLOR_COLS = 4;  // straight RGBA
 // point_widths, stop_offsets, layer_parents and layer_opacity: one value per row.
 
@@ -50,8 +49,8 @@ struct SceneArrays {
     const float* ellipses = nullptr;     int n_ellipses = 0;   // [E, ELLIPSE_COLS]
     const int32_t* draws = nullptr;      int n_draws = 0;      // [D, DRAW_COLS]
     const float* draw_params = nullptr;                        // [D, DRAW_FCOLS]
-    const int32_t* paints = nullptr;     int n_paints = 0;     // [Q, PAINT_COLS]
-    const float* paint_params = nullptr;                       // [Q, PAINT_FCOLS]
+    const int32_t* brushes = nullptr;    int n_brushes = 0;    // [Q, BRUSH_COLS]
+    const float* brush_params = nullptr;                       // [Q, BRUSH_FCOLS]
     const float* stop_offsets = nullptr; int n_stops = 0;      // [T]
     const float* stop_colors = nullptr;                        // [T, 4] straight RGBA
     const int32_t* layer_parents = nullptr; int n_layers = 0;  // [L]; layer 0 is the root
