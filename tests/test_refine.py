@@ -480,9 +480,10 @@ def test_small_targets_are_fitted_at_full_size():
     assert result.coarse_iterations == 0
 
 
-def test_coarse_setting_is_checked():
+@pytest.mark.parametrize("coarse", [1.0, 1.5, -0.1])
+def test_coarse_setting_is_checked(coarse):
     with pytest.raises(VecfitError, match="coarse"):
-        Settings(coarse=1.5).check()
+        Settings(coarse=coarse).check()
 
 
 def test_stopwatch_laps_every_iteration_with_the_cores_phases():

@@ -81,8 +81,8 @@ class Settings:
             raise VecfitError("lr_decay must be in (0, 1]")
         if self.lr_warmup < 0:
             raise VecfitError("lr_warmup must be 0 or more")
-        if not 0 <= self.coarse <= 1:
-            raise VecfitError(f"coarse must be in [0, 1], not {self.coarse}")
+        if not 0 <= self.coarse < 1:  # the last iterations must be at full size
+            raise VecfitError(f"coarse must be at least 0 and below 1, not {self.coarse}")
         devices.resolve(self.device)
         for kind, value in self.lr.items():
             if kind not in PARAMETER_KINDS:
