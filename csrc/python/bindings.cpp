@@ -234,7 +234,7 @@ py::dict layout() {
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "vecfit's compiled core: geometry and rendering on flat arrays";
-    m.def("render", &render, "Render the scene arrays (a dict, see vecfit/pack.py) into [H, W, 4] straight RGBA",
+    m.def("render", &render, "Render the scene arrays (a dict, see vecfit/renderer/pack.py) into [H, W, 4] straight RGBA",
           py::arg("scene"), py::arg("width"), py::arg("height"), py::arg("samples"), py::arg("mode"),
           py::arg("filter"), py::arg("filter_radius"), py::arg("seed"), py::arg("threads"), py::arg("background"),
           py::arg("brute_force") = false, py::arg("device") = -1);
