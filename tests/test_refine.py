@@ -475,6 +475,18 @@ def test_coarse_best_is_taken_at_full_size():
     assert result.best_loss >= min(fine) - 1e-3  # (or the final, unrecorded evaluation)
 
 
+@pytest.mark.parametrize("iterations, coarse, expected", [(1, 0.9, 0), (10, 0.95, 9), (10, 0.5, 5)])
+def test_the_last_iteration_is_at_full_size(iterations, coarse, expected):
+    scene = _circle_scene()
+    scene.width, scene.height = 160, 128
+    scene.view = torch.diag(torch.tensor([4.0, 4.0, 1.0]))
+    big = torch.nn.functional.interpolate(_disc_target().image.permute(2, 0, 1)[None], scale_factor=4)
+    target = Target(big[0].permute(1, 2, 0).contiguous(), (1.0, 1.0, 1.0, 1.0))
+    result = optimize(scene, target, Settings(iterations=iterations, lr_warmup=0, threads=1, coarse=coarse,
+                                              lr={"points": 1.0}))
+    assert result.coarse_iterations == expected
+
+
 def test_small_targets_are_fitted_at_full_size():
     result = optimize(_circle_scene(), _disc_target(), Settings(iterations=4, threads=1, coarse=0.5))
     assert result.coarse_iterations == 0

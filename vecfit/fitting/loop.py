@@ -151,17 +151,18 @@ class Result:
 def _levels(target: Target, settings: Settings, shapes: int):
     """Coarse to fine: the first ``coarse`` share of the iterations fits the target at half
     its size (a quarter of the pixels, the boundaries half as long), where the large moves
-    happen; the rest at full size. Returns the first fine iteration and, for coarse and
-    fine, (Target, the loss's view of its image)."""
+    happen; the rest, and at least the last iteration, at full size. Returns the first
+    full-size iteration and, for coarse and fine, (Target, the loss's view of its image)."""
     fine = (target, target.compared(target.image.float()))
     height, width = target.image.shape[:2]
-    fine_from = int(round(settings.coarse * settings.iterations))
-    small = min(height, width) // 2 < MIN_COARSE_SIDE
-    if fine_from == 0 or small or (height // 2) * (width // 2) < MIN_COARSE_PIXELS_PER_SHAPE * max(shapes, 1):
+    fine_from = min(int(round(settings.coarse * settings.iterations)), max(settings.iterations - 1, 0))
+    too_small = min(height, width) // 2 < MIN_COARSE_SIDE
+    too_dense = (height // 2) * (width // 2) < MIN_COARSE_PIXELS_PER_SHAPE * max(shapes, 1)
+    if fine_from == 0 or too_small or too_dense:
         return 0, (fine, fine)
-    small = torch.from_numpy(downscaled(target.image.numpy(), max(height, width) // 2))
-    coarse_target = Target(small, target.background)
-    return fine_from, ((coarse_target, coarse_target.compared(small.float())), fine)
+    half = torch.from_numpy(downscaled(target.image.numpy(), max(height, width) // 2))
+    coarse = Target(half, target.background)
+    return fine_from, ((coarse, coarse.compared(half.float())), fine)
 
 
 def optimize(scene: Scene, target: Target, settings: Settings,
@@ -191,16 +192,19 @@ def optimize(scene: Scene, target: Target, settings: Settings,
 
     frame = {}
 
+    def level(iteration: int) -> tuple[Target, torch.Tensor]:
+        return levels[iteration >= fine_from]
+
     def evaluate(iteration: int, grad: bool):
-        level, goal = levels[iteration >= fine_from]
-        h, w = level.image.shape[:2]
+        at, goal = level(iteration)
+        h, w = at.image.shape[:2]
         with torch.set_grad_enabled(grad):
             image = render(scene, w, h, samples=settings.samples, mode=settings.mode,
                            seed=settings.seed + iteration, background=target.background,
                            threads=settings.threads, boundary_samples=settings.boundary_samples,
                            device=device)
             frame["image"] = image.detach()
-            return loss_fn(level.compared(image), goal)
+            return loss_fn(at.compared(image), goal)
 
     where = {}
     for i, k in enumerate(kinds):
@@ -265,7 +269,7 @@ def optimize(scene: Scene, target: Target, settings: Settings,
             if hooks and "image" in frame:
                 with torch.no_grad(), phase("hooks"):
                     for hook in hooks:
-                        hook(Step(it, frame["image"], scene, levels[it >= fine_from][0], reset))
+                        hook(Step(it, frame["image"], scene, level(it)[0], reset))
                     for k in kinds:
                         k.project()
             times.append(time.perf_counter() - began)

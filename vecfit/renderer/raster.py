@@ -15,8 +15,7 @@ from vecfit.errors import NonFiniteScene, VecfitError
 from . import device as devices
 from .pack import pack_scene
 from .scene import Scene
-from . import stopwatch
-from .stopwatch import phase
+from .stopwatch import add_core_phases, phase
 
 MODES = ("mc", "analytic")
 FILTERS = ("box", "tent", "gaussian")
@@ -47,19 +46,12 @@ def _core_render(settings: dict, structure: dict, floats, brute_force: bool = Fa
     try:
         with phase("call forward"):
             image = _core.render(scene, **settings, brute_force=brute_force)
-        _add_core_phases()
+        add_core_phases()
         return scene, image
     except ValueError as e:  # the core refused the scene (e.g. layers nested too deeply)
         raise VecfitError(str(e)) from None
     except RuntimeError as e:  # the GPU failed (out of memory, driver)
         raise VecfitError(f"rendering on {devices.device_name(settings['device'])} failed: {e}") from None
-
-
-def _add_core_phases() -> None:
-    """The core's phases of the call just made, into the running Stopwatch (if any)."""
-    if stopwatch.running():
-        for name, seconds in _core.phase_seconds().items():
-            stopwatch.add(f"core {name}", seconds)
 
 
 class _Render(torch.autograd.Function):
@@ -83,7 +75,7 @@ class _Render(torch.autograd.Function):
                                           s["width"], s["height"], s["samples"], s["mode"], s["filter"],
                                           s["filter_radius"], s["seed"], s["threads"], s["background"],
                                           ctx.boundary_density, s["device"], ctx.emulate_gpu_lists)
-            _add_core_phases()
+            add_core_phases()
         except RuntimeError as e:  # the GPU failed (out of memory, driver)
             raise VecfitError(f"gradients on {devices.device_name(s['device'])} failed: {e}") from None
         out = [torch.from_numpy(grads[name]).reshape(shape) for name, shape in zip(FLOAT_INPUTS, ctx.shapes)]

@@ -46,14 +46,13 @@ def phase(name: str):
         watch._current[name] += time.perf_counter() - began
 
 
-def running() -> bool:
-    return _running is not None
-
-
-def add(name: str, seconds: float) -> None:
-    """Adds time measured elsewhere (the core's own phases) to ``name``."""
+def add_core_phases() -> None:
+    """Adds the core's own phase clocks (prepare, plan, the passes) since they were last
+    read, each as ``core NAME``; call it after each call into the core."""
     if _running is not None:
-        _running._current[name] += seconds
+        from vecfit import _core
+        for name, seconds in _core.phase_seconds().items():
+            _running._current[f"core {name}"] += seconds
 
 
 def lap(seconds: float) -> None:
