@@ -240,6 +240,35 @@ def test_gradients_deterministic_and_independent_of_threads():
     assert torch.allclose(a, c, rtol=1e-6, atol=1e-6)
 
 
+def test_interior_subsampling_is_unbiased():
+    """interior_samples=K revisits a random run of K of each pixel's N x N samples, weighted
+    N^2 / K (refine's default is 1 of 2 x 2). Asking for all N^2 is the full pass exactly;
+    one sample's colour gradient, averaged over 32 seeds, equals the full pass's average
+    over the same seeds to 1% (measured 0.17-0.24%; one seed alone 0.8-1.4% off), while
+    the boundary term (points) does not depend on it at all."""
+    def grads(interior, seed):
+        pts = BLOB.clone().requires_grad_(True)
+        lin = LinearGradient(start=torch.tensor([8.0, 10.0]), end=torch.tensor([30.0, 28.0]),
+                             offsets=torch.tensor([0.1, 0.9]), units="userSpaceOnUse",
+                             colors=torch.tensor([[0.9, 0.1, 0.2, 0.95], [0.1, 0.8, 0.1, 0.6]]).requires_grad_(True))
+        colour = torch.tensor([0.8, 0.2, 0.1, 0.7], requires_grad=True)
+        scene = Scene(width=40, height=40, shapes=[background(), Shape(geometry=blob(pts), fill=lin),
+                                                   Shape(geometry=Circle(torch.tensor([22.0, 18.0]), torch.tensor(7.0)),
+                                                         fill=Solid(colour))])
+        img = vecfit.render(scene, samples=2, seed=seed, interior_samples=interior)
+        (img * W).sum().backward()
+        return torch.cat([colour.grad, lin.colors.grad.reshape(-1)]), pts.grad
+    full, full_pts = grads(0, 0)
+    every, every_pts = grads(4, 0)
+    assert torch.equal(full, every) and torch.equal(full_pts, every_pts)
+    one, one_pts = grads(1, 0)
+    assert torch.equal(one_pts, full_pts)
+    assert not torch.equal(one, full)
+    mean_full = sum(grads(0, s)[0] for s in range(32))
+    mean_one = sum(grads(1, s)[0] for s in range(32))
+    assert (mean_one - mean_full).norm() <= 0.01 * mean_full.norm()
+
+
 # ------------------------------------------------------------ analytical prefilter
 # The prefiltered image is a smooth, deterministic function of the geometry (away from
 # ties: a pixel centre exactly on the medial axis between two edges is a kink, which

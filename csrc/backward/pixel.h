@@ -96,7 +96,14 @@ VF_HD void pixel_backward(const SceneView& sc, const TileView& bins, const Rende
         wsum += filter_weight(o.filter, R, R * (2 * fx - 1), R * (2 * fy - 1));
     }
     if (wsum <= 0) return;
-    for (int s = 0; s < N * N; ++s) {
+    // A random run of K consecutive samples (of N x N) stands for all of them, weighted by
+    // N^2 / K: each sample is visited with probability K / N^2, so the sum stays unbiased.
+    const int all = N * N;
+    const int K = (o.mode == MODE_MC && o.interior_samples > 0 && o.interior_samples < all) ? o.interior_samples : all;
+    const int first = K < all ? (int)(mix64(o.seed * 0x2545f4914f6cdd1dull ^ mix64(pixel + 0x632be59bd9b4e019ull)) % (uint64_t)all) : 0;
+    wsum *= (double)K / all;
+    for (int k = 0; k < K; ++k) {
+        const int s = (first + k) % all;
         double fx = ((s % N) + 0.5) / N, fy = ((s / N) + 0.5) / N;
         if (o.mode == MODE_MC) sample_position(o.seed, pixel, s, N, fx, fy);
         double dx = R * (2 * fx - 1), dy = R * (2 * fy - 1);

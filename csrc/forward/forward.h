@@ -19,6 +19,9 @@ struct RenderOptions {
     double filter_radius = 0.5; // support half-width in pixels; also the analytic kernel radius
     uint64_t seed = 0;
     int threads = 0;            // 0: all cores
+    // Monte Carlo backward only: how many of a pixel's samples x samples the interior term
+    // revisits (0: all). Fewer, chosen at random and weighted up, keep it unbiased.
+    int interior_samples = 0;
     bool brute_force = false;   // test every item of every draw (a check of the tiles)
     bool has_background = false;
     double background[4] = {0, 0, 0, 0};  // straight RGBA

@@ -158,10 +158,12 @@ std::atomic<long> backward_fallbacks{0};
 py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_image, int width, int height,
                      int samples, const std::string& mode, const std::string& filter, double filter_radius,
                      uint64_t seed, int threads, py::object background, double boundary_density, int device,
-                     bool emulate_gpu_lists) {
+                     bool emulate_gpu_lists, int interior_samples) {
     SceneInput in = scene_input(scene);
     SceneArrays a = in.arrays();
     RenderOptions o = render_options(width, height, samples, mode, filter, filter_radius, seed, threads, background);
+    if (interior_samples < 0) throw std::invalid_argument("interior_samples must be >= 0");
+    o.interior_samples = interior_samples;
     if (image.size() != (py::ssize_t)width * height * 4 || d_image.size() != image.size())
         throw std::invalid_argument("image and its gradient must be height x width x 4");
     SceneGrads g;
@@ -243,7 +245,7 @@ PYBIND11_MODULE(_core, m) {
           py::arg("scene"), py::arg("image"), py::arg("d_image"), py::arg("width"), py::arg("height"),
           py::arg("samples"), py::arg("mode"), py::arg("filter"), py::arg("filter_radius"), py::arg("seed"),
           py::arg("threads"), py::arg("background"), py::arg("boundary_density"), py::arg("device") = -1,
-          py::arg("emulate_gpu_lists") = false);
+          py::arg("emulate_gpu_lists") = false, py::arg("interior_samples") = 0);
     m.def("layout", &layout,
           "The scene arrays' layout: enums (shape_kinds, draw_kinds, fill_rules, caps, joins, brush_kinds) "
           "and each table's row width (columns)");

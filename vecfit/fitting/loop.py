@@ -50,6 +50,7 @@ class Settings:
     mode: str = "mc"
     samples: int = 2
     boundary_samples: float = 2.0
+    interior_samples: int = 1  # of the N x N samples per pixel, those the backward revisits (0: all)
     seed: int = 0
     threads: int = 0
     device: str = "auto"
@@ -202,7 +203,7 @@ def optimize(scene: Scene, target: Target, settings: Settings,
             image = render(scene, w, h, samples=settings.samples, mode=settings.mode,
                            seed=settings.seed + iteration, background=target.background,
                            threads=settings.threads, boundary_samples=settings.boundary_samples,
-                           device=device)
+                           interior_samples=settings.interior_samples, device=device)
             frame["image"] = image.detach()
             return loss_fn(at.compared(image), goal)
 

@@ -59,9 +59,10 @@ class _Render(torch.autograd.Function):
     (the autograd graph of vecfit.renderer.pack carries them on to the Scene's tensors)."""
 
     @staticmethod
-    def forward(ctx, settings, boundary_density, emulate_gpu_lists, structure, *floats):
+    def forward(ctx, settings, boundary_density, interior_samples, emulate_gpu_lists, structure, *floats):
         ctx.scene, ctx.image = _core_render(settings, structure, floats)
         ctx.settings, ctx.boundary_density = settings, boundary_density
+        ctx.interior_samples = interior_samples
         ctx.emulate_gpu_lists = emulate_gpu_lists
         ctx.shapes = [t.shape for t in floats]
         return torch.from_numpy(ctx.image)
@@ -74,18 +75,19 @@ class _Render(torch.autograd.Function):
                 grads = _core.render_grad(ctx.scene, ctx.image, grad_image.detach().cpu().contiguous().numpy(),
                                           s["width"], s["height"], s["samples"], s["mode"], s["filter"],
                                           s["filter_radius"], s["seed"], s["threads"], s["background"],
-                                          ctx.boundary_density, s["device"], ctx.emulate_gpu_lists)
+                                          ctx.boundary_density, s["device"], ctx.emulate_gpu_lists,
+                                          ctx.interior_samples)
             add_core_phases()
         except RuntimeError as e:  # the GPU failed (out of memory, driver)
             raise VecfitError(f"gradients on {devices.device_name(s['device'])} failed: {e}") from None
         out = [torch.from_numpy(grads[name]).reshape(shape) for name, shape in zip(FLOAT_INPUTS, ctx.shapes)]
-        return (None, None, None, None, *out)
+        return (None, None, None, None, None, *out)
 
 
 def render(scene: Scene, width: int | None = None, height: int | None = None, *,
            samples: int = 2, mode: str = "mc", filter: str = "box", filter_radius: float = 0.5,
            seed: int = 0, background=None, threads: int | None = None, boundary_samples: float = 2.0,
-           device: str = "cpu", _brute_force: bool = False, _gpu_lists: bool = False) -> torch.Tensor:
+           interior_samples: int = 0, device: str = "cpu", _brute_force: bool = False, _gpu_lists: bool = False) -> torch.Tensor:
     """Render ``scene`` into an [H, W, 4] float tensor of straight RGBA.
 
     samples: N means N x N stratified samples per pixel (jittered in "mc" mode, at the
@@ -95,7 +97,9 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
 
     The result is differentiable with respect to every tensor of the scene. In "mc" mode
     the backward pass samples the boundaries (``boundary_samples`` points per pixel of
-    boundary length, same seed); in "analytic" mode it differentiates the prefilter.
+    boundary length, same seed) and revisits ``interior_samples`` of each pixel's N x N
+    samples for the colours' (interior) term, a random run weighted up (0: all of them);
+    in "analytic" mode it differentiates the prefilter.
 
     device: where the pixels are shaded: "cpu", "cuda" or "cuda:N" (needs a core built
     with VECFIT_CUDA=1; see vecfit.has_cuda()), or "auto" (a GPU when there is one). The
@@ -136,7 +140,8 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
                     filter_radius=float(filter_radius), seed=int(seed), threads=int(threads or 0),
                     background=background, device=devices.resolve(device))
     if torch.is_grad_enabled() and any(t.requires_grad for t in floats) and not _brute_force:
-        return _Render.apply(settings, float(boundary_samples), bool(_gpu_lists), structure, *floats)
+        return _Render.apply(settings, float(boundary_samples), int(interior_samples), bool(_gpu_lists),
+                             structure, *floats)
     image = _core_render(settings, structure, floats, brute_force=_brute_force)[1]
     return torch.from_numpy(image)
 
