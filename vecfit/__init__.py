@@ -1,6 +1,14 @@
 """vecfit: vectorize raster images and refine vector graphics against them.
 
 The public API: load_svg, render, the Scene and its parts, and the device queries."""
+import os
+
+# Before torch loads its OpenMP runtime: idle OpenMP threads sleep instead of spinning.
+# Spinning, they took a quarter of the CPU from the core's own threads between torch's
+# small per-iteration operations (a refine iteration of peppers took 1.9x as long with
+# them spinning, on 2 busy cores; see benchmarks/RESULTS.md). A user's own setting wins.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
 from .errors import SvgError, VecfitError
 from .renderer.device import cuda_device_count, has_cuda
 from .renderer.raster import render
