@@ -7,6 +7,10 @@ import time
 import warnings
 from pathlib import Path
 
+# Before torch loads (import this module first): idle OpenMP threads sleep, as the vecfit
+# command sets it (see vecfit/__init__.py); spinning they distort every timing here.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
 ROOT = Path(__file__).resolve().parents[1]
 # ../shared beside the repository, or where VECFIT_SHARED points (as for the tests)
 SHARED = Path(os.environ.get("VECFIT_SHARED") or ROOT.parent / "shared")
