@@ -73,3 +73,22 @@ def scene_workload(name, mode, samples, threads, repeats, device="cpu"):
             p.grad = None
         return t1 - t0, t2 - t1
     return timed(run, repeats)
+
+
+def parse_sets(items) -> dict:
+    """--set optimize.mode=analytic -> {"optimize": {"mode": "analytic"}}"""
+    out: dict = {}
+    for item in items:
+        key, _, value = item.partition("=")
+        *path, last = key.split(".")
+        d = out
+        for p in path:
+            d = d.setdefault(p, {})
+        try:
+            d[last] = int(value)
+        except ValueError:
+            try:
+                d[last] = float(value)
+            except ValueError:
+                d[last] = value
+    return out
