@@ -12,7 +12,8 @@ a permutation drawn with seed 0, its first 1,437 images train, the other 360 tes
 The encoder (an MLP) maps an image to a 16-dimensional Gaussian; the decoder (an MLP)
 maps a code to 4 cubic strokes (4 control points each, and a width), rendered black on
 white at 32x32 by `vecfit.render_batch` (Monte Carlo, 2x2 samples). The loss is the
-squared error summed over the pixels plus BETA times the KL divergence to N(0, I).
+squared error summed over the pixels plus BETA times the KL divergence to N(0, I), BETA
+rising from 0 over the first 5 epochs.
 
 It writes to --out: `samples.svg` (an 8x8 grid decoded from random codes), `interpolation.svg`
 (a row morphing between two test digits), `reconstructions.png` (test digits above their
@@ -41,7 +42,8 @@ from vecfit.renderer.scene import Scene, Shape, Solid
 SIZE = 32         # pixels
 STROKES = 4       # cubic strokes per digit
 LATENT = 16
-BETA = 0.5        # weight of the KL term against the summed squared error
+BETA = 0.2        # weight of the KL term against the summed squared error ...
+BETA_WARMUP = 5   # ... reached linearly over the first epochs (else the codes collapse)
 BATCH = 64
 MARGIN = 2.0      # control points stay this far inside the canvas
 TRAIN, TEST = 1437, 360
@@ -53,8 +55,9 @@ def load_digits(subset: int | None = None) -> tuple[torch.Tensor, torch.Tensor]:
     from sklearn.datasets import load_digits as sklearn_digits
 
     ink = torch.tensor(sklearn_digits().images, dtype=torch.float32) / 16
-    big = nn.functional.interpolate(ink[:, None], size=(SIZE, SIZE), mode="bilinear", align_corners=False)[:, 0]
-    images = 1 - big.clamp(0, 1)
+    big = nn.functional.interpolate(ink[:, None], size=(SIZE, SIZE), mode="bicubic", align_corners=False)[:, 0]
+    # Upscaling 8x8 blurs the strokes into grey; a contrast ramp makes them ink again.
+    images = 1 - ((big - 0.2) / 0.5).clamp(0, 1)
     order = torch.randperm(len(images), generator=torch.Generator().manual_seed(0))
     train, test = images[order[:TRAIN]], images[order[TRAIN:TRAIN + TEST]]
     if subset:
@@ -75,17 +78,21 @@ class Encoder(nn.Module):
 
 class Decoder(nn.Module):
     """A code -> STROKES cubic strokes: control points [B, STROKES, 4, 2] in pixels and
-    widths [B, STROKES] (0.8 to 3 px)."""
+    widths [B, STROKES] (1 to 4 px)."""
 
     def __init__(self):
         super().__init__()
         self.body = nn.Sequential(nn.Linear(LATENT, 128), nn.ReLU(), nn.Linear(128, 256), nn.ReLU(),
                                   nn.Linear(256, STROKES * 9))
+        # Strokes start spread over the canvas (control points' biases uniform in logit
+        # space), not all as dots at its centre, which the image gradient barely sees.
+        with torch.no_grad():
+            self.body[-1].bias.reshape(STROKES, 9)[:, :8].uniform_(-1.5, 1.5)
 
     def forward(self, z):
         out = self.body(z).reshape(-1, STROKES, 9)
         points = MARGIN + (SIZE - 2 * MARGIN) * torch.sigmoid(out[..., :8]).reshape(-1, STROKES, 4, 2)
-        widths = 0.8 + 2.2 * torch.sigmoid(out[..., 8])
+        widths = 1.0 + 3.0 * torch.sigmoid(out[..., 8])
         return points, widths
 
 
@@ -175,8 +182,8 @@ def train(args) -> int:
     out.mkdir(parents=True, exist_ok=True)
     report = {"data": {"train": len(train_set), "test": len(test_set),
                        "split": "sklearn load_digits, permutation with seed 0: first 1437 train, next 360 test"},
-              "settings": {"strokes": STROKES, "latent": LATENT, "beta": BETA, "batch": BATCH, "lr": args.lr,
-                           "seed": args.seed, "size": SIZE, "samples": 2},
+              "settings": {"strokes": STROKES, "latent": LATENT, "beta": BETA, "beta_warmup_epochs": BETA_WARMUP,
+                           "batch": BATCH, "lr": args.lr, "seed": args.seed, "size": SIZE, "samples": 2},
               "epochs": [], "interrupted": False}
     test_error, psnr = evaluate(encoder, decoder, test_set, args.threads, args.device)
     report["initial"] = {"test_error": test_error, "test_psnr": psnr}
@@ -193,7 +200,8 @@ def train(args) -> int:
                 z = mean + torch.randn_like(mean) * (0.5 * log_var).exp()
                 recon = draw(*decoder(z), seed=step, threads=args.threads, device=args.device)
                 error = ((recon - batch) ** 2).sum(dim=(1, 2))
-                loss = (error + BETA * kl_divergence(mean, log_var)).mean()
+                beta = BETA * min(1.0, (epoch + first / len(order)) / BETA_WARMUP)
+                loss = (error + beta * kl_divergence(mean, log_var)).mean()
                 opt.zero_grad()
                 loss.backward()
                 opt.step()
