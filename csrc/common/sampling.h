@@ -50,7 +50,7 @@ VF_HD void sample_position(uint64_t seed, uint64_t pixel, int s, int n, double& 
     y = (sy + (px + v) / n) / n;
 }
 
-enum FilterKind : int { FILTER_BOX = 0, FILTER_TENT = 1, FILTER_GAUSSIAN = 2 };
+enum FilterKind : int { FILTER_BOX = 0, FILTER_TENT = 1, FILTER_GAUSSIAN = 2, FILTER_PARABOLIC = 3, FILTER_HANN = 4 };
 
 // Unnormalised filter weight at offset (dx, dy) from the pixel centre, support radius r.
 VF_HD double filter_weight(int kind, double r, double dx, double dy) {
@@ -60,6 +60,12 @@ VF_HD double filter_weight(int kind, double r, double dx, double dy) {
             double s = r / 2;  // truncated at two standard deviations
             return std::exp(-(dx * dx + dy * dy) / (2 * s * s));
         }
+        // diffvg's "radial parabolic" (separable despite its name) and Hann windows; their
+        // constant factors cancel in the normalisation by the sum of the weights.
+        case FILTER_PARABOLIC: return vmax(0.0, 1 - (dx / r) * (dx / r)) * vmax(0.0, 1 - (dy / r) * (dy / r));
+        case FILTER_HANN:
+            if (std::fabs(dx) >= r || std::fabs(dy) >= r) return 0.0;
+            return 0.25 * (1 + std::cos(M_PI * dx / r)) * (1 + std::cos(M_PI * dy / r));
         default: return 1.0;
     }
 }

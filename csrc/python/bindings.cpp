@@ -54,7 +54,9 @@ int parse_filter(const std::string& f) {
     if (f == "box") return 0;
     if (f == "tent") return 1;
     if (f == "gaussian") return 2;
-    throw std::invalid_argument("filter must be 'box', 'tent' or 'gaussian', not '" + f + "'");
+    if (f == "parabolic") return 3;
+    if (f == "hann") return 4;
+    throw std::invalid_argument("filter must be 'box', 'tent', 'gaussian', 'parabolic' or 'hann', not '" + f + "'");
 }
 
 // The scene's arrays, kept alive for the duration of a call.

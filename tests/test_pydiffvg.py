@@ -1,0 +1,291 @@
+"""pydiffvg on vecfit: diffvg's API, checked by inverse rendering written against that API
+only (as diffvg's own tests and the projects built on it use it).
+
+Each feature: render a target, perturb the parameters, optimise them back with Adam on
+the L2 image loss, and assert that they come back; the tolerance is stated per test (in
+pixels for geometry, in colour units for colours). Images are 32-48 px, 2 x 2 samples,
+at most 200 iterations: the whole file takes about 30 s on 2 cores.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import torch
+
+import diffvg
+import pydiffvg
+import vecfit
+from vecfit.renderer import scene as vs
+
+S = 40  # canvas and image size
+
+
+def render(shapes, groups, size=S, samples=2, seed=0, background=None, **options):
+    args = pydiffvg.RenderFunction.serialize_scene(size, size, shapes, groups, **options)
+    return pydiffvg.RenderFunction.apply(size, size, samples, samples, seed, background, *args)
+
+
+def fit(make, truth: dict, start: dict, iterations=150, lr=0.5, samples=2, size=S, same_samples=False, **kw):
+    """Adam from ``start`` towards the parameters that rendered the target from ``truth``;
+    returns the fitted parameters. ``make(params) -> (shapes, groups, options)``. Each
+    iteration draws new samples, unless ``same_samples`` (the target's samples)."""
+    with torch.no_grad():
+        shapes, groups, options = make({k: v.clone() for k, v in truth.items()})
+        target = render(shapes, groups, size=size, samples=samples, seed=1234, **options, **kw)
+    params = {k: v.detach().clone().requires_grad_(True) for k, v in start.items()}
+    rates = lr if isinstance(lr, dict) else {k: lr for k in params}
+    opt = torch.optim.Adam([{"params": [params[k]], "lr": rates[k]} for k in params])
+    # cosine decay to 10%: the last steps settle instead of jittering at the full rate
+    decay = torch.optim.lr_scheduler.LambdaLR(opt, lambda i: 0.1 + 0.45 * (1 + math.cos(math.pi * i / iterations)))
+    for it in range(iterations):
+        opt.zero_grad()
+        shapes, groups, options = make(params)
+        img = render(shapes, groups, size=size, samples=samples, seed=1234 if same_samples else it, **options, **kw)
+        loss = ((img - target) ** 2).mean()
+        loss.backward()
+        opt.step()
+        decay.step()
+    return {k: v.detach() for k, v in params.items()}
+
+
+def on_curve(points, closed):
+    """Points along the cubics (8 per segment): control points may trade off against each
+    other with little change to the image, the curve they draw may not."""
+    pts = torch.cat([points, points[:1]]) if closed else points
+    t = torch.linspace(0, 1, 8)[:, None]
+    out = []
+    for k in range(0, len(pts) - 1, 3):
+        p0, p1, p2, p3 = pts[k:k + 4]
+        out.append((1 - t) ** 3 * p0 + 3 * (1 - t) ** 2 * t * p1 + 3 * (1 - t) * t * t * p2 + t ** 3 * p3)
+    return torch.cat(out)
+
+
+def close(a, b, tol):
+    err = float((torch.as_tensor(a) - torch.as_tensor(b)).abs().max())
+    assert err <= tol, f"{a} vs {b}: off by {err:.3g} (tolerance {tol})"
+
+
+BLUE = torch.tensor([0.2, 0.3, 0.9, 1.0])
+
+
+def one(shape, fill=BLUE, **group):
+    return [shape], [pydiffvg.ShapeGroup(torch.tensor([0]), fill_color=fill, **group)], {}
+
+
+# ------------------------------------------------------------------------ shapes
+
+def test_circle():
+    got = fit(lambda p: one(pydiffvg.Circle(p["r"], p["c"])),
+              {"r": torch.tensor(10.0), "c": torch.tensor([20.0, 18.0])},
+              {"r": torch.tensor(7.0), "c": torch.tensor([16.0, 22.0])})
+    close(got["r"], 10.0, 0.15)
+    close(got["c"], [20.0, 18.0], 0.15)
+
+
+def test_ellipse():
+    got = fit(lambda p: one(pydiffvg.Ellipse(p["r"], p["c"])),
+              {"r": torch.tensor([12.0, 7.0]), "c": torch.tensor([20.0, 19.0])},
+              {"r": torch.tensor([9.0, 9.0]), "c": torch.tensor([17.0, 22.0])})
+    close(got["r"], [12.0, 7.0], 0.15)
+    close(got["c"], [20.0, 19.0], 0.15)
+
+
+def test_rect():
+    got = fit(lambda p: one(pydiffvg.Rect(p["lo"], p["hi"])),
+              {"lo": torch.tensor([8.0, 11.0]), "hi": torch.tensor([30.0, 27.0])},
+              {"lo": torch.tensor([11.0, 8.0]), "hi": torch.tensor([26.0, 31.0])})
+    close(got["lo"], [8.0, 11.0], 0.15)
+    close(got["hi"], [30.0, 27.0], 0.15)
+
+
+STAR = torch.tensor([[20.0, 4.0], [29.4, 33.0], [4.8, 15.1], [35.2, 15.1], [10.6, 33.0]])
+
+
+def test_self_intersecting_polygon_even_odd():
+    # A pentagram: even-odd leaves the centre pentagon empty, which the fit must reproduce.
+    make = lambda p: one(pydiffvg.Polygon(p["pts"], True), use_even_odd_rule=True)  # noqa: E731
+    start = STAR + torch.tensor([[1.5, -1.0], [-1.0, 1.5], [1.0, 1.0], [-1.5, -1.0], [1.0, -1.5]])
+    got = fit(make, {"pts": STAR}, {"pts": start}, lr=0.2)
+    close(got["pts"], STAR, 0.3)
+    with torch.no_grad():
+        img = render(*make({"pts": STAR})[:2])
+    assert float(img[20, 20, 3]) < 0.05 and float(img[8, 20, 3]) > 0.95  # hole inside, star tip filled
+
+
+# three bulging sides between sharp corners (points 0, 3, 6): a smooth joint would let its
+# point slide along the outline without changing the image
+BLOB = torch.tensor([[6.0, 8.0], [14.0, 2.0], [26.0, 4.0], [34.0, 12.0], [36.0, 22.0], [28.0, 32.0],
+                     [18.0, 36.0], [8.0, 32.0], [2.0, 18.0]])
+
+
+def test_closed_cubic_path():
+    # three cubics, the last wrapping round to points[0]
+    make = lambda p: one(pydiffvg.Path(torch.tensor([2, 2, 2]), p["pts"], True))  # noqa: E731
+    g = torch.Generator().manual_seed(0)
+    start = BLOB + (torch.rand(BLOB.shape, generator=g) - 0.5) * 3
+    got = fit(make, {"pts": BLOB}, {"pts": start}, iterations=200, lr=0.2)
+    close(on_curve(got["pts"], True), on_curve(BLOB, True), 0.5)
+    close(got["pts"], BLOB, 1.5)  # control points: less well determined by the image
+
+
+def stroke_only(path):
+    return [path], [pydiffvg.ShapeGroup(torch.tensor([0]), fill_color=None,
+                                        stroke_color=torch.tensor([0.9, 0.2, 0.1, 1.0]))], {}
+
+
+CURVE = torch.tensor([[6.0, 30.0], [12.0, 6.0], [28.0, 6.0], [34.0, 30.0]])
+
+
+def test_open_stroke():
+    make = lambda p: stroke_only(pydiffvg.Path(torch.tensor([2]), p["pts"], False, stroke_width=p["w"]))  # noqa: E731
+    got = fit(make, {"pts": CURVE, "w": torch.tensor(2.0)},
+              {"pts": CURVE + torch.tensor([[1.5, 1.0], [-1.0, 1.5], [1.0, -1.0], [-1.5, -1.0]]),
+               "w": torch.tensor(1.4)}, iterations=200, lr={"pts": 0.2, "w": 0.05})
+    close(got["w"], 2.0, 0.1)
+    close(got["pts"][[0, 3]], CURVE[[0, 3]], 0.3)  # the end points (round caps)
+    close(on_curve(got["pts"], False), on_curve(CURVE, False), 0.5)
+    close(got["pts"], CURVE, 1.5)  # control points: less well determined by the image
+
+
+def test_per_point_thickness():
+    line = torch.tensor([[6.0, 20.0], [34.0, 20.0]])
+    make = lambda p: stroke_only(pydiffvg.Path(torch.tensor([0]), line, False, stroke_width=p["w"]))  # noqa: E731
+    got = fit(make, {"w": torch.tensor([1.5, 4.0])}, {"w": torch.tensor([3.0, 2.5])}, lr=0.05)
+    close(got["w"], [1.5, 4.0], 0.1)
+
+
+# ----------------------------------------------------------------------- paints
+
+SQUARE = pydiffvg.Rect(torch.tensor([4.0, 4.0]), torch.tensor([36.0, 36.0]))
+
+
+def test_linear_gradient():
+    def make(p):
+        grad = pydiffvg.LinearGradient(p["begin"], p["end"], torch.tensor([0.0, 1.0]), p["colors"])
+        return one(SQUARE, grad)
+    colors = torch.tensor([[0.9, 0.1, 0.1, 1.0], [0.1, 0.2, 0.9, 1.0]])
+    got = fit(make, {"begin": torch.tensor([8.0, 10.0]), "end": torch.tensor([32.0, 28.0]), "colors": colors},
+              {"begin": torch.tensor([12.0, 6.0]), "end": torch.tensor([28.0, 32.0]),
+               "colors": torch.tensor([[0.6, 0.3, 0.3, 1.0], [0.3, 0.3, 0.6, 1.0]])},
+              iterations=200, lr={"begin": 0.3, "end": 0.3, "colors": 0.01})
+    close(got["begin"], [8.0, 10.0], 0.5)
+    close(got["end"], [32.0, 28.0], 0.5)
+    close(got["colors"][:, :3], colors[:, :3], 0.03)
+
+
+def test_radial_gradient():
+    colors = torch.tensor([[1.0, 0.9, 0.2, 1.0], [0.1, 0.1, 0.5, 1.0]])
+
+    def make(p):
+        return one(SQUARE, pydiffvg.RadialGradient(p["c"], p["r"], torch.tensor([0.0, 1.0]), colors))
+    got = fit(make, {"c": torch.tensor([18.0, 22.0]), "r": torch.tensor([14.0, 9.0])},
+              {"c": torch.tensor([22.0, 18.0]), "r": torch.tensor([10.0, 12.0])}, iterations=200, lr=0.3)
+    close(got["c"], [18.0, 22.0], 0.3)
+    close(got["r"], [14.0, 9.0], 0.3)
+
+
+def test_shape_to_canvas_2x3():
+    square = pydiffvg.Rect(torch.tensor([-8.0, -8.0]), torch.tensor([8.0, 8.0]))
+    truth = torch.tensor([[1.0, 0.4, 20.0], [-0.3, 0.8, 19.0]])
+    start = torch.tensor([[0.8, 0.2, 18.0], [-0.1, 1.0, 21.0]])
+    got = fit(lambda p: one(square, shape_to_canvas=p["m"]), {"m": truth}, {"m": start}, iterations=200,
+              lr=0.02)
+    close(got["m"][:, :2], truth[:, :2], 0.03)
+    close(got["m"][:, 2], truth[:, 2], 0.3)
+
+
+# ---------------------------------------------------------------- filter, background
+
+@pytest.mark.parametrize("ftype", [diffvg.FilterType.tent, diffvg.FilterType.parabolic, diffvg.FilterType.hann])
+@pytest.mark.parametrize("prefiltering", [False, True])
+def test_pixel_filter_radius(ftype, prefiltering):
+    # A disk over an opaque square: the image's colour is defined everywhere.
+    shapes = [pydiffvg.Rect(torch.tensor([0.0, 0.0]), torch.tensor([40.0, 40.0])),
+              pydiffvg.Circle(torch.tensor(9.0), torch.tensor([20.0, 20.0]))]
+    groups = [pydiffvg.ShapeGroup(torch.tensor([0]), torch.tensor([1.0, 1.0, 1.0, 1.0])),
+              pydiffvg.ShapeGroup(torch.tensor([1]), BLUE)]
+
+    def make(p):
+        return shapes, groups, dict(filter=pydiffvg.PixelFilter(ftype, p["r"]), use_prefiltering=prefiltering)
+    # Monte Carlo: with new samples each step the expected loss's minimum moves (the
+    # image's variance depends on r), so the fit uses the target's samples.
+    got = fit(make, {"r": torch.tensor(1.5)}, {"r": torch.tensor(0.9)}, iterations=80, lr=0.05,
+              samples=4, same_samples=True)
+    close(got["r"], 1.5, 0.08)
+
+
+def test_background_image():
+    # A disk over a background image whose colour is fitted (visible around the disk).
+    disk = pydiffvg.Circle(torch.tensor(10.0), torch.tensor([20.0, 20.0]))
+    half = torch.tensor([0.7, 0.2, 0.1, 0.6])
+
+    def make(p):
+        return one(disk, fill=torch.tensor([0.1, 0.2, 0.9, 0.5]))
+
+    truth = torch.tensor([0.3, 0.8, 0.5, 1.0])
+    target = render(*make({})[:2], background=truth.expand(S, S, 4).contiguous())
+    bg = half.clone().requires_grad_(True)
+    opt = torch.optim.Adam([bg], lr=0.02)
+    for it in range(150):
+        opt.zero_grad()
+        img = render(*make({})[:2], background=bg.expand(S, S, 4), seed=it)
+        ((img - target) ** 2).mean().backward()
+        opt.step()
+        with torch.no_grad():
+            bg.clamp_(0, 1)
+    close(bg.detach(), truth, 0.02)
+
+
+# ------------------------------------------------------------- the adapter itself
+
+def test_gradients_equal_vecfit_render():
+    """The same scene built with pydiffvg and with vecfit's own Scene: equal images and
+    equal gradients (same seed, same samples)."""
+    pts = BLOB.clone().requires_grad_(True)
+    color = torch.tensor([0.2, 0.5, 0.7, 0.8], requires_grad=True)
+    half = torch.tensor(1.5, requires_grad=True)
+    stroke = torch.tensor([0.1, 0.1, 0.1, 1.0], requires_grad=True)
+    shapes = [pydiffvg.Path(torch.tensor([2, 2, 2]), pts, True, stroke_width=half)]
+    groups = [pydiffvg.ShapeGroup(torch.tensor([0]), color, use_even_odd_rule=False, stroke_color=stroke)]
+    weights = torch.rand(S, S, 4, generator=torch.Generator().manual_seed(3))
+    (render(shapes, groups, seed=7) * weights).sum().backward()
+    ours = [t.grad.clone() for t in (pts, color, half, stroke)]
+
+    pts2, color2, half2, stroke2 = (t.detach().clone().requires_grad_(True) for t in (pts, color, half, stroke))
+    geometry = vs.Path(points=pts2, degrees=np.array([3, 3, 3]), subpaths=[(0, 3, True)])
+    scene = vs.Scene(width=S, height=S, shapes=[
+        vs.Shape(geometry=geometry, stroke=vs.Solid(stroke2), stroke_width=2 * half2, linecap="round",
+                 linejoin="round"),
+        vs.Shape(geometry=geometry, fill=vs.Solid(color2))])
+    (vecfit.render(scene, S, S, samples=2, seed=7) * weights).sum().backward()
+    for a, b in zip(ours, (pts2.grad, color2.grad, half2.grad, stroke2.grad)):
+        assert torch.allclose(a, b, rtol=1e-5, atol=1e-5)
+
+
+def test_output_size_differs_from_canvas():
+    shapes, groups, _ = one(pydiffvg.Circle(torch.tensor(10.0), torch.tensor([20.0, 20.0])))
+    args = pydiffvg.RenderFunction.serialize_scene(S, S, shapes, groups)
+    small = pydiffvg.RenderFunction.apply(20, 20, 4, 4, 0, None, *args)
+    assert small.shape == (20, 20, 4)
+    # the disk of radius 10 in a 40 px canvas covers radius 5 in the 20 px image
+    cover = float(small[..., 3].sum())
+    assert abs(cover - math.pi * 25) < 1.5
+
+
+def test_modules_are_one():
+    import vecfit.pydiffvg as inner
+    assert pydiffvg is inner
+    assert diffvg.FilterType.hann == pydiffvg.FilterType.hann
+
+
+def test_from_svg_path():
+    paths = pydiffvg.from_svg_path("M 10 10 C 20 0 30 0 40 10 L 40 30 Z M 0 0 L 5 5",
+                                   shape_to_canvas=torch.tensor([[2.0, 0, 1], [0, 2.0, 0], [0, 0, 1]]))
+    assert len(paths) == 2
+    first, second = paths
+    assert first.is_closed and first.num_control_points.tolist() == [2, 0, 0]
+    assert torch.allclose(first.points[0], torch.tensor([21.0, 20.0]))
+    assert first.points.shape == (5, 2)  # closed: the last line wraps to points[0]
+    assert not second.is_closed and second.points.shape == (2, 2)

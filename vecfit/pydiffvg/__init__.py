@@ -1,0 +1,36 @@
+"""pydiffvg on vecfit: diffvg's Python API (``import pydiffvg``) over vecfit's renderer.
+
+Code written for diffvg's ``pydiffvg`` runs unchanged: the same classes, functions,
+argument orders and defaults (see README "Coming from diffvg"). What differs, and why:
+
+- Rendering is vecfit's: exact curves, SVG-correct strokes (the stroke of a diffvg shape
+  is every point within ``stroke_width``, i.e. round caps and joins), and straight
+  (not premultiplied) RGBA out, as diffvg gives.
+- ``num_samples_x`` and ``num_samples_y`` may differ in diffvg; vecfit samples N x N per
+  pixel with N the larger of the two. ``use_prefiltering=True`` is vecfit's analytical
+  mode at one sample per pixel. The box filter always covers exactly the pixel (its
+  radius is ignored); tent, parabolic and Hann filters use the radius (at least 0.5).
+- The filter radius's gradient is a central difference of two further renders with the
+  same samples (only when the radius requires grad): exact to O(h^2) in the analytical
+  mode, an unbiased estimate of that difference in Monte Carlo mode.
+- ``background_image`` is composited under the filtered image per pixel (diffvg does it
+  per sample; the same for the box filter).
+- ``svg_to_scene`` and ``save_svg`` are vecfit's reader and a writer of its own: they keep
+  ellipses, rect positions and radial gradients that diffvg's lose (see pydiffvg.svg).
+- Not yet: ``OutputType.sdf``, ``eval_positions`` and ``RenderFunction.render_grad``
+  (they raise VecfitError).
+"""
+from __future__ import annotations
+
+from .device import get_device, get_use_gpu, set_device, set_use_gpu
+from .enums import ColorType, FilterType, OutputType, ShapeType
+from .image import imwrite
+from .render import RenderFunction, set_print_timing
+from .shapes import (Circle, Ellipse, LinearGradient, Path, PixelFilter, Polygon, RadialGradient, Rect,
+                     ShapeGroup, from_svg_path)
+from .svg import save_svg, svg_to_scene
+
+__all__ = ["Circle", "ColorType", "Ellipse", "FilterType", "LinearGradient", "OutputType", "Path",
+           "PixelFilter", "Polygon", "RadialGradient", "Rect", "RenderFunction", "ShapeGroup", "ShapeType",
+           "from_svg_path", "get_device", "get_use_gpu", "imwrite", "save_svg", "set_device",
+           "set_print_timing", "set_use_gpu", "svg_to_scene"]
