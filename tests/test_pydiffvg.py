@@ -3,8 +3,8 @@ only (as diffvg's own tests and the projects built on it use it).
 
 Each feature: render a target, perturb the parameters, optimise them back with Adam on
 the L2 image loss, and assert that they come back; the tolerance is stated per test (in
-pixels for geometry, in colour units for colours). Images are 32-48 px, 2 x 2 samples,
-at most 200 iterations: the whole file takes about 30 s on 2 cores.
+pixels for geometry, in colour units for colours). Images are 24-40 px, 2 x 2 samples,
+at most 200 iterations: the whole file takes about 40 s on 2 cores.
 """
 from __future__ import annotations
 
@@ -23,7 +23,8 @@ S = 40  # canvas and image size
 
 
 def render(shapes, groups, size=S, samples=2, seed=0, background=None, **options):
-    args = pydiffvg.RenderFunction.serialize_scene(size, size, shapes, groups, **options)
+    """An image of size x size pixels of the S x S canvas."""
+    args = pydiffvg.RenderFunction.serialize_scene(S, S, shapes, groups, **options)
     return pydiffvg.RenderFunction.apply(size, size, samples, samples, seed, background, *args)
 
 
@@ -236,6 +237,63 @@ def test_background_image():
         with torch.no_grad():
             bg.clamp_(0, 1)
     close(bg.detach(), truth, 0.02)
+
+
+# --------------------------------------------------------------------------- sdf
+
+def test_sdf_output():
+    """OutputType.sdf: signed distances (negative inside) equal the exact ones, and fitting
+    an ellipse and a rect to a target sdf brings their parameters back (0.05 px)."""
+    def make(p):
+        shapes = [pydiffvg.Ellipse(p["r"], p["c"]), pydiffvg.Rect(p["lo"], torch.tensor([36.0, 36.0]))]
+        groups = [pydiffvg.ShapeGroup(torch.tensor([0]), BLUE), pydiffvg.ShapeGroup(torch.tensor([1]), BLUE)]
+        return shapes, groups, dict(output_type=pydiffvg.OutputType.sdf)
+
+    with torch.no_grad():
+        disk = make({"r": torch.tensor([8.0, 8.0]), "c": torch.tensor([14.0, 12.0]), "lo": torch.tensor([50.0, 50.0])})
+        sdf = render(disk[0][:1], disk[1][:1], **disk[2])
+    ys, xs = torch.meshgrid(torch.arange(S) + 0.5, torch.arange(S) + 0.5, indexing="ij")
+    exact = torch.sqrt((xs - 14) ** 2 + (ys - 12) ** 2) - 8
+    assert sdf.shape == (S, S, 1)
+    close(sdf[..., 0], exact, 1e-3)
+    # rendered at 24 x 24 (the canvas stays 40 x 40): every pixel measures every shape
+    truth = {"r": torch.tensor([9.0, 6.0]), "c": torch.tensor([14.0, 13.0]), "lo": torch.tensor([26.0, 28.0])}
+    got = fit(make, truth, {"r": torch.tensor([7.0, 7.0]), "c": torch.tensor([16.0, 11.0]),
+                            "lo": torch.tensor([24.0, 30.0])}, iterations=100, lr=0.3, size=24)
+    for k in truth:
+        close(got[k], truth[k], 0.05)
+
+
+def test_sdf_at_eval_positions():
+    """eval_positions: N x 1 distances at the given points; a circle fitted to the
+    distances at 8 points comes back (0.05 px), and the points' own gradient is the
+    distance's direction."""
+    g = torch.Generator().manual_seed(1)
+    points = torch.rand(8, 2, generator=g) * S
+
+    def sdf(r, c, positions=points):
+        args = pydiffvg.RenderFunction.serialize_scene(
+            S, S, [pydiffvg.Circle(r, c)], [pydiffvg.ShapeGroup(torch.tensor([0]), BLUE)],
+            output_type=pydiffvg.OutputType.sdf, eval_positions=positions)
+        return pydiffvg.RenderFunction.apply(S, S, 1, 1, 0, None, *args)
+
+    target = sdf(torch.tensor(10.0), torch.tensor([21.0, 17.0]))
+    exact = (points - torch.tensor([21.0, 17.0])).norm(dim=1, keepdim=True) - 10
+    assert target.shape == (8, 1)
+    close(target, exact, 1e-3)
+    r, c = torch.tensor(7.0, requires_grad=True), torch.tensor([18.0, 20.0], requires_grad=True)
+    opt = torch.optim.Adam([r, c], lr=0.5)
+    decay = torch.optim.lr_scheduler.LambdaLR(opt, lambda i: 0.05 + 0.475 * (1 + math.cos(math.pi * i / 100)))
+    for _ in range(100):
+        opt.zero_grad()
+        ((sdf(r, c) - target) ** 2).mean().backward()
+        opt.step()
+        decay.step()
+    close(r.detach(), 10.0, 0.05)
+    close(c.detach(), [21.0, 17.0], 0.05)
+    p = torch.tensor([[30.0, 17.0]], requires_grad=True)
+    sdf(torch.tensor(10.0), torch.tensor([21.0, 17.0]), p).sum().backward()
+    close(p.grad, [[1.0, 0.0]], 1e-3)
 
 
 # ------------------------------------------------------------- the adapter itself

@@ -17,7 +17,11 @@ argument orders and defaults (see README "Coming from diffvg"). What differs, an
   per sample; the same for the box filter).
 - ``svg_to_scene`` and ``save_svg`` are vecfit's reader and a writer of its own: they keep
   ellipses, rect positions and radial gradients that diffvg's lose (see pydiffvg.svg).
-- Not yet: ``OutputType.sdf``, ``eval_positions`` and ``RenderFunction.render_grad``
+- ``OutputType.sdf`` (H x W x 1, or N x 1 at ``eval_positions``) is the signed distance
+  to the nearest boundary of any group's fill or stroke, negative inside one, in canvas
+  units, from vecfit's analytical coverage (see pydiffvg.sdf); ``eval_positions`` takes
+  one small render per point (hundreds of points, not millions).
+- Not yet: ``eval_positions`` with colour output and ``RenderFunction.render_grad``
   (they raise VecfitError).
 """
 from __future__ import annotations

@@ -17,6 +17,7 @@ from vecfit.renderer.raster import render
 
 from . import device
 from .convert import Parsed, to_scene
+from .sdf import sdf_at, sdf_image
 from .enums import FILTER_NAMES, ColorType, FilterType, OutputType, ShapeType
 from .shapes import Circle, Ellipse, LinearGradient, Path, PixelFilter, Polygon, RadialGradient, Rect
 
@@ -128,10 +129,18 @@ class RenderFunction:
     def apply(width, height, num_samples_x, num_samples_y, seed, background_image, *args):
         start = time.perf_counter()
         parsed = Parsed(args)
-        if parsed.output_type != OutputType.color:
-            raise VecfitError("pydiffvg on vecfit renders OutputType.color only (no sdf yet)")
-        if isinstance(parsed.eval_positions, torch.Tensor) and parsed.eval_positions.numel() > 0:
-            raise VecfitError("pydiffvg on vecfit does not evaluate eval_positions yet")
+        positions = parsed.eval_positions
+        has_positions = isinstance(positions, torch.Tensor) and positions.numel() > 0
+        if parsed.output_type == OutputType.sdf:
+            if has_positions:
+                out = sdf_at(parsed, positions, device.render_device())
+            else:
+                out = sdf_image(parsed, int(width), int(height), device.render_device())
+            if _print_timing:
+                print(f"pydiffvg (vecfit): sdf {time.perf_counter() - start:.4f} s")
+            return out.to(device.get_device())
+        if has_positions:
+            raise VecfitError("pydiffvg on vecfit evaluates eval_positions for OutputType.sdf only")
         scene = to_scene(parsed)
         ftype = FilterType(int(parsed.filter_type))
         radius = parsed.filter_radius
