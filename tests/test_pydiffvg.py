@@ -322,6 +322,35 @@ def test_gradients_equal_vecfit_render():
         assert torch.allclose(a, b, rtol=1e-5, atol=1e-5)
 
 
+def test_same_objects_rendered_again_see_their_changes():
+    """The adapter reuses what it built for the same tensors (see convert._reuse): values
+    changed in place, a reassigned attribute and changed shape ids must all show, and
+    the images equal those of freshly made objects."""
+    pts = BLOB.clone().requires_grad_(True)
+    path = pydiffvg.Path(torch.tensor([2, 2, 2]), pts, True)
+    disk = pydiffvg.Circle(torch.tensor(5.0), torch.tensor([30.0, 30.0]))
+    group = pydiffvg.ShapeGroup(torch.tensor([0]), BLUE.clone())
+
+    def image(shapes, color=None, index=0):
+        fresh = pydiffvg.ShapeGroup(torch.tensor([index]), BLUE.clone() if color is None else color)
+        return render(shapes, [fresh]).detach()
+
+    first = render([path, disk], [group])
+    first[..., 3].sum().backward()
+    assert pts.grad.abs().sum() > 0
+    with torch.no_grad():
+        pts += 3.0  # in place, as an optimiser steps
+    moved = render([path, disk], [group]).detach()
+    assert (moved - first.detach()).abs().max() > 0.5
+    assert torch.equal(moved, image([pydiffvg.Path(torch.tensor([2, 2, 2]), BLOB + 3.0, True), disk]))
+    path.points = BLOB.clone()  # a new tensor
+    assert torch.equal(render([path, disk], [group]).detach(), image([path, disk]))
+    group.fill_color = torch.tensor([1.0, 0.0, 0.0, 1.0])
+    assert torch.equal(render([path, disk], [group]).detach(), image([path, disk], group.fill_color))
+    group.shape_ids[0] = 1  # in place: now the disk
+    assert torch.equal(render([path, disk], [group]).detach(), image([path, disk], group.fill_color, 1))
+
+
 def test_output_size_differs_from_canvas():
     shapes, groups, _ = one(pydiffvg.Circle(torch.tensor(10.0), torch.tensor([20.0, 20.0])))
     args = pydiffvg.RenderFunction.serialize_scene(S, S, shapes, groups)
