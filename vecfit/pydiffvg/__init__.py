@@ -13,6 +13,8 @@ argument orders and defaults (see README "Coming from diffvg"). What differs, an
 - The filter radius's gradient is a central difference of two further renders with the
   same samples (only when the radius requires grad): exact to O(h^2) in the analytical
   mode, an unbiased estimate of that difference in Monte Carlo mode.
+- ``RenderFunction.render_grad`` (the per-pixel translation gradient) is a central
+  difference of the image over a small translation of the scene (five renders).
 - ``background_image`` is composited under the filtered image per pixel (diffvg does it
   per sample; the same for the box filter).
 - ``svg_to_scene`` and ``save_svg`` are vecfit's reader and a writer of its own: they keep
@@ -21,8 +23,7 @@ argument orders and defaults (see README "Coming from diffvg"). What differs, an
   to the nearest boundary of any group's fill or stroke, negative inside one, in canvas
   units, from vecfit's analytical coverage (see pydiffvg.sdf); ``eval_positions`` takes
   one small render per point (hundreds of points, not millions).
-- Not yet: ``eval_positions`` with colour output and ``RenderFunction.render_grad``
-  (they raise VecfitError).
+- Not yet: ``eval_positions`` with colour output (it raises VecfitError).
 """
 from __future__ import annotations
 

@@ -71,14 +71,25 @@ def _merge(fg: torch.Tensor, bg: torch.Tensor) -> torch.Tensor:
     return torch.cat([torch.where(alpha > 0, rgb / safe, torch.zeros_like(rgb)), alpha], dim=-1)
 
 
+def _difference(image, hi, lo, step):
+    """(hi - lo) / step for straight RGBA images, taken on premultiplied colour and carried
+    to straight colour with ``image``'s alpha: where a pixel's alpha leaves 0 its
+    straight colour jumps from 0 to the shape's, which is not a change to count."""
+    premult = lambda im: torch.cat([im[..., :3] * im[..., 3:], im[..., 3:]], dim=-1)  # noqa: E731
+    d = (premult(hi) - premult(lo)) / step
+    alpha, d_alpha = image[..., 3:], d[..., 3:]
+    safe = torch.where(alpha > 0, alpha, torch.ones_like(alpha))
+    d_rgb = torch.where(alpha > 0, (d[..., :3] - image[..., :3] * d_alpha) / safe, torch.zeros_like(d[..., :3]))
+    return torch.cat([d_rgb, d_alpha], dim=-1)
+
+
 class _FilterRadius(torch.autograd.Function):
     """Passes the image through; its backward adds the filter radius's dL/dr, from a
-    central difference of two more renders with the same samples (common random numbers).
-    The difference is taken on premultiplied colour and carried to straight colour with
-    the image's own alpha, so that a pixel whose alpha leaves 0 (its straight colour jumps
-    from 0 to the shape's) does not count as a jump. Steps: 2% of r in the analytical
-    mode (a smooth function of r), 10% in Monte Carlo mode (fewer samples cross an edge
-    over a small step: a larger step has less variance)."""
+    central difference of two more renders with the same samples (common random numbers),
+    see _difference. Steps: 0.2% of r in the analytical mode (a smooth function of r; a
+    large step would mix colours across an edge where alpha is near 0), 10% in Monte
+    Carlo mode (fewer samples cross an edge over a small step: a larger step has less
+    variance)."""
 
     @staticmethod
     def forward(ctx, radius, image, render_at, step):
@@ -94,13 +105,38 @@ class _FilterRadius(torch.autograd.Function):
         hi_r, lo_r = r + h, max(0.5, r - h)  # the core never filters narrower than 0.5 px
         with torch.no_grad():
             hi, lo = ctx.render_at(hi_r), ctx.render_at(lo_r)
-            premult = lambda im: torch.cat([im[..., :3] * im[..., 3:], im[..., 3:]], dim=-1)  # noqa: E731
-            d = (premult(hi) - premult(lo)) / (hi_r - lo_r)
-            alpha, d_alpha = image[..., 3:], d[..., 3:]
-            safe = torch.where(alpha > 0, alpha, torch.ones_like(alpha))
-            d_rgb = torch.where(alpha > 0, (d[..., :3] - image[..., :3] * d_alpha) / safe, torch.zeros_like(d[..., :3]))
-            d_r = (grad[..., :3] * d_rgb).sum() + (grad[..., 3:] * d_alpha).sum()
+            d_r = (grad * _difference(image, hi, lo, hi_r - lo_r)).sum()
         return d_r.reshape(()), grad, None, None
+
+
+def _translated(args: list, step: torch.Tensor) -> list:
+    """The serialized scene with every group's shape_to_canvas (and so its gradients'
+    canvas coordinates) moved by ``step``."""
+    parsed = Parsed(args)
+    move = torch.eye(3)
+    move[:2, 2] = step
+    out = list(args)
+    matrices = {id(g[4]) for g in parsed.groups}
+    for i, item in enumerate(out):
+        if isinstance(item, torch.Tensor) and id(item) in matrices:
+            m = item.detach().float()
+            if m.shape == (2, 3):
+                m = torch.cat([m, torch.tensor([[0.0, 0.0, 1.0]])])
+            out[i] = move @ m
+    return _shift_gradients(out, parsed, step)
+
+
+def _shift_gradients(args: list, parsed: Parsed, step: torch.Tensor) -> list:
+    """Gradient paints are in canvas coordinates: their points move with the scene."""
+    points = set()
+    for _, fill, stroke, _, _ in parsed.groups:
+        for paint in (fill, stroke):
+            if paint is not None and paint[0] != ColorType.constant:
+                points.add(id(paint[1][0]))  # begin, or the radial centre
+                if paint[0] == ColorType.linear_gradient:
+                    points.add(id(paint[1][1]))  # end
+    return [item.detach() + step if isinstance(item, torch.Tensor) and id(item) in points else item
+            for item in args]
 
 
 class RenderFunction:
@@ -157,9 +193,40 @@ class RenderFunction:
         image = render_at(r)
         if (isinstance(radius, torch.Tensor) and radius.requires_grad and torch.is_grad_enabled()
                 and ftype != FilterType.box):
-            image = _FilterRadius.apply(radius, image, render_at, 0.02 if parsed.use_prefiltering else 0.1)
+            image = _FilterRadius.apply(radius, image, render_at, 0.002 if parsed.use_prefiltering else 0.1)
         if background_image is not None:
             image = _merge(image, background_image.to(image.device, torch.float32))
         if _print_timing:
             print(f"pydiffvg (vecfit): forward pass {time.perf_counter() - start:.4f} s")
         return image.to(device.get_device())
+
+    @staticmethod
+    def render_grad(grad_img, width, height, num_samples_x, num_samples_y, seed, background_image, *args):
+        """diffvg's translation gradient image [H, W, 2]: for each pixel, its share of
+        dL/d(translation of the whole scene, in canvas units), sum(grad_img * dI/dt) at
+        that pixel, for the loss L whose gradient with respect to the image is grad_img.
+        Here a central difference of the image over a translation each way, with the same
+        samples (five renders): 0.002 px in the analytical mode, where the image is smooth;
+        a quarter pixel in Monte Carlo mode, where it counts the samples that an edge
+        crosses (noisy per pixel, right on average)."""
+        parsed = Parsed(args)
+        if parsed.output_type != OutputType.color:
+            raise VecfitError("render_grad: pydiffvg on vecfit has the translation gradient for colour output only")
+        # a small step where the image is smooth in t (analytical mode); where it is a step
+        # function of t (Monte Carlo), one large enough for edges to cross some samples
+        h = (0.002 if parsed.use_prefiltering else 0.25) * float(parsed.canvas_width) / int(width)
+        grad = grad_img.detach().cpu().float()
+        out = []
+        with torch.no_grad():
+            image = RenderFunction.apply(width, height, num_samples_x, num_samples_y, seed, background_image,
+                                         *args).cpu()
+            for axis in (0, 1):
+                images = []
+                for sign in (1.0, -1.0):
+                    step = torch.zeros(2)
+                    step[axis] = sign * h
+                    image = RenderFunction.apply(width, height, num_samples_x, num_samples_y, seed, background_image,
+                                                 *_translated(args, step))
+                    images.append(image.cpu())
+                out.append((_difference(image, images[0], images[1], 2 * h) * grad).sum(dim=-1))
+        return torch.stack(out, dim=-1).to(device.get_device())
