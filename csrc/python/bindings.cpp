@@ -154,6 +154,19 @@ py::array_t<float> render(const py::dict& scene, int width, int height, int samp
     return image;
 }
 
+// dL/d(filter radius), Monte Carlo mode: g is dL/d(the filtered premultiplied colour of
+// each pixel, background excluded), height x width x 4. On the CPU.
+double filter_radius_grad(const py::dict& scene, Array<float> g, int width, int height, int samples,
+                          const std::string& filter, double filter_radius, uint64_t seed, int threads) {
+    SceneInput in = scene_input(scene);
+    SceneArrays a = in.arrays();
+    RenderOptions o = render_options(width, height, samples, "mc", filter, filter_radius, seed, threads, py::none());
+    if (g.size() != (py::ssize_t)width * height * 4) throw std::invalid_argument("g must be height x width x 4");
+    py::gil_scoped_release release;
+    PreparedScene prepared = timed_prepare(a);
+    return filter_radius_gradient(prepared, o, g.data());
+}
+
 // Backward passes redone on the CPU because a sample overflowed a GPU thread's lists.
 std::atomic<long> backward_fallbacks{0};
 
@@ -246,6 +259,10 @@ PYBIND11_MODULE(_core, m) {
           py::arg("samples"), py::arg("mode"), py::arg("filter"), py::arg("filter_radius"), py::arg("seed"),
           py::arg("threads"), py::arg("background"), py::arg("boundary_density"), py::arg("device") = -1,
           py::arg("emulate_gpu_lists") = false);
+    m.def("filter_radius_grad", &filter_radius_grad,
+          "dL/d(filter radius) in Monte Carlo mode, given dL/d(premultiplied colour) per pixel",
+          py::arg("scene"), py::arg("g"), py::arg("width"), py::arg("height"), py::arg("samples"),
+          py::arg("filter"), py::arg("filter_radius"), py::arg("seed"), py::arg("threads"));
     m.def("layout", &layout,
           "The scene arrays' layout: enums (shape_kinds, draw_kinds, fill_rules, caps, joins, brush_kinds) "
           "and each table's row width (columns)");

@@ -10,9 +10,9 @@ argument orders and defaults (see README "Coming from diffvg"). What differs, an
   pixel with N the larger of the two. ``use_prefiltering=True`` is vecfit's analytical
   mode at one sample per pixel. The box filter always covers exactly the pixel (its
   radius is ignored); tent, parabolic and Hann filters use the radius (at least 0.5).
-- The filter radius's gradient is a central difference of two further renders with the
-  same samples (only when the radius requires grad): exact to O(h^2) in the analytical
-  mode, an unbiased estimate of that difference in Monte Carlo mode.
+- The filter radius's gradient (taken only when the radius requires grad): in Monte Carlo
+  mode the core's estimate from the image's own samples (one more pass over them); in
+  the analytical mode a central difference of two more renders.
 - ``RenderFunction.render_grad`` (the per-pixel translation gradient) is a central
   difference of the image over a small translation of the scene (five renders).
 - ``background_image`` is composited under the filtered image per pixel (diffvg does it

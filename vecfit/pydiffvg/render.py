@@ -12,7 +12,9 @@ import time
 
 import torch
 
+from vecfit import _core
 from vecfit.errors import VecfitError
+from vecfit.renderer.pack import pack_scene
 from vecfit.renderer.raster import render
 
 from . import device
@@ -84,29 +86,58 @@ def _difference(image, hi, lo, step):
 
 
 class _FilterRadius(torch.autograd.Function):
-    """Passes the image through; its backward adds the filter radius's dL/dr, from a
-    central difference of two more renders with the same samples (common random numbers),
-    see _difference. Steps: 0.2% of r in the analytical mode (a smooth function of r; a
-    large step would mix colours across an edge where alpha is near 0), 10% in Monte
-    Carlo mode (fewer samples cross an edge over a small step: a larger step has less
-    variance)."""
+    """Passes the image through; its backward adds the filter radius's dL/dr from
+    ``gradient(image, dL/d(image))``: _mc_radius_gradient or _analytic_radius_gradient."""
 
     @staticmethod
-    def forward(ctx, radius, image, render_at, step):
-        ctx.render_at, ctx.r, ctx.step = render_at, float(radius.detach()), step
+    def forward(ctx, radius, image, gradient):
+        ctx.gradient = gradient
         ctx.save_for_backward(image.detach())
         return image.clone()
 
     @staticmethod
     def backward(ctx, grad):
         (image,) = ctx.saved_tensors
-        r = ctx.r
-        h = max(1e-3, ctx.step * r)
-        hi_r, lo_r = r + h, max(0.5, r - h)  # the core never filters narrower than 0.5 px
         with torch.no_grad():
-            hi, lo = ctx.render_at(hi_r), ctx.render_at(lo_r)
-            d_r = (grad * _difference(image, hi, lo, hi_r - lo_r)).sum()
-        return d_r.reshape(()), grad, None, None
+            d_r = torch.tensor(float(ctx.gradient(image, grad.detach())), dtype=torch.float32)
+        return d_r, grad, None
+
+
+def _premultiplied_adjoint(image, grad):
+    """dL/d(premultiplied RGBA) from dL/d(straight RGBA) of a straight image (no
+    background: the adapter composites background images after the render)."""
+    alpha, rgb = image[..., 3:], image[..., :3]
+    safe = torch.where(alpha > 0, alpha, torch.ones_like(alpha))
+    g_rgb = torch.where(alpha > 0, grad[..., :3] / safe, torch.zeros_like(rgb))
+    g_a = grad[..., 3:] - (g_rgb * rgb).sum(dim=-1, keepdim=True)
+    return torch.cat([g_rgb, g_a], dim=-1)
+
+
+def _mc_radius_gradient(scene, width, height, settings):
+    """Monte Carlo mode: the core's estimate with the image's own samples (the radius
+    derivative of the filtered integral, see filter_radius_kernel in csrc/common/sampling.h;
+    one more pass over the samples, on the CPU)."""
+    def gradient(image, grad):
+        arrays = pack_scene(scene, width, height).arrays()
+        core_scene = {k: (v.detach().cpu().float().numpy() if isinstance(v, torch.Tensor) else v)
+                      for k, v in arrays.items()}
+        g = _premultiplied_adjoint(image.cpu(), grad.cpu()).contiguous().numpy()
+        return _core.filter_radius_grad(core_scene, g, width, height, settings["samples"], settings["filter"],
+                                        settings["filter_radius"], settings["seed"], 0)
+    return gradient
+
+
+def _analytic_radius_gradient(render_at, r):
+    """Analytical mode (a smooth function of r, whose kernel the core does not
+    differentiate): a central difference of two more renders, 0.2% of r each way (a
+    larger step would mix colours across an edge where alpha is near 0; see
+    _difference)."""
+    def gradient(image, grad):
+        h = max(1e-3, 0.002 * r)
+        hi_r, lo_r = r + h, max(0.5, r - h)  # the core never filters narrower than 0.5 px
+        hi, lo = render_at(hi_r), render_at(lo_r)
+        return (grad * _difference(image, hi, lo, hi_r - lo_r)).sum()
+    return gradient
 
 
 def _translated(args: list, step: torch.Tensor) -> list:
@@ -193,7 +224,12 @@ class RenderFunction:
         image = render_at(r)
         if (isinstance(radius, torch.Tensor) and radius.requires_grad and torch.is_grad_enabled()
                 and ftype != FilterType.box):
-            image = _FilterRadius.apply(radius, image, render_at, 0.002 if parsed.use_prefiltering else 0.1)
+            if parsed.use_prefiltering:
+                gradient = _analytic_radius_gradient(render_at, r)
+            else:
+                gradient = _mc_radius_gradient(scene, int(width), int(height),
+                                               dict(options, filter_radius=r))
+            image = _FilterRadius.apply(radius, image, gradient)
         if background_image is not None:
             image = _merge(image, background_image.to(image.device, torch.float32))
         if _print_timing:
