@@ -433,3 +433,15 @@ def test_from_svg_path():
     assert torch.allclose(first.points[0], torch.tensor([21.0, 20.0]))
     assert first.points.shape == (5, 2)  # closed: the last line wraps to points[0]
     assert not second.is_closed and second.points.shape == (2, 2)
+
+
+def test_imwrite_gamma_and_channels(tmp_path):
+    from PIL import Image
+    img = torch.full((2, 3, 4), 0.5)
+    pydiffvg.imwrite(img, tmp_path / "sub" / "a.png")  # folders are made
+    with Image.open(tmp_path / "sub" / "a.png") as im:
+        px = im.convert("RGBA").getpixel((0, 0))
+    assert px[:3] == (186, 186, 186) and px[3] == 128  # 0.5 ** (1 / 2.2) = 0.7297; alpha as is
+    pydiffvg.imwrite(torch.tensor([[0.0, 1.0]]), tmp_path / "g.png", gamma=1.0)  # H x W: grey
+    with Image.open(tmp_path / "g.png") as im:
+        assert im.mode == "RGB" and im.getpixel((1, 0)) == (255, 255, 255)

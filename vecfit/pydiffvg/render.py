@@ -19,8 +19,8 @@ from vecfit.renderer.raster import render
 
 from . import device
 from .convert import Parsed, to_scene
-from .sdf import sdf_at, sdf_image
 from .enums import FILTER_NAMES, ColorType, FilterType, OutputType, ShapeType
+from .sdf import sdf_at, sdf_image
 from .shapes import Circle, Ellipse, LinearGradient, Path, PixelFilter, Polygon, RadialGradient, Rect
 
 _print_timing = False
