@@ -321,6 +321,36 @@ def test_sdf_at_eval_positions():
     close(p.grad, [[1.0, 0.0]], 1e-3)
 
 
+def test_colour_at_eval_positions():
+    """Colour output at eval_positions: N x 4 straight RGBA at the points, and a linear
+    gradient's end point fitted to the colours at 6 points comes back (0.05 px)."""
+    pos = torch.tensor([[4.0, 10.0], [12.0, 5.0], [20.0, 15.0], [28.0, 8.0], [36.0, 12.0], [20.0, 30.0]])
+    stops = torch.tensor([[1.0, 0.0, 0.0, 1.0], [0.0, 0.0, 1.0, 1.0]])
+
+    def colours(begin, end):
+        shapes = [pydiffvg.Rect(torch.tensor([0.0, 0.0]), torch.tensor([40.0, 20.0])),
+                  pydiffvg.Circle(torch.tensor(5.0), torch.tensor([20.0, 30.0]))]
+        groups = [pydiffvg.ShapeGroup(torch.tensor([0]), pydiffvg.LinearGradient(begin, end, torch.tensor([0.0, 1.0]),
+                                                                                  stops)),
+                  pydiffvg.ShapeGroup(torch.tensor([1]), torch.tensor([0.0, 1.0, 0.0, 0.5]))]
+        args = pydiffvg.RenderFunction.serialize_scene(S, S, shapes, groups, eval_positions=pos)
+        return pydiffvg.RenderFunction.apply(S, S, 2, 2, 0, None, *args)
+
+    target = colours(torch.tensor([2.0, 0.0]), torch.tensor([38.0, 6.0]))
+    assert target.shape == (6, 4)
+    close(target[5], [0.0, 1.0, 0.0, 0.5], 1e-6)  # the circle's centre
+    t = ((pos[0] - torch.tensor([2.0, 0.0])) @ torch.tensor([36.0, 6.0])) / (36.0 ** 2 + 6.0 ** 2)
+    close(target[0], (1 - t) * stops[0] + t * stops[1], 1e-5)
+    # (begin can slide across the gradient's direction without changing any colour: fit end)
+    end = torch.tensor([34.0, 3.0], requires_grad=True)
+    opt = torch.optim.Adam([end], lr=0.5)
+    for _ in range(150):
+        opt.zero_grad()
+        ((colours(torch.tensor([2.0, 0.0]), end) - target) ** 2).sum().backward()
+        opt.step()
+    close(end.detach(), [38.0, 6.0], 0.05)
+
+
 # ------------------------------------------------------------------ render_grad
 
 @pytest.mark.parametrize("prefiltering", [True, False])

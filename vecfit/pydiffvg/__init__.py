@@ -23,7 +23,9 @@ argument orders and defaults (see README "Coming from diffvg"). What differs, an
   to the nearest boundary of any group's fill or stroke, negative inside one, in canvas
   units, from vecfit's analytical coverage (see pydiffvg.sdf); ``eval_positions`` takes
   one small render per point (hundreds of points, not millions).
-- Not yet: ``eval_positions`` with colour output (it raises VecfitError).
+- Colour output at ``eval_positions`` (N x 4) is the colour at each point itself (a
+  1 x 1 analytical render of the scene magnified 1000 times about it; see
+  pydiffvg.points); ``background_image`` does not apply there.
 """
 from __future__ import annotations
 

@@ -20,6 +20,7 @@ from vecfit.renderer.raster import render
 from . import device
 from .convert import Parsed, to_scene
 from .enums import FILTER_NAMES, ColorType, FilterType, OutputType, ShapeType
+from .points import colors_at
 from .sdf import sdf_at, sdf_image
 from .shapes import Circle, Ellipse, LinearGradient, Path, PixelFilter, Polygon, RadialGradient, Rect
 
@@ -207,7 +208,10 @@ class RenderFunction:
                 print(f"pydiffvg (vecfit): sdf {time.perf_counter() - start:.4f} s")
             return out.to(device.get_device())
         if has_positions:
-            raise VecfitError("pydiffvg on vecfit evaluates eval_positions for OutputType.sdf only")
+            out = colors_at(parsed, positions, device.render_device())
+            if _print_timing:
+                print(f"pydiffvg (vecfit): colours at points {time.perf_counter() - start:.4f} s")
+            return out.to(device.get_device())
         scene = to_scene(parsed)
         ftype = FilterType(int(parsed.filter_type))
         radius = parsed.filter_radius
