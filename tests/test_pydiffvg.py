@@ -4,7 +4,7 @@ only (as diffvg's own tests and the projects built on it use it).
 Each feature: render a target, perturb the parameters, optimise them back with Adam on
 the L2 image loss, and assert that they come back; the tolerance is stated per test (in
 pixels for geometry, in colour units for colours). Images are 24-40 px, 2 x 2 samples,
-at most 200 iterations: the whole file takes about 40 s on 2 cores.
+at most 200 iterations: the whole file takes about 50 s on 2 cores.
 """
 from __future__ import annotations
 

@@ -85,3 +85,13 @@ def test_ellipse_and_rect_position_survive(tmp_path):
     assert isinstance(rect, pydiffvg.Rect)
     assert rect.p_min.tolist() == [20, 15] and rect.p_max.tolist() == [30, 20]
     assert torch.allclose(groups[0].fill_color, torch.tensor([1.0, 0, 0, 1]))
+
+
+def test_save_svg_background(tmp_path):
+    shapes = [pydiffvg.Circle(torch.tensor(4.0), torch.tensor([10.0, 10.0]))]
+    groups = [pydiffvg.ShapeGroup(torch.tensor([0]), torch.tensor([0.0, 0.0, 1.0, 1.0]))]
+    pydiffvg.save_svg(tmp_path / "b.svg", 20, 20, shapes, groups, background=torch.tensor([1.0, 1.0, 0.0]))
+    w, h, shapes2, groups2 = pydiffvg.svg_to_scene(tmp_path / "b.svg")
+    assert len(groups2) == 2 and torch.allclose(groups2[0].fill_color, torch.tensor([1.0, 1.0, 0.0, 1.0]))
+    image = draw(w, h, shapes2, groups2)
+    assert float(image[..., 3].min()) == 1.0

@@ -261,10 +261,19 @@ class _Defs:
         return f"url(#{gid})", 1.0
 
 
-def save_svg(filename, width, height, shapes, shape_groups, use_gamma=False):
+def save_svg(filename, width, height, shapes, shape_groups, use_gamma=False, background=None):
     """Write shapes and groups as an SVG that vecfit (and any SVG viewer) draws as
-    pydiffvg renders them; written atomically. ``use_gamma``: colours raised to 1/2.2."""
+    pydiffvg renders them; written atomically. ``use_gamma``: colours raised to 1/2.2.
+    ``background`` (as later diffvg versions take it): an RGB or RGBA colour, written as a
+    rect under everything."""
     defs, body = _Defs(use_gamma), []
+    if background is not None:
+        rgba = finite(background).reshape(-1)
+        value, opacity = _color(np.concatenate([rgba, [1.0]]) if rgba.size == 3 else rgba, use_gamma)
+        attrs = {"x": "0", "y": "0", "width": _num(width), "height": _num(height), "fill": value}
+        if opacity < 1:
+            attrs["fill-opacity"] = _num(opacity)
+        body.append(f"  <rect {_attrs(attrs)}/>")
     for group in shape_groups:
         members = [shapes[int(i)] for i in finite(group.shape_ids).reshape(-1)]
         if not members or (group.fill_color is None and group.stroke_color is None):
