@@ -56,7 +56,9 @@ int parse_filter(const std::string& f) {
     if (f == "box") return 0;
     if (f == "tent") return 1;
     if (f == "gaussian") return 2;
-    throw std::invalid_argument("filter must be 'box', 'tent' or 'gaussian', not '" + f + "'");
+    if (f == "parabolic") return 3;
+    if (f == "hann") return 4;
+    throw std::invalid_argument("filter must be 'box', 'tent', 'gaussian', 'parabolic' or 'hann', not '" + f + "'");
 }
 
 // The scene's arrays, kept alive for the duration of a call.
@@ -172,6 +174,19 @@ py::dict grads_dict(const SceneGrads& g) {
     r["stop_colors"] = out(g.stop_colors, STOP_COLOR_COLS);
     r["layer_opacity"] = out(g.layer_opacity, 1);
     return r;
+}
+
+// dL/d(filter radius), Monte Carlo mode: g is dL/d(the filtered premultiplied colour of
+// each pixel, background excluded), height x width x 4. On the CPU.
+double filter_radius_grad(const py::dict& scene, Array<float> g, int width, int height, int samples,
+                          const std::string& filter, double filter_radius, uint64_t seed, int threads) {
+    SceneInput in = scene_input(scene);
+    SceneArrays a = in.arrays();
+    RenderOptions o = render_options(width, height, samples, "mc", filter, filter_radius, seed, threads, py::none());
+    if (g.size() != (py::ssize_t)width * height * 4) throw std::invalid_argument("g must be height x width x 4");
+    py::gil_scoped_release release;
+    PreparedScene prepared = timed_prepare(a);
+    return filter_radius_gradient(prepared, o, g.data());
 }
 
 // Backward passes redone on the CPU because a sample overflowed a GPU thread's lists.
@@ -339,6 +354,10 @@ PYBIND11_MODULE(_core, m) {
           py::arg("scenes"), py::arg("images"), py::arg("d_images"), py::arg("width"), py::arg("height"),
           py::arg("samples"), py::arg("mode"), py::arg("filter"), py::arg("filter_radius"), py::arg("seeds"),
           py::arg("threads"), py::arg("background"), py::arg("boundary_density"), py::arg("interior_samples") = 0);
+    m.def("filter_radius_grad", &filter_radius_grad,
+          "dL/d(filter radius) in Monte Carlo mode, given dL/d(premultiplied colour) per pixel",
+          py::arg("scene"), py::arg("g"), py::arg("width"), py::arg("height"), py::arg("samples"),
+          py::arg("filter"), py::arg("filter_radius"), py::arg("seed"), py::arg("threads"));
     m.def("layout", &layout,
           "The scene arrays' layout: enums (shape_kinds, draw_kinds, fill_rules, caps, joins, brush_kinds) "
           "and each table's row width (columns)");

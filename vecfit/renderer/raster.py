@@ -18,7 +18,7 @@ from .scene import Scene
 from .stopwatch import add_core_phases, phase
 
 MODES = ("mc", "analytic")
-FILTERS = ("box", "tent", "gaussian")
+FILTERS = ("box", "tent", "gaussian", "parabolic", "hann")
 MAX_PIXELS = 64_000_000  # a float RGBA image of that size already takes 1 GB
 
 
