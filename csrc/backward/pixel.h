@@ -132,15 +132,16 @@ VF_HD void boundary_sample(const SceneView& sc, const TileView& bins, const Boun
     // Just inside a stroke piece is inside the stroke by construction (within w/2 of the
     // curve along its normal); fills need both sides for orientation.
     bool fill_piece = pc.kind == Piece::FILL_SEGMENT || (pc.kind == Piece::ELLIPSE && pc.side == 0);
-    bool in_minus = !fill_piece || draw_covers_at(sc, bins, bs.draw, p - EPS_NORMAL * bs.n);
-    bool in_plus = draw_covers_at(sc, bins, bs.draw, p + EPS_NORMAL * bs.n);
+    auto off = [&](double e) { return Vec2{mul_add_rn(p.x, e, bs.n.x), mul_add_rn(p.y, e, bs.n.y)}; };
+    bool in_minus = !fill_piece || draw_covers_at(sc, bins, bs.draw, off(-EPS_NORMAL));
+    bool in_plus = draw_covers_at(sc, bins, bs.draw, off(EPS_NORMAL));
     if (pc.kind == Piece::FILL_SEGMENT && !in_minus && in_plus) {
         bs.n = -bs.n;  // the segment runs the other way round
         for (int i = 0; i < bs.nv; ++i) bs.v[i].value = -bs.v[i].value;
         vswap(in_minus, in_plus);
     }
     if (!in_minus || in_plus) return;  // no change of coverage across p
-    Vec2 outside = p + EPS_NORMAL * bs.n;
+    Vec2 outside = off(EPS_NORMAL);  // (after the flip above)
     double delta[4];
     if (bc.no_layers) {
         jump_without_layers(sc, bins, outside, bs.draw, delta);
@@ -153,14 +154,20 @@ VF_HD void boundary_sample(const SceneView& sc, const TileView& bins, const Boun
         for (int i = 0; i < 4; ++i) delta[i] = c_in[i] - c_out[i];
     }
     if (delta[0] == 0 && delta[1] == 0 && delta[2] == 0 && delta[3] == 0) return;
-    int x0 = vmax(0, (int)std::floor(p.x - R)), x1 = vmin(W - 1, (int)std::floor(p.x + R));
-    int y0 = vmax(0, (int)std::floor(p.y - R)), y1 = vmin(H - 1, (int)std::floor(p.y + R));
+    // The change is at p+ (`outside`, where moving the boundary outwards changes the
+    // scene), so the pixels whose half-open support holds p+ see it: one of two pixels
+    // beside a line, none where p+ is off the canvas (an edge on the canvas border facing
+    // out). Deciding at p+, EPS_NORMAL from p, keeps rounding out of it: p on a pixel line
+    // or the border (integer coordinates, a canvas-sized rect) is one rounding of seg_eval
+    // from either side, and nvcc's contracted multiply-adds round differently from the
+    // host's.
+    int x0 = vmax(0, (int)std::floor(outside.x - R)), x1 = vmin(W - 1, (int)std::floor(outside.x + R));
+    int y0 = vmax(0, (int)std::floor(outside.y - R)), y1 = vmin(H - 1, (int)std::floor(outside.y + R));
     double total = 0;
     for (int py = y0; py <= y1; ++py)
         for (int px = x0; px <= x1; ++px) {
-            // Half-open support, as a pixel's samples are: a point on the line between two
-            // pixels belongs to one of them, not both.
-            double dx = p.x - (px + 0.5), dy = p.y - (py + 0.5);
+            // Half-open support, as a pixel's samples are: a point belongs to one pixel of two.
+            double dx = outside.x - (px + 0.5), dy = outside.y - (py + 0.5);
             if (dx < -R || dx >= R || dy < -R || dy >= R) continue;
             double w = filter_weight(bc.filter, R, dx, dy) / bc.filter_integral;
             const double* gp = bc.gpix + 4 * ((size_t)py * W + px);
