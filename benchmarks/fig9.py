@@ -17,7 +17,7 @@ import numpy as np
 from common import SCENES
 
 import vecfit
-from vecfit.renderer.fig9 import fig9, weighting
+from vecfit.renderer.fig9 import fig9, mean_derivative, weighting
 
 
 def main():
@@ -28,6 +28,9 @@ def main():
     ap.add_argument("--step", type=float, default=0.5)
     ap.add_argument("--size", type=int, default=0)
     ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--small-step", type=float, default=0.01, help="analytical: a second check at this step")
+    ap.add_argument("--points", type=int, default=16,
+                    help="analytical: the +-step difference against the mean autograd derivative at this many points")
     args = ap.parse_args()
     print(f"| scene, mode | weighting 0 | weighting 1 |  (step {args.step} px)")
     print("|---|---|---|")
@@ -52,6 +55,24 @@ def main():
                 cells = " | ".join(f"{100 * r:.1f}% ({a:.4g} vs {f:.4g})" for r, a, f in zip(rel, ad, fd))
                 label = f"MC {samples}x{samples}, {n} seeds" if mode == "mc" else "analytical 1x1"
                 print(f"| {name} {w}x{h}, {label} | {cells} |", flush=True)
+            if mode == "analytic":
+                # The analytical image curves within +-0.5 px (the kernel's support is one
+                # pixel wide): the derivative at 0 against a small step, and the wide
+                # step against the mean derivative over it.
+                small = np.array(fig9(scene, w, h, weights, step=args.small_step, mode=mode, samples=1,
+                                      threads=args.threads))
+                ad, fd = small.T
+                rel = np.abs(ad - fd) / np.abs(fd)
+                cells = " | ".join(f"{100 * r:.1f}% ({a:.4g} vs {f:.4g})" for r, a, f in zip(rel, ad, fd))
+                print(f"| {name} {w}x{h}, analytical 1x1, step {args.small_step} | {cells} |", flush=True)
+                if args.points:
+                    mean = np.array(mean_derivative(scene, w, h, weights, step=args.step, points=args.points,
+                                                    mode=mode, samples=1, threads=args.threads))
+                    fd = runs[0, :, 1]
+                    rel = np.abs(mean - fd) / np.abs(fd)
+                    cells = " | ".join(f"{100 * r:.1f}% ({a:.4g} vs {f:.4g})" for r, a, f in zip(rel, mean, fd))
+                    print(f"| {name} {w}x{h}, analytical 1x1, mean autograd over +-{args.step} "
+                          f"({args.points} points) | {cells} |", flush=True)
 
 
 if __name__ == "__main__":

@@ -48,20 +48,32 @@ def shifted(scene: Scene, dx: torch.Tensor, keep=None) -> Scene:
     return out
 
 
-def loss(scene, W, width, height, dx, **kw):
-    image = render(shifted(scene, dx, kw.pop("keep", None)), width, height, **kw)
+def weighted(image: torch.Tensor, W: torch.Tensor) -> torch.Tensor:
     return (image.double() * W.double()).sum()  # (a float32 sum's rounding shows in small steps)
 
 
-def fig9(scene: Scene, width: int, height: int, weights, step: float = 0.5, **kw):
-    """[(autograd, central difference)] per weighting for dL/d delta; kw go to render
-    (mode, samples, seed, ...; keep= selects shapes)."""
-    out = []
-    for W in weights:
-        dx = torch.tensor(0.0, requires_grad=True)
-        loss(scene, W, width, height, dx, **dict(kw)).backward()
-        with torch.no_grad():
-            plus = loss(scene, W, width, height, torch.tensor(step), **dict(kw))
-            minus = loss(scene, W, width, height, torch.tensor(-step), **dict(kw))
-        out.append((dx.grad.item(), float(plus - minus) / (2 * step)))
-    return out
+def fig9(scene: Scene, width: int, height: int, weights, step: float = 0.5, keep=None, **kw):
+    """[(autograd, central difference)] of dL/d delta for each weighting W (one render
+    and one backward pass per W for autograd, two renders for the differences); kw go to
+    render (mode, samples, seed, ...); keep(i, shape) selects shapes."""
+    dx = torch.tensor(0.0, requires_grad=True)
+    image = render(shifted(scene, dx, keep), width, height, **kw)
+    ads = [torch.autograd.grad(weighted(image, W), dx, retain_graph=True)[0].item() for W in weights]
+    with torch.no_grad():
+        plus = render(shifted(scene, torch.tensor(step), keep), width, height, **kw)
+        minus = render(shifted(scene, torch.tensor(-step), keep), width, height, **kw)
+    return [(ad, float(weighted(plus, W) - weighted(minus, W)) / (2 * step)) for ad, W in zip(ads, weights)]
+
+
+def mean_derivative(scene: Scene, width: int, height: int, weights, step: float = 0.5, points: int = 16, **kw):
+    """Per weighting, the mean of the autograd derivative at `points` midpoints of
+    [-step, step]: what the central difference over +-step equals when L is continuous
+    (it is the mean of L' over the interval), to check autograd with a wide step where L
+    curves within it."""
+    total = [0.0] * len(weights)
+    for k in range(points):
+        dx = torch.tensor(-step + (k + 0.5) * 2 * step / points, requires_grad=True)
+        image = render(shifted(scene, dx), width, height, **kw)
+        for i, W in enumerate(weights):
+            total[i] += torch.autograd.grad(weighted(image, W), dx, retain_graph=True)[0].item() / points
+    return total
