@@ -12,11 +12,13 @@ any small step). Tolerance 3%, the issue's: the remaining error is the kinks of 
 prefiltered image (thin strokes' centre lines, medial axes of slivers), which make L' vary
 by a few % within 0.01 px.
 
-Monte Carlo 4x4 at +-0.5 px, mean of 3 seeds: tiger 3.9% / 7.9%, mcseem2 1.0% / 2.7%
-(measured with these seeds). The estimate is unbiased, its error falls like 1/sqrt(seeds)
-(tiger: 14% / 34% with 1 seed, 3.5% / 7% with 4, 1.6% / 3.3% with 16: benchmarks/fig9.py),
-so the tolerance, 12%, is about 1.5x the error of 3 seeds on the worse weighting.
-Cost: about 25 s in all.
+Monte Carlo 4x4 at +-0.5 px, mean of 3 seeds: tiger 0.4% / 8.3%, mcseem2 3.2% / 7.2%
+(these seeds). The estimate is unbiased, its error falls like 1/sqrt(seeds) (tiger: 14% /
+34% with 1 seed, 3.5% / 7.2% with 4, 1.6% / 3.3% with 16: benchmarks/fig9.py), so the
+tolerance, 12%, is about 1.5x the error of 3 seeds on the worse weighting. (mcseem2 keeps
+2-5% at 16 seeds: its edges lie on pixel lines, where the image has a kink; the boundary
+term takes the derivative towards +x, central differences the mean of both sides.)
+Cost: about 30 s in all.
 """
 from __future__ import annotations
 
