@@ -116,10 +116,10 @@ def join_polygon_sd(poly, q):
 def join_sd(v, t_in, t_out, kind, hw, q, miter_limit=4.0):
     if kind == "round":
         return (q - v).norm(dim=-1) - hw
-    s = 1.0 if float(cross(t_in, t_out)) >= 0 else -1.0
+    s = 1.0 if float(cross(t_in, t_out).detach()) >= 0 else -1.0
     n_in, n_out = -s * perp(t_in), -s * perp(t_out)
     cos_half = (0.5 * (1 + (t_in * t_out).sum())).clamp(min=0).sqrt()
-    if kind == "miter" and 1 / float(cos_half) <= miter_limit:
+    if kind == "miter" and 1 / float(cos_half.detach()) <= miter_limit:
         poly = [v, v + hw * n_in, v + (hw / cos_half) * unit(n_in + n_out), v + hw * n_out]
     else:
         poly = [v, v + hw * n_in, v + hw * n_out]
