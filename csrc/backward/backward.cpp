@@ -24,7 +24,16 @@ void pixel_adjoints(const RenderOptions& o, const float* image, const float* d_i
         const float* s = image + 4 * p;
         const float* ds = d_image + 4 * p;
         double a = s[3];
-        if (a <= 0) continue;  // straight colour undefined: no gradient
+        if (a <= 0) {
+            // An empty pixel: its straight colour jumps from 0 to the colour of whatever
+            // comes to cover it (no derivative), but its alpha is the premultiplied alpha
+            // (background empty too), so a boundary moving into it still has a gradient
+            // through alpha. (Skipping such pixels gave a shape's edge lying exactly on a
+            // pixel line no gradient towards the empty side: the boundary sample there
+            // lands in the empty pixel.)
+            g[4 * (size_t)p + 3] = ds[3];
+            continue;
+        }
         double gc[4];
         double sum = 0;
         for (int i = 0; i < 3; ++i) {
