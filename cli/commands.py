@@ -318,6 +318,26 @@ def paint(target, paths, kind, preset, frames, output, report, comparison, confi
              lambda bar: run_paint(target, config, outputs, progress=bar, frames=frames))
 
 
+@main.command()
+@click.argument("init_svg", type=click.Path(dir_okay=False))
+@click.argument("edited", type=click.Path(dir_okay=False))
+@click.option("--mask", type=click.Path(dir_okay=False),
+              help="PNG of EDITED's size, white where the edit is (default: where EDITED differs "
+                   "from INIT_SVG's render).")
+@optimize_options
+def edit(init_svg, edited, mask, output, report, comparison, config_file, quiet, **options):
+    """Bring an edit made on INIT_SVG's render (EDITED, a PNG) into the SVG: its own
+    parameters are fitted to EDITED, changing as little as possible outside the edit.
+    Writes NAME.vecfit.svg (elements, ids and groups kept), a report and a comparison
+    picture (original | edited | result | difference)."""
+    from vecfit.jobs.edit import run as run_edit
+    from vecfit.jobs.fit import Outputs
+
+    config = _resolve_config("edit", None, config_file, options)
+    outputs = Outputs.beside(Path(edited), output, report, comparison)
+    _run_job("edit", config["optimize"]["iterations"], quiet,
+             lambda bar: run_edit(edited, init_svg, config, outputs, progress=bar, mask=mask))
+
 
 # ------------------------------------------------------------------------------ batch
 

@@ -69,6 +69,25 @@ def pyramid(a: torch.Tensor, b: torch.Tensor, levels: int = 4) -> torch.Tensor:
     return total
 
 
+def weighted_l2(a: torch.Tensor, b: torch.Tensor, weight: torch.Tensor) -> torch.Tensor:
+    """L2 with a per-pixel weight ([H, W]): the mean of weight x squared difference."""
+    return torch.mean(weight[..., None] * (a - b) ** 2)
+
+
+def weighted_l1(a: torch.Tensor, b: torch.Tensor, weight: torch.Tensor) -> torch.Tensor:
+    return torch.mean(weight[..., None] * torch.abs(a - b))
+
+
+def weighted(name: str):
+    """The loss ``name`` with a per-pixel weight: l2 and l1 (a weight has no plain meaning
+    for SSIM's windows or the pyramid's pooled levels)."""
+    table = {"l2": weighted_l2, "l1": weighted_l1}
+    if name not in table:
+        get(name)  # an unknown name is refused as such
+        raise VecfitError(f"loss {name!r} takes no per-pixel weight; use l2 or l1")
+    return table[name]
+
+
 def get(name: str):
     table = {"l2": l2, "l1": l1, "ssim": ssim_loss, "pyramid": pyramid}
     if name not in table:

@@ -31,20 +31,29 @@ def error_map(result: np.ndarray, target: np.ndarray) -> np.ndarray:
 
 def comparison_image(target: np.ndarray, initial: np.ndarray, optimized: np.ndarray) -> np.ndarray:
     """Four panels side by side, RGB float: target, initial, optimised, error map."""
-    h, w = target.shape[:2]
+    return panels_image([target, initial, optimized, error_map(optimized, target)])
+
+
+def panels_image(images: list[np.ndarray]) -> np.ndarray:
+    """RGB float images side by side, each scaled to the first one's panel size (its
+    longest side at most PANEL_MAX), GAP white pixels between them."""
+    h, w = images[0].shape[:2]
     scale = min(1.0, PANEL_MAX / max(h, w))
     size = (max(1, round(w * scale)), max(1, round(h * scale)))
-    panels = [_panel(target, size), _panel(initial, size), _panel(optimized, size),
-              _panel(error_map(optimized, target), size)]
     pw, ph = size
-    out = np.ones((ph, 4 * pw + 3 * GAP, 3), dtype=np.float32)
-    for i, p in enumerate(panels):
-        out[:, i * (pw + GAP):i * (pw + GAP) + pw] = p
+    out = np.ones((ph, len(images) * pw + (len(images) - 1) * GAP, 3), dtype=np.float32)
+    for i, image in enumerate(images):
+        out[:, i * (pw + GAP):i * (pw + GAP) + pw] = _panel(image, size)
     return out
 
 
 def save_comparison(path, target, initial, optimized) -> None:
-    pixels = to_uint8(comparison_image(target, initial, optimized))
+    save_panels(path, comparison_image(target, initial, optimized))
+
+
+def save_panels(path, image: np.ndarray) -> None:
+    """An RGB float picture (panels_image) as a PNG, atomically."""
+    pixels = to_uint8(image)
     atomic_write(path, lambda tmp: Image.fromarray(pixels, "RGB").save(tmp, format="PNG"))
 
 
