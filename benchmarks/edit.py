@@ -32,11 +32,13 @@ from vecfit.jobs.fit import Outputs
 sys.path.insert(0, str(ROOT / "tests"))
 from editing_cases import edited_svg, structure  # noqa: E402  (shared with the tests)
 
-# scene -> (render width, indices of the drawn elements recoloured, index moved, dx, dy)
+# scene -> (render width, indices of the drawn elements recoloured, index moved, dx, dy in
+# user units)
+# (the move is 3 px right and 2 px down at the render's size)
 CASES = {
-    "cat": (368, [(5, "#3b7dd8"), (20, "#e8c33a"), (33, "#45a35b")], 12, 3.0, 2.0),
-    "ice_cream": (700, [(10, "#8a2be2"), (40, "#ff7f50"), (90, "#2e8b57")], 60, 4.0, 0.0),
-    "tiger": (495, [(30, "#2060c0"), (120, "#30a050"), (200, "#c03070")], 150, 3.0, 3.0),
+    "cat": (368, [(5, "#3b7dd8"), (20, "#e8c33a"), (33, "#45a35b")], 12, 1.5, 1.0),
+    "ice_cream": (700, [(10, "#8a2be2"), (40, "#ff7f50"), (90, "#2e8b57")], 60, 6.0, 4.0),
+    "tiger": (495, [(30, "#2060c0"), (120, "#30a050"), (200, "#c03070")], 150, 3.0, 2.0),
 }
 
 

@@ -338,6 +338,27 @@ def edit(init_svg, edited, mask, output, report, comparison, config_file, quiet,
     _run_job("edit", config["optimize"]["iterations"], quiet,
              lambda bar: run_edit(edited, init_svg, config, outputs, progress=bar, mask=mask))
 
+@main.command()
+@click.argument("svg", type=click.Path(dir_okay=False))
+@click.option("--width", required=True, metavar="W|P%",
+              help="New width: pixels (120) or a percentage of the SVG's (70%).")
+@click.option("--height", metavar="H|P%", help="New height (default: unchanged).")
+@optimize_options
+def retarget(svg, width, height, output, report, comparison, config_file, quiet, **options):
+    """Content-aware resizing of SVG (seam carving brought into the vector file): seams of
+    least energy are carved out of its render in rounds, and its points are fitted to each
+    round's carved image. Writes NAME.vecfit.svg at the new size (every element, id and
+    group kept), a report and a comparison picture (input | plain scaling | retargeted)."""
+    from vecfit.jobs.fit import Outputs
+    from vecfit.jobs.retarget import run as run_retarget
+
+    config = _resolve_config("retarget", None, config_file, options)
+    outputs = Outputs.beside(Path(svg), output, report, comparison)
+    r = config["retarget"]
+    rounds = r["steps"] * (2 if height is not None else 1)
+    _run_job("retarget", rounds * r["iterations_per_step"] + r["final_iterations"], quiet,
+             lambda bar: run_retarget(svg, config, outputs, progress=bar, width=width, height=height))
+
 
 # ------------------------------------------------------------------------------ batch
 

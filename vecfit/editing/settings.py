@@ -12,7 +12,7 @@ from vecfit.errors import VecfitError
 class EditSettings:
     changed_weight: float = 10.0  # loss weight of a changed pixel (an unchanged one: 1)
     anchor: float = 100.0         # penalty on changing what acts only outside the changed region
-    anchor_free: float = 1.0      # ... and what acts inside it (see vecfit.fitting.anchor)
+    anchor_free: float = 100.0     # ... and what acts inside it (see vecfit.fitting.anchor)
     threshold: float = 0.1        # a pixel changed where a channel differs by more than this
     min_area: int = 4             # changed specks smaller than this (pixels) are no edit
     grow: int = 2                 # the changed region grown by this many pixels

@@ -97,7 +97,7 @@ class Target:
     """What the render is compared with: [H, W, 4] straight RGBA in [0, 1] at the size
     rendered, and the background to render over (None when the target is transparent).
     ``weight`` ([H, W], optional): how much each pixel counts in the loss (`vecfit edit`
-    weights the edited region); l2 and l1 only."""
+    weights the edited region); l2, l1 and pyramid only."""
     image: torch.Tensor
     background: Optional[tuple] = None
     weight: Optional[torch.Tensor] = None

@@ -47,6 +47,20 @@ def panels_image(images: list[np.ndarray]) -> np.ndarray:
     return out
 
 
+def side_by_side(images: list[np.ndarray]) -> np.ndarray:
+    """RGB float images of different sizes side by side at one scale (the tallest panel at
+    most PANEL_MAX high and the widest at most PANEL_MAX wide), top-aligned on white."""
+    scale = min(1.0, PANEL_MAX / max(max(i.shape[0], i.shape[1]) for i in images))
+    sizes = [(max(1, round(i.shape[1] * scale)), max(1, round(i.shape[0] * scale))) for i in images]
+    out = np.ones((max(h for _, h in sizes), sum(w for w, _ in sizes) + GAP * (len(images) - 1), 3),
+                  dtype=np.float32)
+    x = 0
+    for image, (w, h) in zip(images, sizes):
+        out[:h, x:x + w] = _panel(image, (w, h))
+        x += w + GAP
+    return out
+
+
 def save_comparison(path, target, initial, optimized) -> None:
     save_panels(path, comparison_image(target, initial, optimized))
 

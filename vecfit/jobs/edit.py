@@ -32,7 +32,7 @@ from .config import settings_of
 from .fit import Outputs, _render_full, background_for, load_target
 
 MOVED_PX = 0.1        # an element counts as changed when a length moved this many pixels
-RECOLOURED = 0.5 / 255  # ... or a colour channel changed this much
+RECOLOURED = 1.5 / 255  # ... or a colour channel more than a step of #rrggbb
 
 
 def fit_canvas(scene: Scene, image: np.ndarray, svg_path, image_path) -> None:
