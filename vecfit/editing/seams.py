@@ -9,6 +9,14 @@ import cv2
 import numpy as np
 
 
+def foreground(seen: np.ndarray, background: np.ndarray) -> np.ndarray:
+    """[H, W] in [0, 1]: how far each pixel is from the background (largest channel
+    difference). Vector art is flat: the inside of a shape has no more gradient energy
+    than the empty canvas around it, so without this the seams cut through shapes as
+    readily as through the background."""
+    return np.abs(np.asarray(seen, np.float32) - np.asarray(background, np.float32)).max(axis=2)
+
+
 def energy(image: np.ndarray) -> np.ndarray:
     """[H, W] gradient magnitude (|d/dx| + |d/dy|, Sobel, summed over the channels)."""
     a = np.asarray(image, np.float32)
@@ -46,16 +54,18 @@ def remove_seam(image: np.ndarray, seam: np.ndarray) -> np.ndarray:
     return image[keep].reshape(h, w - 1, *image.shape[2:])
 
 
-def carve(image: np.ndarray, count: int, seen=None) -> tuple[np.ndarray, list[np.ndarray]]:
+def carve(image: np.ndarray, count: int, seen=None, salience=None) -> tuple[np.ndarray, list[np.ndarray]]:
     """``image`` less ``count`` vertical seams, each found on what the previous left, and
     the seams (each in the columns of the image it was removed from). ``seen``: the image
-    whose energy decides (default ``image``), carved alongside it."""
+    whose energy decides (default ``image``); ``salience`` ([H, W]): added to the energy.
+    Both are carved alongside the image."""
     seen = image if seen is None else seen
+    salience = np.zeros(image.shape[:2], np.float32) if salience is None else salience
     seams = []
     for _ in range(count):
-        seam = vertical_seam(energy(seen))
+        seam = vertical_seam(energy(seen) + salience)
         seams.append(seam)
-        image, seen = remove_seam(image, seam), remove_seam(seen, seam)
+        image, seen, salience = (remove_seam(a, seam) for a in (image, seen, salience))
     return image, seams
 
 

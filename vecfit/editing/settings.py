@@ -38,6 +38,8 @@ class RetargetSettings:
     iterations_per_step: int = 40  # Adam iterations fitting each round's carved image
     final_iterations: int = 60     # more at the end, against the last carved image
     work_size: int = 512           # carve and fit at this longest side (0: the SVG's size)
+    foreground: float = 1.0        # seam energy added per pixel unlike the bare canvas
+
 
     def check(self) -> None:
         if self.steps < 1:
@@ -45,5 +47,7 @@ class RetargetSettings:
         for name in ("iterations_per_step", "final_iterations", "work_size"):
             if getattr(self, name) < 0:
                 raise VecfitError(f"retarget.{name} must be 0 or more, not {getattr(self, name)}")
+        if not (math.isfinite(self.foreground) and self.foreground >= 0):
+            raise VecfitError(f"retarget.foreground must be a number >= 0, not {self.foreground}")
         if 0 < self.work_size < 32:
             raise VecfitError(f"retarget.work_size must be 0 or at least 32, not {self.work_size}")

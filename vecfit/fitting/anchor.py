@@ -67,7 +67,10 @@ def acting_on(scene: Scene, region: np.ndarray, kinds: list[str], *, samples: in
         if isinstance(g, Path) and id(g.points) in out:
             free = out[id(g.points)].any(dim=1).numpy()
             if free.any():
-                grown = np.convolve(free.astype(int), np.ones(2 * NEIGHBOURS + 1, int), "same") > 0
+                grown = free.copy()
+                for k in range(1, min(NEIGHBOURS, len(free) - 1) + 1):
+                    grown[k:] |= free[:-k]
+                    grown[:-k] |= free[k:]
                 out[id(g.points)] = torch.from_numpy(grown)[:, None].expand(g.points.shape).clone()
     return out
 

@@ -23,7 +23,7 @@ import torch
 
 from vecfit import __version__
 from vecfit.editing.points import carve_points
-from vecfit.editing.seams import carve
+from vecfit.editing.seams import carve, foreground
 from vecfit.editing.settings import RetargetSettings
 from vecfit.errors import VecfitError
 from vecfit.fitting.loop import Settings, Target, optimize
@@ -103,9 +103,13 @@ def run(svg_path, config: dict, outputs: Outputs, progress=None, width=None, hei
     background = background_for(original, opt["background"])
     goal_w, goal_h = min(ww, max(1, round(new_w * s_x))), min(wh, max(1, round(new_h * s_y)))
     # Vertical seams first (width), then horizontal ones (height, on the transposed image).
-    carved_w, seams_w = carve(original, ww - goal_w, seen=seen(original, background))
-    _, seams_h = carve(carved_w.transpose(1, 0, 2), wh - goal_h,
-                              seen=seen(carved_w, background).transpose(1, 0, 2))
+    empty = seen(np.zeros((1, 1, 4), np.float32), background)[0, 0]  # the bare canvas
+    look = seen(original, background)
+    carved_w, seams_w = carve(original, ww - goal_w, seen=look,
+                              salience=retarget.foreground * foreground(look, empty))
+    look = seen(carved_w, background).transpose(1, 0, 2)
+    _, seams_h = carve(carved_w.transpose(1, 0, 2), wh - goal_h, seen=look,
+                       salience=retarget.foreground * foreground(look, empty))
     plan = [(0, chunk) for chunk in _rounds(len(seams_w), retarget.steps)]
     plan += [(1, chunk) for chunk in _rounds(len(seams_h), retarget.steps)]
 
