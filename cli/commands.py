@@ -366,13 +366,13 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
 @click.argument("in_dir", type=click.Path(exists=True, file_okay=False))
 @click.option("-o", "--out-dir", required=True, type=click.Path(file_okay=False),
               help="Folder for the outputs and the summary (not IN_DIR).")
-@click.option("--mode", required=True, type=click.Choice(["trace", "refine", "paint"]),
+@click.option("--mode", required=True, type=click.Choice(["trace", "refine", "paint", "edit"]),
               help="The command run on each image.")
 @click.option("--config", "config_file", type=click.Path(dir_okay=False),
               help="TOML file overriding the defaults in configs/.")
 @click.option("--preset", help="A preset of the mode's file in configs/.")
 @click.option("--init-dir", type=click.Path(exists=True, file_okay=False),
-              help="refine: the folder of the SVGs (default: IN_DIR).")
+              help="refine, edit: the folder of the SVGs (default: IN_DIR).")
 @click.option("-j", "--jobs", type=click.IntRange(min=0), default=1, show_default=True,
               help="Worker processes (0: one per core); 1 works in this process.")
 @click.option("--threads", type=click.IntRange(min=1),
@@ -387,11 +387,12 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar or per-image lines.")
 def batch(in_dir, out_dir, mode, config_file, preset, init_dir, jobs, threads, resume, scheduler,
           device, quiet):
-    """Run refine, trace or paint on every image in IN_DIR (*.png, *.jpg, *.jpeg, *.bmp,
-    *.tif, *.tiff, *.webp; not recursive), writing NAME.svg, NAME.report.json and
+    """Run refine, trace, paint or edit on every image in IN_DIR (*.png, *.jpg, *.jpeg,
+    *.bmp, *.tif, *.tiff, *.webp; not recursive), writing NAME.svg, NAME.report.json and
     NAME.compare.png per image, and summary.csv, summary.json and index.html (with
-    thumbs/) into OUT_DIR. For refine, each image is paired with the SVG of the same name
-    in IN_DIR (or --init-dir); an image without one is reported as unpaired. A failing
+    thumbs/) into OUT_DIR. For refine and edit, each image (for edit: the edited render)
+    is paired with the SVG of the same name in IN_DIR (or --init-dir); an image without
+    one is reported as unpaired. A failing
     image is recorded with its reason and the others go on.
 
     \b

@@ -224,3 +224,22 @@ def test_edit_config_is_checked():
         resolve("edit", overrides={"edit": {"anchr": 1.0}})
     with pytest.raises(Exception, match="changed_weight"):
         resolve("edit", overrides={"edit": {"changed_weight": 0.5}})
+
+
+def test_batch_edit_pairs_each_edited_image_with_its_svg(drawing, tmp_path):
+    folder = tmp_path / "in"
+    folder.mkdir()
+    (folder / "drawing.svg").write_text(DRAWING)
+    (folder / "drawing.png").write_bytes((drawing / "edited.png").read_bytes())
+    (folder / "lonely.png").write_bytes((drawing / "edited.png").read_bytes())
+    (tmp_path / "quick.toml").write_text("[optimize]\niterations = 30\nlr_warmup = 5\nthreads = 2\n")
+    r = run("batch", folder, "-o", tmp_path / "out", "--mode", "edit", "--config", tmp_path / "quick.toml", "-q")
+    assert r.exit_code == 1, r.output  # lonely.png has no SVG
+    rows = {row["file"]: row for row in json.loads((tmp_path / "out" / "summary.json").read_text())["images"]}
+    assert rows["lonely.png"]["status"] == "unpaired"
+    done = rows["drawing.png"]
+    assert done["status"] == "done" and done["psnr_after"] > done["psnr_before"] + 5
+    assert structure(tmp_path / "out" / "drawing.svg") == structure(folder / "drawing.svg")
+    r = run("batch", folder, "-o", tmp_path / "out", "--mode", "edit", "--config", tmp_path / "quick.toml", "-q")
+    rows = {row["file"]: row for row in json.loads((tmp_path / "out" / "summary.json").read_text())["images"]}
+    assert rows["drawing.png"]["status"] == "skipped (finished)"  # resumed
