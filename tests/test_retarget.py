@@ -157,3 +157,27 @@ def test_bad_input_is_one_clear_line(case, picture):
     lines = [line for line in r.output.splitlines() if line.strip()]
     assert len(lines) == 1 and lines[0].startswith("error:") and words in lines[0], r.output
     assert not (picture / "out.svg").exists()
+
+
+def test_ctrl_c_writes_the_best_result_so_far(picture):
+    """Interrupted in the second round: the SVG is written at that round's width, with
+    every element, and the report says so."""
+    from vecfit.jobs.config import resolve
+    from vecfit.jobs.fit import Outputs
+    from vecfit.jobs.retarget import run as retarget
+
+    calls = []
+
+    def stop(progress):
+        calls.append(progress)
+        if len(calls) == 20:
+            raise KeyboardInterrupt
+
+    config = resolve("retarget", config_file=picture / "fast.toml", overrides={"optimize": {"threads": 2}})
+    outputs = Outputs.beside(picture / "picture.svg", picture / "stopped.svg")
+    report = retarget(picture / "picture.svg", config, outputs, progress=stop, width="50%")
+    assert report["interrupted"] is True and report["iterations"] == 20
+    width = float(ET.parse(outputs.svg).getroot().get("width"))
+    assert 48 < width < 96  # one round of two done: between the input's and the goal's width
+    assert structure(outputs.svg) == structure(picture / "picture.svg")
+    assert json.loads(outputs.report.read_text())["interrupted"] is True
