@@ -12,14 +12,15 @@ from vecfit.errors import VecfitError
 class EditSettings:
     changed_weight: float = 10.0  # loss weight of a changed pixel (an unchanged one: 1)
     anchor: float = 100.0         # penalty on changing what acts only outside the changed region
-    anchor_free: float = 100.0     # ... and what acts inside it (see vecfit.fitting.anchor)
+    anchor_free: float = 10.0      # ... and lengths acting inside it (see vecfit.fitting.anchor)
+    anchor_free_colors: float = 100.0  # ... and colours acting inside it
     threshold: float = 0.1        # a pixel changed where a channel differs by more than this
     min_area: int = 4             # changed specks smaller than this (pixels) are no edit
     grow: int = 2                 # the changed region grown by this many pixels
     reach: int = 2                # elements acting this close to the changed region are free
 
     def check(self) -> None:
-        for name in ("changed_weight", "anchor", "anchor_free", "threshold"):
+        for name in ("changed_weight", "anchor", "anchor_free", "anchor_free_colors", "threshold"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0):
                 raise VecfitError(f"edit.{name} must be a number >= 0, not {value}")

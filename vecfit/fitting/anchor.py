@@ -76,27 +76,29 @@ def acting_on(scene: Scene, region: np.ndarray, kinds: list[str], *, samples: in
 
 
 def anchors(scene: Scene, free: dict[int, torch.Tensor], kinds: list[str], held: float, loose: float,
-            width: int, height: int, channels: int) -> Anchors:
+            loose_colors: float, width: int, height: int, channels: int) -> Anchors:
     """The penalty: per element, ``held`` (for one that does not act on the region) or
-    ``loose`` (one that does) x its squared change, lengths in pixels of the optimised
-    image (``width`` x ``height``), colours and offsets as they are; divided by the number
-    of values the loss averages (pixels x ``channels``), so a weight of 1 makes moving an
-    element by a pixel cost as much as one channel of one pixel wrong by 1.
+    ``loose`` / ``loose_colors`` (a length / a colour or offset that does) x its squared
+    change, lengths in pixels of the optimised image (``width`` x ``height``), colours and
+    offsets as they are; divided by the number of values the loss averages (pixels x
+    ``channels``), so a weight of 1 makes moving an element by a pixel cost as much as one
+    channel of one pixel wrong by 1.
 
-    ``loose`` is small: it only keeps an element that the image barely constrains (an
-    occluded control point, whose tiny gradient Adam would turn into full-rate steps)
-    from wandering."""
+    The loose weights are small: they only keep an element that the image barely
+    constrains (an occluded control point, a colour seen in a few pixels, whose tiny
+    gradient Adam would turn into full-rate steps) from wandering."""
     scales = learning_rate_scales(scene, width, height)  # units per pixel
     per_value = 1.0 / (width * height * channels)
     terms, n_free, n_held = [], 0, 0
     for kind in kinds:
+        length = kind in LENGTH_KINDS
         for t in scene.parameters()[kind]:
             acts = free.get(id(t), torch.zeros(t.shape, dtype=torch.bool))
             n_free += int(acts.sum())
             n_held += int((~acts).sum())
-            weight = torch.where(acts, loose, held) * per_value
+            weight = torch.where(acts, loose if length else loose_colors, held) * per_value
             if not bool((weight > 0).any()):
                 continue
-            unit = scales.get(id(t), 1.0) if kind in LENGTH_KINDS else 1.0
+            unit = scales.get(id(t), 1.0) if length else 1.0
             terms.append((t, t.detach().clone(), weight / unit ** 2))
     return Anchors(terms, n_free, n_held)

@@ -137,7 +137,7 @@ def run(edited_path, svg_path, config: dict, outputs: Outputs, progress=None, ma
     free = acting_on(scene, grown(region_small, reach), kinds, samples=settings.samples,
                      seed=settings.seed, threads=settings.threads, background=background,
                      device=opt["device"])
-    penalty = anchors(scene, free, kinds, edit.anchor, edit.anchor_free, sw, sh,
+    penalty = anchors(scene, free, kinds, edit.anchor, edit.anchor_free, edit.anchor_free_colors, sw, sh,
                       3 if background is not None else 4)
     before = {id(t): t.detach().clone() for k in kinds for t in scene.parameters()[k]}
 
