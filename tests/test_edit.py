@@ -19,7 +19,7 @@ from vecfit.fitting.loop import Settings, Target, optimize
 from vecfit.fitting.metrics import compare, to_rgb
 from vecfit.jobs.config import resolve
 from vecfit.renderer.raster import render
-from vecfit.renderer.scene import Circle, Scene, Shape, Solid
+from vecfit.renderer.scene import Circle, Path, Scene, Shape, Solid
 
 resvg_py = pytest.importorskip("resvg_py")
 
@@ -144,6 +144,11 @@ def test_acting_on_finds_the_parameters_that_change_the_region():
     for t in (right.geometry.center, right.geometry.radius, right.fill.color):
         assert not free[id(t)].any()
     assert not any(t.requires_grad for t in (left.geometry.center, right.fill.color))
+    # a path shorter than the neighbourhood grown around a free point (3 points)
+    triangle = Shape(Path(torch.tensor([[6.0, 10.0], [14.0, 10.0], [10.0, 18.0]]), np.array([1, 1, 1]),
+                          [(0, 3, True)]), fill=Solid(torch.tensor([0.1, 0.6, 0.1, 1.0])))
+    small = Scene(48.0, 32.0, [triangle])
+    assert acting_on(small, region, ["points"], threads=2)[id(triangle.geometry.points)].all()
     penalty = anchors(scene, free, ["points", "radii", "colors"], 100.0, 1.0, 100.0, 48, 32, 3)
     assert penalty.anchored == 2 + 1 + 4 and penalty.free == 2 + 1 + 4
     assert float(penalty()) == 0.0  # nothing moved yet
