@@ -10,13 +10,11 @@ Usage: python benchmarks/edit.py [--threads T] [--scenes cat,ice_cream,tiger]
 from __future__ import annotations
 
 import argparse
-import io
 import math
 import sys
 import tempfile
 import time
 import warnings
-import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np

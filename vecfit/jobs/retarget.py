@@ -23,7 +23,7 @@ import torch
 
 from vecfit import __version__
 from vecfit.editing.points import carve_points
-from vecfit.editing.seams import carve, foreground
+from vecfit.editing.seams import carve, foreground, remove_seam
 from vecfit.editing.settings import RetargetSettings
 from vecfit.errors import VecfitError
 from vecfit.fitting.loop import Settings, Target, optimize
@@ -36,8 +36,8 @@ from vecfit.svg.read import load_svg
 from vecfit.svg.write import write_svg
 
 from .config import settings_of
-from .fit import Outputs, background_for
 from .edit import seen
+from .fit import Outputs, background_for
 
 MIN_SIDE = 11
 _SIZE = re.compile(r"\s*(\d+(?:\.\d*)?|\.\d+)\s*(%|px)?\s*$")
@@ -122,11 +122,10 @@ def run(svg_path, config: dict, outputs: Outputs, progress=None, width=None, hei
         seams = (seams_w if axis == 0 else seams_h)[used[axis]:used[axis] + count]
         used[axis] += count
         carve_points(scene, seams, cur_w, cur_h, axis)
+        image = _apply(image, seams, axis)
         if axis == 0:
-            image = _apply(image, seams, axis)
             cur_w -= count
         else:
-            image = _apply(image, seams, axis)
             cur_h -= count
         scene.width, scene.height = cur_w / s_x, cur_h / s_y
         result = optimize(scene, Target(torch.from_numpy(np.ascontiguousarray(image)), background), loop,
@@ -194,7 +193,6 @@ def run(svg_path, config: dict, outputs: Outputs, progress=None, width=None, hei
 
 def _apply(image: np.ndarray, seams: list, axis: int) -> np.ndarray:
     """``image`` less ``seams`` (vertical for axis 0, horizontal for axis 1)."""
-    from vecfit.editing.seams import remove_seam
     if axis == 1:
         image = image.transpose(1, 0, 2)
     for seam in seams:
