@@ -7,7 +7,11 @@ face's width from eye to eye; the ice-cream truck's blue side, #1CA8E0) in resvg
 of the input and of the output; its width ratio (output / input) is 1.0 when the part is
 not squeezed and 0.70 under plain scaling (measured on the input's render resized).
 
+--squeeze-init: each round starts from the points squeezed uniformly to the round's width
+(plain scaling) instead of carried through its seams, to measure what that start is worth.
+
 Usage: python benchmarks/retarget.py [--threads T] [--scenes cat,ice_cream] [--width 70%]
+       [--work-size N] [--squeeze-init]
 """
 from __future__ import annotations
 
@@ -54,9 +58,34 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--scenes", default="cat,ice_cream")
     ap.add_argument("--width", default="70%")
+    ap.add_argument("--work-size", type=int)
+    ap.add_argument("--squeeze-init", action="store_true")
     args = ap.parse_args()
-    config = resolve("retarget", overrides={"optimize": {"threads": args.threads}})
-    print(f"retarget defaults: {config['retarget']}, {args.threads} threads, --width {args.width}")
+    overrides = {"optimize": {"threads": args.threads}}
+    if args.work_size is not None:
+        overrides["retarget"] = {"work_size": args.work_size}
+    config = resolve("retarget", overrides=overrides)
+    if args.squeeze_init:
+        import vecfit.jobs.retarget as job
+        from vecfit.editing.points import point_tensors
+        from vecfit.renderer.pack import Packer
+
+        def squeeze(scene, seams, width, height, axis=0):
+            """Plain scaling of the points about the canvas origin, in pixels."""
+            import torch
+            factor = (width if axis == 0 else height) - len(seams)
+            factor /= width if axis == 0 else height
+            with torch.no_grad():
+                for shape, m in zip(scene.shapes, Packer(scene, width, height).shape_matrices().double()):
+                    inverse = torch.linalg.inv(m)
+                    for t in point_tensors(shape):
+                        p = t.detach().double().reshape(-1, 2)
+                        px = p @ m[:2, :2].T + m[:2, 2]
+                        px[:, axis] *= factor
+                        t.copy_((px @ inverse[:2, :2].T + inverse[:2, 2]).reshape(t.shape).to(t.dtype))
+        job.carve_points = squeeze
+    print(f"retarget: {config['retarget']}, {args.threads} threads, --width {args.width}, "
+          f"start of each round: {'squeezed' if args.squeeze_init else 'carried through the seams'}")
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.scenes.split(","):
