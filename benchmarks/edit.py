@@ -9,6 +9,8 @@ Usage: python benchmarks/edit.py [--threads T] [--scenes cat,ice_cream,tiger]
 """
 from __future__ import annotations
 
+from common import ROOT, SCENES, resvg_rgb  # first: it sets the process up before torch loads
+
 import argparse
 import math
 import sys
@@ -19,8 +21,6 @@ from pathlib import Path
 
 import numpy as np
 from PIL import Image
-
-from common import ROOT, SCENES, resvg_rgb
 
 from vecfit.fitting.metrics import compare
 from vecfit.jobs.config import resolve

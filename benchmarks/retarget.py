@@ -15,6 +15,8 @@ Usage: python benchmarks/retarget.py [--threads T] [--scenes cat,ice_cream] [--w
 """
 from __future__ import annotations
 
+from common import SCENES  # first: it sets the process up before torch loads
+
 import argparse
 import io
 import tempfile
@@ -26,8 +28,6 @@ from pathlib import Path
 import cv2
 import numpy as np
 from PIL import Image
-
-from common import SCENES
 
 from vecfit.jobs.config import resolve
 from vecfit.jobs.fit import Outputs
