@@ -11,9 +11,10 @@ from __future__ import annotations
 import argparse
 import statistics
 
+from common import SHARED  # first: it sets up threads before torch loads
+
 import torch
 
-from common import SHARED
 
 import vecfit
 from vecfit import _core

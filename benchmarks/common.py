@@ -7,6 +7,10 @@ import time
 import warnings
 from pathlib import Path
 
+# Before torch loads (import this module first): idle OpenMP threads sleep, as the vecfit
+# command sets it (see vecfit/__init__.py); spinning they distort every timing here.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
 ROOT = Path(__file__).resolve().parents[1]
 # ../shared beside the repository, or where VECFIT_SHARED points (as for the tests)
 SHARED = Path(os.environ.get("VECFIT_SHARED") or ROOT.parent / "shared")
@@ -69,3 +73,22 @@ def scene_workload(name, mode, samples, threads, repeats, device="cpu"):
             p.grad = None
         return t1 - t0, t2 - t1
     return timed(run, repeats)
+
+
+def parse_sets(items) -> dict:
+    """--set optimize.mode=analytic -> {"optimize": {"mode": "analytic"}}"""
+    out: dict = {}
+    for item in items:
+        key, _, value = item.partition("=")
+        *path, last = key.split(".")
+        d = out
+        for p in path:
+            d = d.setdefault(p, {})
+        try:
+            d[last] = int(value)
+        except ValueError:
+            try:
+                d[last] = float(value)
+            except ValueError:
+                d[last] = value
+    return out

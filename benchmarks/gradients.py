@@ -12,10 +12,10 @@ import argparse
 import statistics
 import time
 
+from common import scene_workload, timed  # first: it sets up threads before torch loads
+
 import numpy as np
 import torch
-
-from common import scene_workload, timed
 
 import vecfit
 from vecfit.renderer.scene import Path, Scene, Shape, Solid

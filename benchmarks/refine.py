@@ -15,7 +15,7 @@ import tempfile
 import warnings
 from pathlib import Path
 
-from common import SHARED, resvg_rgb
+from common import SHARED, parse_sets, resvg_rgb
 
 from vecfit.io.colors import parse_background
 from vecfit.jobs.config import resolve
@@ -26,25 +26,6 @@ from vecfit.renderer.stopwatch import Stopwatch
 
 PHOTOS = SHARED / "data" / "photos"
 TARGETS = {"kitty": "kitty.jpg", "peppers": "peppers.png"}
-
-
-def parse_sets(items) -> dict:
-    """--set optimize.mode=analytic -> {"optimize": {"mode": "analytic"}}"""
-    out: dict = {}
-    for item in items:
-        key, _, value = item.partition("=")
-        *path, last = key.split(".")
-        d = out
-        for p in path:
-            d = d.setdefault(p, {})
-        try:
-            d[last] = int(value)
-        except ValueError:
-            try:
-                d[last] = float(value)
-            except ValueError:
-                d[last] = value
-    return out
 
 
 def main() -> None:

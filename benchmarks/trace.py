@@ -1,7 +1,7 @@
 """Tracing quality and speed: skimage's photographs traced at several path budgets.
 
     python benchmarks/trace.py [--budgets 250,500,1000,2000] [--images astronaut,...]
-                               [--overlap-check] [--refine 1000[,...]] [--iterations N]
+                               [--overlap-check] [--refine 1000[,...]] [--iterations N] [--set KEY=VALUE ...]
 
 For each image and path budget: the paths and segments written, the trace time, and the
 PSNR of the trace rendered by vecfit (MC 2x2, box filter, over white) against the image
@@ -69,10 +69,12 @@ def main():
     ap.add_argument("--refine", default="", help="budgets to trace and refine at, e.g. 1000")
     ap.add_argument("--iterations", type=int, help="refinement iterations (default: the config's)")
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--set", action="append", default=[],
+                    help="with --refine: a config override, KEY=VALUE (e.g. optimize.coarse=0.3)")
     args = ap.parse_args()
     if args.refine:
         refine_table([int(b) for b in args.refine.split(",")], args.images.split(","),
-                     args.iterations, args.threads)
+                     args.iterations, args.threads, args.set)
         return
     budgets = [int(b) for b in args.budgets.split(",")]
     images = args.images.split(",")
@@ -114,7 +116,7 @@ def main():
         print(f"{'mean':16s} {np.mean([r[0] for r in rows]):8.2f} {np.mean([r[1] for r in rows]):8.2f}")
 
 
-def refine_table(budgets, images, iterations, threads):
+def refine_table(budgets, images, iterations, threads, sets=()):
     """Trace + refine with the defaults: PSNR before / after and wall time per image."""
     from PIL import Image
 
@@ -123,7 +125,7 @@ def refine_table(budgets, images, iterations, threads):
     from vecfit.fitting.metrics import compare
     from vecfit.jobs.fit import Outputs
     from vecfit.jobs.trace import run as trace
-    from common import resvg_rgb  # (benchmarks/ is on sys.path: the script's own folder)
+    from common import parse_sets, resvg_rgb  # (benchmarks/ is on sys.path: the script's own folder)
 
     print("| image | budget | paths | PSNR trace | PSNR refined (vecfit) | PSNR refined (resvg) "
           "| trace s | refine s | s/iter | total s |")
@@ -135,7 +137,9 @@ def refine_table(budgets, images, iterations, threads):
             target = Path(tmp) / f"{name}.png"
             Image.fromarray((image[..., :3] * 255 + 0.5).astype(np.uint8)).save(target)
             for b in budgets:
-                overrides = {"trace": {"paths": b}, "optimize": {"threads": threads}}
+                overrides = parse_sets(sets)
+                overrides.setdefault("trace", {})["paths"] = b
+                overrides.setdefault("optimize", {})["threads"] = threads
                 if iterations is not None:
                     overrides["optimize"]["iterations"] = iterations
                 config = resolve("trace", overrides=overrides)

@@ -1,5 +1,10 @@
+import os
 import sys
 from pathlib import Path
+
+# As vecfit does on import, but before anything loads torch: idle OpenMP threads sleep
+# (spinning, they starve the core's threads on a busy machine; see vecfit/__init__.py).
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 # Test helpers (reference renderer, conformance harness) live next to the tests.
 sys.path.insert(0, str(Path(__file__).resolve().parent))

@@ -112,6 +112,36 @@ def test_the_installed_wheel_runs_every_command(user_env, tmp_path):
     assert version.startswith("vecfit 0.") and "core:" in version, version
 
 
+PYDIFFVG_SCRIPT = """
+import torch, pydiffvg, diffvg, vecfit.pydiffvg
+assert pydiffvg is vecfit.pydiffvg and pydiffvg.__file__.startswith(SITE), pydiffvg.__file__
+center = torch.tensor([12.0, 8.0], requires_grad=True)
+shapes = [pydiffvg.Circle(torch.tensor(4.0), center)]
+groups = [pydiffvg.ShapeGroup(torch.tensor([0]), torch.tensor([1.0, 0.8, 0.0, 1.0]))]
+args = pydiffvg.RenderFunction.serialize_scene(24, 16, shapes, groups,
+                                               pydiffvg.PixelFilter(diffvg.FilterType.hann, torch.tensor(1.0)))
+img = pydiffvg.RenderFunction.apply(24, 16, 2, 2, 0, None, *args)
+(img[:, :12, 3].sum() - img[:, 12:, 3].sum()).backward()
+assert img.shape == (16, 24, 4) and center.grad[0] < 0, center.grad
+pydiffvg.save_svg("d.svg", 24, 16, shapes, groups)
+w, h, shapes2, groups2 = pydiffvg.svg_to_scene("d.svg")
+assert (w, h, len(shapes2)) == (24, 16, 1)
+pydiffvg.imwrite(img.detach(), "d.png")
+print("ok")
+"""
+
+
+def test_the_installed_wheel_has_pydiffvg(user_env, tmp_path):
+    """`import pydiffvg` and `import diffvg` in the installed wheel: render, gradients, SVG."""
+    site = subprocess.check_output([user_env, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+                                   text=True).strip()
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VECFIT_SHARED")}
+    r = subprocess.run([str(user_env), "-c", f"SITE = {site!r}\n" + PYDIFFVG_SCRIPT], cwd=tmp_path, env=env,
+                       capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0 and r.stdout.strip() == "ok", r.stdout + r.stderr
+    assert (tmp_path / "d.png").stat().st_size > 0
+
+
 def test_sdist_carries_the_sources(tmp_path):
     pytest.importorskip("build", reason="the sdist is built with the 'build' package (dev extra)")
     r = subprocess.run([sys.executable, "-m", "build", "--sdist", "--outdir", str(tmp_path), str(ROOT)],
@@ -122,7 +152,8 @@ def test_sdist_carries_the_sources(tmp_path):
         names = {n.split("/", 1)[1] for n in tar.getnames() if "/" in n}
     for needed in ("README.md", "LICENSE", "pyproject.toml", "CMakeLists.txt",
                    "configs/refine.toml", "configs/trace.toml", "configs/paint.toml",
-                   "cli/commands.py", "vecfit/__init__.py", "vecfit/__main__.py"):
+                   "cli/commands.py", "vecfit/__init__.py", "vecfit/__main__.py",
+                   "compat/pydiffvg/__init__.py", "compat/diffvg/__init__.py", "vecfit/pydiffvg/render.py"):
         assert needed in names, needed
     assert any(n.startswith("csrc/") and n.endswith(".cpp") for n in names)
     assert not any(n.startswith(("build/", ".venv/", "out/")) for n in names)

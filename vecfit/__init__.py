@@ -11,6 +11,7 @@ os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 from .errors import SvgError, VecfitError
 from .renderer.device import cuda_device_count, has_cuda
+from .renderer.batch import render_batch
 from .renderer.raster import render
 from .renderer.scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient, Rect,
                              Scene, Shape, Solid)
@@ -19,7 +20,7 @@ __version__ = "0.1.0"
 
 __all__ = ["Circle", "Ellipse", "Group", "LinearGradient", "Path", "RadialGradient", "Rect", "Scene",
            "Shape", "Solid", "SvgError", "VecfitError", "cuda_device_count", "has_cuda", "load_svg",
-           "render", "__version__"]
+           "render", "render_batch", "__version__"]
 
 
 def load_svg(path) -> Scene:

@@ -101,7 +101,8 @@ BackwardPlan plan_backward(const PreparedScene& prepared, const RenderOptions& o
     bc.height = o.height;
     bc.R = R;
     bc.filter = o.filter;
-    if (o.filter == FILTER_TENT) bc.filter_integral = R * R;
+    if (o.filter == FILTER_TENT || o.filter == FILTER_HANN) bc.filter_integral = R * R;
+    else if (o.filter == FILTER_PARABOLIC) bc.filter_integral = (4 * R / 3) * (4 * R / 3);
     else if (o.filter == FILTER_GAUSSIAN) {
         double sigma = R / 2, one = sigma * std::sqrt(2 * M_PI) * std::erf(R / (sigma * std::sqrt(2.0)));
         bc.filter_integral = one * one;

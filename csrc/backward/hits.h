@@ -103,6 +103,8 @@ VF_HD void collect_hits_analytic(const SceneView& sc, const TileView& bins, Vec2
         Hit h;
         h.draw = e.draw;
         h.sd = entry_sdf(sc, bins, e, region, p, r, &h.arg);
+        if (h.arg.kind == SdfArg::SEGMENT && std::fabs(h.sd) < ON_EDGE)
+            h.arg.side = entry_inside_side(sc, bins, e, region, h.arg);
         h.cov = kernel_coverage(h.sd / r);
         if (h.cov <= 0) continue;
         brush_color(sc, sc.brushes[d.brush], p, h.brush);

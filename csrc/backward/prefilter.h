@@ -44,13 +44,25 @@ VF_HD void fill_sdf_backward(const SceneView& sc, const PreparedDraw& d, const H
     const SdfArg& arg = h.arg;
     double sign = h.sd < 0 ? -1 : 1;
     double dist = distance(arg.closest, p);
+    if (arg.kind == SdfArg::SEGMENT) {
+        // d sd / d(closest point): the inward direction, sign (closest - p) / dist off the
+        // edge; on it, the unit normal on the inside's side (none where both or neither are).
+        const PreparedSegment& seg = sc.fill_items[arg.item];
+        Vec2 inward;
+        if (dist >= ON_EDGE) inward = (sign / dist) * (arg.closest - p);
+        else {
+            Vec2 tangent = seg_deriv(seg.seg, arg.t);
+            double speed = length(tangent);
+            if (arg.side == 0 || speed <= 0) return;
+            inward = (arg.side / speed) * perp(tangent);
+        }
+        for (int i = 0; i <= seg.seg.degree; ++i)
+            add_point_grad(g, seg.point_index[i], (g_sd * bernstein(seg.seg.degree, i, arg.t)) * inward);
+        return;
+    }
     if (dist <= 0) return;
     Vec2 dir = (1 / dist) * (arg.closest - p);  // d dist / d(closest point)
-    if (arg.kind == SdfArg::SEGMENT) {
-        const PreparedSegment& seg = sc.fill_items[arg.item];
-        for (int i = 0; i <= seg.seg.degree; ++i)
-            add_point_grad(g, seg.point_index[i], (g_sd * sign * bernstein(seg.seg.degree, i, arg.t)) * dir);
-    } else if (arg.kind == SdfArg::ELLIPSE) {
+    if (arg.kind == SdfArg::ELLIPSE) {
         Vec2 u = inverse(d.ellipse_axes) * (arg.closest - d.ellipse_center);
         add_ellipse_grad(g, d, g_sd * sign, dir, u);
     }

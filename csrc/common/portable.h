@@ -63,4 +63,17 @@ VF_HD void vswap(T& a, T& b) {
     b = t;
 }
 
+// a + b c with the product and the sum each rounded, on the host and the device alike:
+// nvcc contracts a + b * c into one fused multiply-add (rounded once), so a point
+// computed that way can differ from the host's in the last bit, and a decision taken on
+// it (which pixel, which side of an edge) with it. (The host build has no -march, so gcc
+// emits no FMA there.)
+VF_HD double mul_add_rn(double a, double b, double c) {
+#ifdef __CUDA_ARCH__
+    return __dadd_rn(a, __dmul_rn(b, c));
+#else
+    return a + b * c;
+#endif
+}
+
 }  // namespace vf

@@ -50,7 +50,7 @@ VF_HD void sample_position(uint64_t seed, uint64_t pixel, int s, int n, double& 
     y = (sy + (px + v) / n) / n;
 }
 
-enum FilterKind : int { FILTER_BOX = 0, FILTER_TENT = 1, FILTER_GAUSSIAN = 2 };
+enum FilterKind : int { FILTER_BOX = 0, FILTER_TENT = 1, FILTER_GAUSSIAN = 2, FILTER_PARABOLIC = 3, FILTER_HANN = 4 };
 
 // Unnormalised filter weight at offset (dx, dy) from the pixel centre, support radius r.
 VF_HD double filter_weight(int kind, double r, double dx, double dy) {
@@ -60,8 +60,42 @@ VF_HD double filter_weight(int kind, double r, double dx, double dy) {
             double s = r / 2;  // truncated at two standard deviations
             return std::exp(-(dx * dx + dy * dy) / (2 * s * s));
         }
+        // diffvg's "radial parabolic" (separable despite its name) and Hann windows; their
+        // constant factors cancel in the normalisation by the sum of the weights.
+        case FILTER_PARABOLIC: return vmax(0.0, 1 - (dx / r) * (dx / r)) * vmax(0.0, 1 - (dy / r) * (dy / r));
+        case FILTER_HANN:
+            if (std::fabs(dx) >= r || std::fabs(dy) >= r) return 0.0;
+            return 0.25 * (1 + std::cos(M_PI * dx / r)) * (1 + std::cos(M_PI * dy / r));
         default: return 1.0;
     }
+}
+
+// The radius derivative's kernel (Monte Carlo mode): a pixel is I(r) = E[W(u) c(p + r u)] /
+// E[W(u)] over u uniform in [-1, 1]^2, with W(u) = filter_weight at (r u_x, r u_y), which
+// depends on u alone. Substituting q = p + r u and differentiating under the integral,
+// dI/dr = E[D(u) c(p + r u)] / (r E[W(u)]) with D = -2 W - grad W . u, where the filter
+// vanishes on its support's edge (tent, parabolic, Hann; not the truncated Gaussian,
+// whose edge adds a boundary term, nor the box, whose radius is fixed). Separable
+// W = h(u_x) h(u_y): D = -2 h(x) h(y) - x h'(x) h(y) - h(x) y h'(y).
+VF_HD double filter_radius_kernel(int kind, double ux, double uy) {
+    double hx, hy, xhx, yhy;  // h(x), h(y), x h'(x), y h'(y)
+    switch (kind) {
+        case FILTER_TENT:
+            hx = 1 - std::fabs(ux), hy = 1 - std::fabs(uy);
+            xhx = -std::fabs(ux), yhy = -std::fabs(uy);
+            break;
+        case FILTER_PARABOLIC:
+            hx = 1 - ux * ux, hy = 1 - uy * uy;
+            xhx = -2 * ux * ux, yhy = -2 * uy * uy;
+            break;
+        case FILTER_HANN:
+            hx = 0.5 * (1 + std::cos(M_PI * ux)), hy = 0.5 * (1 + std::cos(M_PI * uy));
+            xhx = -0.5 * M_PI * ux * std::sin(M_PI * ux), yhy = -0.5 * M_PI * uy * std::sin(M_PI * uy);
+            break;
+        default: return 0.0;
+    }
+    if (hx < 0 || hy < 0) return 0.0;
+    return -2 * hx * hy - xhx * hy - hx * yhy;
 }
 
 }  // namespace vf

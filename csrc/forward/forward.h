@@ -45,4 +45,9 @@ ForwardPlan plan_forward(const PreparedScene& scene, const RenderOptions& option
 // out: height x width x 4 floats, straight (not premultiplied) RGBA.
 void render_forward(const PreparedScene& scene, const RenderOptions& options, float* out);
 
+// dL/d(filter radius) in Monte Carlo mode (see filter_radius_kernel, common/sampling.h),
+// given g: height x width x 4, dL/d(each pixel's filtered premultiplied colour, background
+// excluded). 0 for the box filter (its radius is fixed) and the Gaussian (not supported).
+double filter_radius_gradient(const PreparedScene& scene, const RenderOptions& options, const float* g);
+
 }  // namespace vf

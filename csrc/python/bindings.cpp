@@ -5,6 +5,8 @@
 #include <pybind11/stl.h>
 
 #include <atomic>
+#include <exception>
+#include <vector>
 #include <initializer_list>
 #include <stdexcept>
 #include <string>
@@ -54,7 +56,9 @@ int parse_filter(const std::string& f) {
     if (f == "box") return 0;
     if (f == "tent") return 1;
     if (f == "gaussian") return 2;
-    throw std::invalid_argument("filter must be 'box', 'tent' or 'gaussian', not '" + f + "'");
+    if (f == "parabolic") return 3;
+    if (f == "hann") return 4;
+    throw std::invalid_argument("filter must be 'box', 'tent', 'gaussian', 'parabolic' or 'hann', not '" + f + "'");
 }
 
 // The scene's arrays, kept alive for the duration of a call.
@@ -152,6 +156,39 @@ py::array_t<float> render(const py::dict& scene, int width, int height, int samp
     return image;
 }
 
+// The gradients of a scene's float arrays, as numpy arrays by the names render() takes.
+py::dict grads_dict(const SceneGrads& g) {
+    auto out = [](const std::vector<double>& v, py::ssize_t cols) {
+        py::array_t<float> arr({(py::ssize_t)(cols > 0 ? v.size() / cols : v.size()), cols});
+        float* p = arr.mutable_data();
+        for (size_t i = 0; i < v.size(); ++i) p[i] = (float)v[i];
+        return arr;
+    };
+    py::dict r;
+    r["points"] = out(g.points, POINT_COLS);
+    r["point_widths"] = out(g.point_widths, 1);
+    r["ellipses"] = out(g.ellipses, ELLIPSE_COLS);
+    r["draw_params"] = out(g.draw_params, DRAW_FCOLS);
+    r["brush_params"] = out(g.brush_params, BRUSH_FCOLS);
+    r["stop_offsets"] = out(g.stop_offsets, 1);
+    r["stop_colors"] = out(g.stop_colors, STOP_COLOR_COLS);
+    r["layer_opacity"] = out(g.layer_opacity, 1);
+    return r;
+}
+
+// dL/d(filter radius), Monte Carlo mode: g is dL/d(the filtered premultiplied colour of
+// each pixel, background excluded), height x width x 4. On the CPU.
+double filter_radius_grad(const py::dict& scene, Array<float> g, int width, int height, int samples,
+                          const std::string& filter, double filter_radius, uint64_t seed, int threads) {
+    SceneInput in = scene_input(scene);
+    SceneArrays a = in.arrays();
+    RenderOptions o = render_options(width, height, samples, "mc", filter, filter_radius, seed, threads, py::none());
+    if (g.size() != (py::ssize_t)width * height * 4) throw std::invalid_argument("g must be height x width x 4");
+    py::gil_scoped_release release;
+    PreparedScene prepared = timed_prepare(a);
+    return filter_radius_gradient(prepared, o, g.data());
+}
+
 // Backward passes redone on the CPU because a sample overflowed a GPU thread's lists.
 std::atomic<long> backward_fallbacks{0};
 
@@ -181,22 +218,84 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
         if (fixed && !done) ++backward_fallbacks;
         if (!done) render_backward(prepared, a, o, image.data(), d_image.data(), boundary_density, g);
     }
-    auto out = [](const std::vector<double>& v, py::ssize_t cols) {
-        py::array_t<float> arr({(py::ssize_t)(cols > 0 ? v.size() / cols : v.size()), cols});
-        float* p = arr.mutable_data();
-        for (size_t i = 0; i < v.size(); ++i) p[i] = (float)v[i];
-        return arr;
-    };
-    py::dict r;
-    r["points"] = out(g.points, POINT_COLS);
-    r["point_widths"] = out(g.point_widths, 1);
-    r["ellipses"] = out(g.ellipses, ELLIPSE_COLS);
-    r["draw_params"] = out(g.draw_params, DRAW_FCOLS);
-    r["brush_params"] = out(g.brush_params, BRUSH_FCOLS);
-    r["stop_offsets"] = out(g.stop_offsets, 1);
-    r["stop_colors"] = out(g.stop_colors, STOP_COLOR_COLS);
-    r["layer_opacity"] = out(g.layer_opacity, 1);
-    return r;
+    return grads_dict(g);
+}
+
+// Runs task(b) for every scene of a batch on up to `threads` threads, one scene per
+// thread at a time; the first error (in scene order) is raised after all have run.
+template <class Task>
+void for_each_scene(int n, int threads, Task task) {
+    std::vector<std::exception_ptr> errors(n);
+    ThreadPool::instance().parallel_for(n, threads, [&](int b, int) {
+        try {
+            task(b);
+        } catch (...) {
+            errors[b] = std::current_exception();
+        }
+    });
+    for (auto& e : errors)
+        if (e) std::rethrow_exception(e);
+}
+
+std::vector<SceneInput> batch_inputs(const py::list& scenes, const std::vector<uint64_t>& seeds) {
+    if (seeds.size() != scenes.size()) throw std::invalid_argument("a batch needs one seed per scene");
+    std::vector<SceneInput> inputs;
+    inputs.reserve(scenes.size());
+    for (const py::handle& s : scenes) inputs.push_back(scene_input(s.cast<py::dict>()));
+    return inputs;
+}
+
+// A batch of scenes rendered at one size with one set of options (each its own seed), in
+// one call: parallel over the scenes, each scene on one thread. For training loops that
+// render many small scenes a step, where one call per scene would cost more than its pixels.
+py::array_t<float> render_batch(const py::list& scenes, int width, int height, int samples, const std::string& mode,
+                                const std::string& filter, double filter_radius, const std::vector<uint64_t>& seeds,
+                                int threads, py::object background) {
+    std::vector<SceneInput> inputs = batch_inputs(scenes, seeds);
+    RenderOptions o = render_options(width, height, samples, mode, filter, filter_radius, 0, 1, background);
+    const int n = (int)inputs.size();
+    const size_t pixels = (size_t)width * height;
+    py::array_t<float> images({(py::ssize_t)n, (py::ssize_t)height, (py::ssize_t)width, (py::ssize_t)4});
+    float* out = images.mutable_data();
+    {
+        py::gil_scoped_release release;
+        for_each_scene(n, threads, [&](int b) {
+            SceneArrays a = inputs[b].arrays();
+            RenderOptions ob = o;
+            ob.seed = seeds[b];
+            render_forward(timed_prepare(a), ob, out + 4 * pixels * b);
+        });
+    }
+    return images;
+}
+
+// Gradients of a batch rendered by render_batch: one dict per scene, as render_grad's.
+py::list render_grad_batch(const py::list& scenes, Array<float> images, Array<float> d_images, int width, int height,
+                           int samples, const std::string& mode, const std::string& filter, double filter_radius,
+                           const std::vector<uint64_t>& seeds, int threads, py::object background,
+                           double boundary_density, int interior_samples) {
+    std::vector<SceneInput> inputs = batch_inputs(scenes, seeds);
+    RenderOptions o = render_options(width, height, samples, mode, filter, filter_radius, 0, 1, background);
+    if (interior_samples < 0) throw std::invalid_argument("interior_samples must be >= 0");
+    o.interior_samples = interior_samples;
+    const int n = (int)inputs.size();
+    const size_t pixels = (size_t)width * height;
+    if (images.size() != (py::ssize_t)(4 * pixels * n) || d_images.size() != images.size())
+        throw std::invalid_argument("images and their gradients must be batch x height x width x 4");
+    std::vector<SceneGrads> grads(n);
+    {
+        py::gil_scoped_release release;
+        for_each_scene(n, threads, [&](int b) {
+            SceneArrays a = inputs[b].arrays();
+            RenderOptions ob = o;
+            ob.seed = seeds[b];
+            render_backward(timed_prepare(a), a, ob, images.data() + 4 * pixels * b, d_images.data() + 4 * pixels * b,
+                            boundary_density, grads[b]);
+        });
+    }
+    py::list out;
+    for (const SceneGrads& g : grads) out.append(grads_dict(g));
+    return out;
 }
 
 // The array layout of scene.h for Python (vecfit/renderer/layout.py reads it, so that
@@ -246,6 +345,19 @@ PYBIND11_MODULE(_core, m) {
           py::arg("samples"), py::arg("mode"), py::arg("filter"), py::arg("filter_radius"), py::arg("seed"),
           py::arg("threads"), py::arg("background"), py::arg("boundary_density"), py::arg("device") = -1,
           py::arg("emulate_gpu_lists") = false, py::arg("interior_samples") = 0);
+    m.def("render_batch", &render_batch,
+          "Render a list of scene dicts at one size into [B, H, W, 4] straight RGBA, in parallel over the scenes",
+          py::arg("scenes"), py::arg("width"), py::arg("height"), py::arg("samples"), py::arg("mode"),
+          py::arg("filter"), py::arg("filter_radius"), py::arg("seeds"), py::arg("threads"), py::arg("background"));
+    m.def("render_grad_batch", &render_grad_batch,
+          "Gradients of a batch rendered by render_batch: a list of dicts, one per scene, as render_grad's",
+          py::arg("scenes"), py::arg("images"), py::arg("d_images"), py::arg("width"), py::arg("height"),
+          py::arg("samples"), py::arg("mode"), py::arg("filter"), py::arg("filter_radius"), py::arg("seeds"),
+          py::arg("threads"), py::arg("background"), py::arg("boundary_density"), py::arg("interior_samples") = 0);
+    m.def("filter_radius_grad", &filter_radius_grad,
+          "dL/d(filter radius) in Monte Carlo mode, given dL/d(premultiplied colour) per pixel",
+          py::arg("scene"), py::arg("g"), py::arg("width"), py::arg("height"), py::arg("samples"),
+          py::arg("filter"), py::arg("filter_radius"), py::arg("seed"), py::arg("threads"));
     m.def("layout", &layout,
           "The scene arrays' layout: enums (shape_kinds, draw_kinds, fill_rules, caps, joins, brush_kinds) "
           "and each table's row width (columns)");

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "backward/pixel.h"
 #include "common/bezier.h"
 #include "common/ellipse.h"
 #include "common/roots.h"
@@ -36,6 +37,19 @@ Segment segment_from(const Array<double>& pts) {
 }  // namespace
 
 void register_test_hooks(py::module_& m) {
+    m.def("boundary_pixels", [](std::pair<double, double> p, std::pair<double, double> n, double R, int W, int H) {
+        // The pixels a Monte Carlo boundary sample at p (outward normal n) counts for.
+        Vec2 pp{p.first, p.second};
+        BoundarySupport s;
+        std::vector<std::pair<int, int>> out;
+        if (!boundary_support(pp, nudged(pp, EPS_NORMAL, {n.first, n.second}), R, W, H, s)) return out;
+        double dx, dy;
+        for (int py = s.y0; py <= s.y1; ++py)
+            for (int px = s.x0; px <= s.x1; ++px)
+                if (s.holds(px, py, dx, dy)) out.push_back({px, py});
+        return out;
+    }, py::arg("p"), py::arg("n"), py::arg("filter_radius"), py::arg("width"), py::arg("height"));
+
     m.def("polynomial_roots", [](std::vector<double> coeffs, double lo, double hi) {
         if (coeffs.empty() || coeffs.size() > 6) throw std::invalid_argument("degree must be 0..5");
         double roots[5];

@@ -55,7 +55,9 @@ namespace vf {
 struct SdfArg {
     enum Kind { NONE, SEGMENT, ELLIPSE, SWEEP, BUTT, END } kind = NONE;
     int item = -1;     // fill or stroke item (global index)
-    int side = 0;      // BUTT / END: 0 at the item's start, 1 at its end
+    int side = 0;      // BUTT / END: 0 at the item's start, 1 at its end; SEGMENT on the
+                       // edge (see ON_EDGE): +1 / -1 where the inside lies along +/- the
+                       // segment's left normal, 0 where it lies on both sides or neither
     double t = 0;      // SEGMENT / SWEEP: parameter of the closest point
     Vec2 closest;      // SEGMENT / SWEEP / ELLIPSE: the closest point
 };
@@ -83,6 +85,12 @@ VF_HD int ray_crossings(const PreparedSegment& s, Vec2 p, double x_max = 1e300) 
     }
     return w;
 }
+
+// A fill's signed distance is +-|closest - p|; within ON_EDGE (pixels) of the edge the
+// direction closest - p is lost to rounding (exactly 0 where a pixel centre lies on the
+// edge, as on mcseem2's 45-degree segments through integer points), so its gradient takes
+// the segment's normal, turned towards the inside (SdfArg::side).
+constexpr double ON_EDGE = 1e-7;
 
 // Parabolic prefilter kernel: coverage of a half-plane at signed distance d (in units of
 // the kernel radius, positive outside): 1/2 + (d^3 - 3d)/4 on [-1, 1]; and its slope.

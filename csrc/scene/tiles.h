@@ -114,4 +114,19 @@ VF_HD double entry_sdf(const SceneView& sc, const TileView& bins, const TileEntr
     return winding_inside(tile_winding(sc, bins, e, region, p), d.fill_rule) ? -dist : dist;
 }
 
+// For a fill hit within ON_EDGE of its closest segment: which side of the segment (along
+// its left normal at arg.t) is inside, from the winding numbers just off the edge (see
+// SdfArg::side). Rare: only where a sample lies on an edge.
+VF_HD int entry_inside_side(const SceneView& sc, const TileView& bins, const TileEntry& e, const Box& region,
+                            const SdfArg& arg) {
+    const PreparedDraw& d = sc.draws[e.draw];
+    Vec2 tangent = seg_deriv(sc.fill_items[arg.item].seg, arg.t);
+    double speed = length(tangent);
+    if (speed <= 0) return 0;
+    Vec2 n = (10 * ON_EDGE / speed) * perp(tangent);
+    bool plus = winding_inside(tile_winding(sc, bins, e, region, arg.closest + n), d.fill_rule);
+    bool minus = winding_inside(tile_winding(sc, bins, e, region, arg.closest - n), d.fill_rule);
+    return plus == minus ? 0 : (plus ? 1 : -1);
+}
+
 }  // namespace vf

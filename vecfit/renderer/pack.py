@@ -360,7 +360,8 @@ class _PathBatch:
             return
         counts = [len(p) for p in self.points]
         local = torch.cat(self.points).float()
-        owner = torch.repeat_interleave(torch.tensor(self.owner), torch.tensor(counts))
+        # (numpy: torch's repeat_interleave wakes its thread pool, 0.6 ms a call on 2 busy cores)
+        owner = torch.from_numpy(np.repeat(np.asarray(self.owner, dtype=np.int64), counts))
         m = matrices[owner]
         out.points.append(torch.einsum("nij,nj->ni", m[:, :2, :2], local) + m[:, :2, 2])
         if any(w is not None for w in self.widths):

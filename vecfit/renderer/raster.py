@@ -18,7 +18,7 @@ from .scene import Scene
 from .stopwatch import add_core_phases, phase
 
 MODES = ("mc", "analytic")
-FILTERS = ("box", "tent", "gaussian")
+FILTERS = ("box", "tent", "gaussian", "parabolic", "hann")
 MAX_PIXELS = 64_000_000  # a float RGBA image of that size already takes 1 GB
 
 
@@ -52,6 +52,41 @@ def _core_render(settings: dict, structure: dict, floats, brute_force: bool = Fa
         raise VecfitError(str(e)) from None
     except RuntimeError as e:  # the GPU failed (out of memory, driver)
         raise VecfitError(f"rendering on {devices.device_name(settings['device'])} failed: {e}") from None
+
+
+def check_options(samples, mode: str, filter: str, filter_radius: float) -> None:
+    if mode not in MODES:
+        raise VecfitError(f"mode must be one of {', '.join(MODES)}, not {mode!r}")
+    if filter not in FILTERS:
+        raise VecfitError(f"filter must be one of {', '.join(FILTERS)}, not {filter!r}")
+    if int(samples) < 1:
+        raise VecfitError("samples must be at least 1")
+    if not (filter_radius > 0 and math.isfinite(filter_radius)):
+        raise VecfitError("filter radius must be a positive number")
+
+
+def background_rgba(background) -> list[float] | None:
+    """None, or the background as 4 floats (RGB gets alpha 1)."""
+    if background is None:
+        return None
+    bg = [float(v) for v in background]
+    if len(bg) == 3:
+        bg.append(1.0)
+    if len(bg) != 4:
+        raise VecfitError("background must have 3 or 4 components")
+    return bg
+
+
+def packed_for_core(scene: Scene, width: int, height: int) -> tuple[dict, list]:
+    """The scene packed at width x height: the integer tables (structure) and the float
+    arrays in FLOAT_INPUTS order (differentiable), checked to be finite."""
+    with phase("pack"):
+        arrays = pack_scene(scene, width, height).arrays()
+    floats = [arrays[name].to(torch.float32) for name in FLOAT_INPUTS]
+    for name, value in zip(FLOAT_INPUTS, floats):
+        if not torch.isfinite(value.detach()).all():
+            raise NonFiniteScene(f"the scene has non-finite values ({name})")
+    return {k: v for k, v in arrays.items() if k not in FLOAT_INPUTS}, floats
 
 
 class _Render(torch.autograd.Function):
@@ -110,32 +145,13 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     (_brute_force and _gpu_lists are for tests: every draw tested at every sample, and the
     CPU backward pass run first with a GPU thread's list sizes, see backward_fallbacks.)
     """
-    if mode not in MODES:
-        raise VecfitError(f"mode must be one of {', '.join(MODES)}, not {mode!r}")
-    if filter not in FILTERS:
-        raise VecfitError(f"filter must be one of {', '.join(FILTERS)}, not {filter!r}")
-    if int(samples) < 1:
-        raise VecfitError("samples must be at least 1")
-    if not (filter_radius > 0 and math.isfinite(filter_radius)):
-        raise VecfitError("filter radius must be a positive number")
+    check_options(samples, mode, filter, filter_radius)
     width, height = output_size(scene, width, height)
     if width * height > MAX_PIXELS:
         raise VecfitError(f"{width} x {height} pixels is too large to render "
                           f"(at most {MAX_PIXELS // 1_000_000} million pixels)")
-    if background is not None:
-        bg = [float(v) for v in background]
-        if len(bg) == 3:
-            bg.append(1.0)
-        if len(bg) != 4:
-            raise VecfitError("background must have 3 or 4 components")
-        background = bg
-    with phase("pack"):
-        arrays = pack_scene(scene, width, height).arrays()
-    floats = [arrays[name].to(torch.float32) for name in FLOAT_INPUTS]
-    for name, value in zip(FLOAT_INPUTS, floats):
-        if not torch.isfinite(value.detach()).all():
-            raise NonFiniteScene(f"the scene has non-finite values ({name})")
-    structure = {k: v for k, v in arrays.items() if k not in FLOAT_INPUTS}
+    background = background_rgba(background)
+    structure, floats = packed_for_core(scene, width, height)
     settings = dict(width=width, height=height, samples=int(samples), mode=mode, filter=filter,
                     filter_radius=float(filter_radius), seed=int(seed), threads=int(threads or 0),
                     background=background, device=devices.resolve(device))
