@@ -33,6 +33,8 @@ bench: install
 	$(PY) benchmarks/refine.py
 	$(PY) benchmarks/trace.py
 	$(PY) benchmarks/paint.py
+	$(PY) benchmarks/edit.py
+	$(PY) benchmarks/retarget.py
 
 # A GPU session (the `device` tool): the device machine reaches no registry and does not
 # see ../shared, so what it needs travels in .gpu/ (carry [".gpu"]); there, run

@@ -318,6 +318,47 @@ def paint(target, paths, kind, preset, frames, output, report, comparison, confi
              lambda bar: run_paint(target, config, outputs, progress=bar, frames=frames))
 
 
+@main.command()
+@click.argument("init_svg", type=click.Path(dir_okay=False))
+@click.argument("edited", type=click.Path(dir_okay=False))
+@click.option("--mask", type=click.Path(dir_okay=False),
+              help="PNG of EDITED's size, white where the edit is (default: where EDITED differs "
+                   "from INIT_SVG's render).")
+@optimize_options
+def edit(init_svg, edited, mask, output, report, comparison, config_file, quiet, **options):
+    """Bring an edit made on INIT_SVG's render (EDITED, a PNG) into the SVG: its own
+    parameters are fitted to EDITED, changing as little as possible outside the edit.
+    Writes NAME.vecfit.svg (elements, ids and groups kept), a report and a comparison
+    picture (original | edited | result | difference)."""
+    from vecfit.jobs.edit import run as run_edit
+    from vecfit.jobs.fit import Outputs
+
+    config = _resolve_config("edit", None, config_file, options)
+    outputs = Outputs.beside(Path(edited), output, report, comparison)
+    _run_job("edit", config["optimize"]["iterations"], quiet,
+             lambda bar: run_edit(edited, init_svg, config, outputs, progress=bar, mask=mask))
+
+@main.command()
+@click.argument("svg", type=click.Path(dir_okay=False))
+@click.option("--width", required=True, metavar="W|P%",
+              help="New width: pixels (120) or a percentage of the SVG's (70%).")
+@click.option("--height", metavar="H|P%", help="New height (default: unchanged).")
+@optimize_options
+def retarget(svg, width, height, output, report, comparison, config_file, quiet, **options):
+    """Content-aware resizing of SVG (seam carving brought into the vector file): seams of
+    least energy are carved out of its render in rounds, and its points are fitted to each
+    round's carved image. Writes NAME.vecfit.svg at the new size (every element, id and
+    group kept), a report and a comparison picture (input | plain scaling | retargeted)."""
+    from vecfit.jobs.fit import Outputs
+    from vecfit.jobs.retarget import run as run_retarget
+
+    config = _resolve_config("retarget", None, config_file, options)
+    outputs = Outputs.beside(Path(svg), output, report, comparison)
+    r = config["retarget"]
+    rounds = r["steps"] * (2 if height is not None else 1)
+    _run_job("retarget", rounds * r["iterations_per_step"] + r["final_iterations"], quiet,
+             lambda bar: run_retarget(svg, config, outputs, progress=bar, width=width, height=height))
+
 
 # ------------------------------------------------------------------------------ batch
 
@@ -325,13 +366,13 @@ def paint(target, paths, kind, preset, frames, output, report, comparison, confi
 @click.argument("in_dir", type=click.Path(exists=True, file_okay=False))
 @click.option("-o", "--out-dir", required=True, type=click.Path(file_okay=False),
               help="Folder for the outputs and the summary (not IN_DIR).")
-@click.option("--mode", required=True, type=click.Choice(["trace", "refine", "paint"]),
+@click.option("--mode", required=True, type=click.Choice(["trace", "refine", "paint", "edit"]),
               help="The command run on each image.")
 @click.option("--config", "config_file", type=click.Path(dir_okay=False),
               help="TOML file overriding the defaults in configs/.")
 @click.option("--preset", help="A preset of the mode's file in configs/.")
 @click.option("--init-dir", type=click.Path(exists=True, file_okay=False),
-              help="refine: the folder of the SVGs (default: IN_DIR).")
+              help="refine, edit: the folder of the SVGs (default: IN_DIR).")
 @click.option("-j", "--jobs", type=click.IntRange(min=0), default=1, show_default=True,
               help="Worker processes (0: one per core); 1 works in this process.")
 @click.option("--threads", type=click.IntRange(min=1),
@@ -346,11 +387,12 @@ def paint(target, paths, kind, preset, frames, output, report, comparison, confi
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar or per-image lines.")
 def batch(in_dir, out_dir, mode, config_file, preset, init_dir, jobs, threads, resume, scheduler,
           device, quiet):
-    """Run refine, trace or paint on every image in IN_DIR (*.png, *.jpg, *.jpeg, *.bmp,
-    *.tif, *.tiff, *.webp; not recursive), writing NAME.svg, NAME.report.json and
+    """Run refine, trace, paint or edit on every image in IN_DIR (*.png, *.jpg, *.jpeg,
+    *.bmp, *.tif, *.tiff, *.webp; not recursive), writing NAME.svg, NAME.report.json and
     NAME.compare.png per image, and summary.csv, summary.json and index.html (with
-    thumbs/) into OUT_DIR. For refine, each image is paired with the SVG of the same name
-    in IN_DIR (or --init-dir); an image without one is reported as unpaired. A failing
+    thumbs/) into OUT_DIR. For refine and edit, each image (for edit: the edited render)
+    is paired with the SVG of the same name in IN_DIR (or --init-dir); an image without
+    one is reported as unpaired. A failing
     image is recorded with its reason and the others go on.
 
     \b

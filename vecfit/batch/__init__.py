@@ -1,4 +1,4 @@
-"""`vecfit batch`: every image of a folder through refine, trace or paint; resumable,
+"""`vecfit batch`: every image of a folder through refine, trace, paint or edit; resumable,
 parallel on one machine (worker processes) or on a Dask distributed cluster, with a
 summary (summary.csv, summary.json, index.html with thumbnails).
 

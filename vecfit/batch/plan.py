@@ -1,10 +1,10 @@
-"""What a batch run has to do: the images of a folder, their SVG pairs (refine), their
+"""What a batch run has to do: the images of a folder, their SVG pairs (refine, edit), their
 outputs, and which of them are finished already (resume).
 
 A finished image is one whose report (written last by every job) exists and says:
 the same command, not interrupted, finite metrics, the same settings as now (less
 ``optimize.threads``, which divides the machine's cores and does not change the result),
-for refine the same initial SVG; its SVG and comparison picture exist; and neither the
+for refine and edit the same initial SVG; its SVG and comparison picture exist; and neither the
 image nor its initial SVG changed after the report was written.
 """
 from __future__ import annotations
@@ -19,10 +19,11 @@ from vecfit.jobs.fit import Outputs, same_path
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp")
 SVG_SUFFIXES = (".svg", ".svgz")
-MODES = ("refine", "trace", "paint")
+MODES = ("refine", "trace", "paint", "edit")
+PAIRED = ("refine", "edit")  # modes that pair each image with the SVG of its name
 # The job function of each mode, as "module:function", imported where the task runs.
 JOBS = {"refine": "vecfit.jobs.refine:run", "trace": "vecfit.jobs.trace:run",
-        "paint": "vecfit.jobs.paint:run"}
+        "paint": "vecfit.jobs.paint:run", "edit": "vecfit.jobs.edit:run"}
 
 # Statuses of a summary row.
 DONE = "done"
@@ -173,7 +174,7 @@ def make_plan(in_dir: Path, out_dir: Path, mode: str, config: dict, *, init_dir:
     stems: dict[str, list[Path]] = {}
     for p in images:
         stems.setdefault(p.stem, []).append(p)
-    svgs = svg_index(init_dir or in_dir) if mode == "refine" else {}
+    svgs = svg_index(init_dir or in_dir) if mode in PAIRED else {}
     svg_home = init_dir or in_dir
     for image in images:
         name = image.stem
@@ -185,7 +186,7 @@ def make_plan(in_dir: Path, out_dir: Path, mode: str, config: dict, *, init_dir:
                 f"{others} have the same name {name!r}: their outputs would collide (rename all but one)")
             continue
         init_svg = None
-        if mode == "refine":
+        if mode in PAIRED:
             pairs = svgs.get(name, [])
             if not pairs:
                 plan.rows[image.name] = empty_row(

@@ -2,7 +2,7 @@
 written, stale temporaries swept; resumable after Ctrl-C or a crash.
 
 The per-image work is the commands' own job functions (vecfit.jobs.refine.run,
-vecfit.jobs.trace.run, vecfit.jobs.paint.run), called by vecfit.batch.work.run_task."""
+vecfit.jobs.trace.run, vecfit.jobs.paint.run, vecfit.jobs.edit.run), called by vecfit.batch.work.run_task."""
 from __future__ import annotations
 
 import copy
@@ -15,7 +15,7 @@ from pathlib import Path
 from vecfit.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, VecfitError
 from vecfit.jobs.fit import same_path
 
-from .plan import FAILED, INTERRUPTED, MODES, NOT_RUN, UNPAIRED, make_plan, result_row
+from .plan import FAILED, INTERRUPTED, MODES, NOT_RUN, PAIRED, UNPAIRED, make_plan, result_row
 from .summary import SUMMARY_FILES, THUMBS, count, write_all
 
 
@@ -116,14 +116,14 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
               jobs: int = 1, threads: int | None = None, resume: bool = True, init_dir=None,
               scheduler: str | None = None, client=None, job: str | None = None,
               reporter=None, device: str | None = None) -> BatchResult:
-    """Runs ``mode`` (refine, trace, paint) on every image directly in ``in_dir``, writing
+    """Runs ``mode`` (refine, trace, paint, edit) on every image directly in ``in_dir``, writing
     NAME.svg, NAME.report.json and NAME.compare.png per image and the summary into
     ``out_dir``.
 
     jobs: worker processes on this machine (0: one per core; 1 runs in this process);
     threads: threads per worker (default: the cores divided between the workers; 1 per
     task on a Dask cluster). resume: skip finished images (see vecfit.batch.plan).
-    init_dir: where refine's SVGs are (default in_dir). scheduler: a Dask scheduler's
+    init_dir: where refine's (edit's) SVGs are (default in_dir). scheduler: a Dask scheduler's
     address (or give a connected ``client``). job: "module:function" in place of the
     mode's job function (same signature; for tests and extensions). reporter: an object
     with start(total), row(row) and finish() (see vecfit.batch.progress.Progress).
@@ -140,8 +140,8 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
         raise BatchUsageError(f"{in_dir}: no such folder" if not in_dir.exists()
                               else f"{in_dir}: not a folder")
     if init_dir is not None:
-        if mode != "refine":
-            raise BatchUsageError("--init-dir is for --mode refine")
+        if mode not in PAIRED:
+            raise BatchUsageError("--init-dir is for --mode refine and --mode edit")
         if not init_dir.is_dir():
             raise BatchUsageError(f"{init_dir}: no such folder")
     for d in (in_dir, init_dir):

@@ -71,7 +71,7 @@ def _remove_outputs(task: Task) -> None:
 def _call(task: Task):
     job = load_job(task.job)
     outputs = task.outputs()
-    if task.mode == "refine":
+    if task.init_svg is not None:  # refine, edit: the image and its SVG
         return job(task.image, task.init_svg, task.config, outputs, progress=None)
     return job(task.image, task.config, outputs, progress=None)
 

@@ -17,7 +17,7 @@ from typing import Callable, Optional
 import torch
 
 from vecfit.errors import NonFiniteScene, VecfitError
-from vecfit.io.images import downscaled
+from vecfit.io.images import downscaled, downscaled_weight
 from vecfit.renderer import device as devices
 from vecfit.renderer.raster import MODES, render
 from vecfit.renderer.scene import Scene
@@ -95,9 +95,17 @@ class Settings:
 @dataclass
 class Target:
     """What the render is compared with: [H, W, 4] straight RGBA in [0, 1] at the size
-    rendered, and the background to render over (None when the target is transparent)."""
+    rendered, and the background to render over (None when the target is transparent).
+    ``weight`` ([H, W], optional): how much each pixel counts in the loss (`vecfit edit`
+    weights the edited region); l2, l1 and pyramid only."""
     image: torch.Tensor
     background: Optional[tuple] = None
+    weight: Optional[torch.Tensor] = None
+
+    def loss(self, loss_fn, name: str, compared: torch.Tensor, goal: torch.Tensor) -> torch.Tensor:
+        if self.weight is None:
+            return loss_fn(compared, goal)
+        return losses.weighted(name)(compared, goal, self.weight)
 
     @property
     def opaque(self) -> bool:
@@ -162,19 +170,27 @@ def _levels(target: Target, settings: Settings, shapes: int):
     if fine_from == 0 or too_small or too_dense:
         return 0, (fine, fine)
     half = torch.from_numpy(downscaled(target.image.numpy(), max(height, width) // 2))
-    coarse = Target(half, target.background)
+    weight = None
+    if target.weight is not None:
+        weight = torch.from_numpy(downscaled_weight(target.weight.numpy(), half.shape[:2]))
+    coarse = Target(half, target.background, weight)
     return fine_from, ((coarse, coarse.compared(half.float())), fine)
 
 
 def optimize(scene: Scene, target: Target, settings: Settings,
              progress: Callable[[Progress], None] | None = None,
-             hooks: tuple[Callable[[Step], None], ...] = (), keep_alpha=()) -> Result:
+             hooks: tuple[Callable[[Step], None], ...] = (), keep_alpha=(),
+             penalty: Callable[[], torch.Tensor] | None = None) -> Result:
     """Fit ``scene`` to ``target`` in place; returns the loss curve and counts. The Scene
     ends at the best parameters seen. Ctrl-C stops early (``Result.interrupted``).
     ``hooks`` run after every iteration (see Step): re-seeding, saving frames.
     ``keep_alpha``: colour tensors whose alpha must not change (e.g. a backdrop that
-    has to keep the canvas covered)."""
+    has to keep the canvas covered). ``penalty``: a term added to every iteration's loss,
+    computed from the Scene's tensors (its gradient reaches them with the image's), e.g.
+    `vecfit edit`'s cost of moving what the edit did not touch."""
     settings.check()
+    if target.weight is not None:
+        losses.weighted(settings.loss)  # refuses a loss that takes no weight, before any work
     loss_fn = losses.get(settings.loss)
     height, width = target.image.shape[:2]
     fine_from, levels = _levels(target, settings, len(scene.shapes))
@@ -205,7 +221,8 @@ def optimize(scene: Scene, target: Target, settings: Settings,
                            threads=settings.threads, boundary_samples=settings.boundary_samples,
                            interior_samples=settings.interior_samples, device=device)
             frame["image"] = image.detach()
-            return loss_fn(at.compared(image), goal)
+            loss = at.loss(loss_fn, settings.loss, at.compared(image), goal)
+            return loss if penalty is None else loss + penalty()
 
     where = {}
     for i, k in enumerate(kinds):

@@ -69,6 +69,39 @@ def pyramid(a: torch.Tensor, b: torch.Tensor, levels: int = 4) -> torch.Tensor:
     return total
 
 
+def weighted_l2(a: torch.Tensor, b: torch.Tensor, weight: torch.Tensor) -> torch.Tensor:
+    """L2 with a per-pixel weight ([H, W]): the mean of weight x squared difference."""
+    return torch.mean(weight[..., None] * (a - b) ** 2)
+
+
+def weighted_l1(a: torch.Tensor, b: torch.Tensor, weight: torch.Tensor) -> torch.Tensor:
+    return torch.mean(weight[..., None] * torch.abs(a - b))
+
+
+def weighted_pyramid(a: torch.Tensor, b: torch.Tensor, weight: torch.Tensor, levels: int = 4) -> torch.Tensor:
+    """``pyramid`` with a per-pixel weight, pooled with the images level by level."""
+    x = a.permute(2, 0, 1)[None]
+    y = b.permute(2, 0, 1)[None]
+    w = weight[None, None]
+    total = torch.mean(w * (x - y) ** 2)
+    for _ in range(levels - 1):
+        if min(x.shape[-2:]) < 2:
+            break
+        x, y, w = F.avg_pool2d(x, 2), F.avg_pool2d(y, 2), F.avg_pool2d(w, 2)
+        total = total + torch.mean(w * (x - y) ** 2)
+    return total
+
+
+def weighted(name: str):
+    """The loss ``name`` with a per-pixel weight: l2, l1 and pyramid (a weight has no
+    plain meaning for SSIM's windows)."""
+    table = {"l2": weighted_l2, "l1": weighted_l1, "pyramid": weighted_pyramid}
+    if name not in table:
+        get(name)  # an unknown name is refused as such
+        raise VecfitError(f"loss {name!r} takes no per-pixel weight; use l2, l1 or pyramid")
+    return table[name]
+
+
 def get(name: str):
     table = {"l2": l2, "l1": l1, "ssim": ssim_loss, "pyramid": pyramid}
     if name not in table:

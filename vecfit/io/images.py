@@ -83,3 +83,11 @@ def downscaled(image: np.ndarray, max_size: int) -> np.ndarray:
     a = small[..., 3:]
     rgb = np.where(a > 0, small[..., :3] / np.maximum(a, 1e-12), 0)
     return np.concatenate([np.clip(rgb, 0, 1), np.clip(a, 0, 1)], axis=2).astype(np.float32)
+
+
+def downscaled_weight(weight: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """A per-pixel weight [H, W] area-averaged to ``size`` = (height, width)."""
+    if weight.shape[:2] == tuple(size):
+        return weight
+    return cv2.resize(weight.astype(np.float32), (size[1], size[0]),
+                      interpolation=cv2.INTER_AREA).astype(np.float32)

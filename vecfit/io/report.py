@@ -31,20 +31,43 @@ def error_map(result: np.ndarray, target: np.ndarray) -> np.ndarray:
 
 def comparison_image(target: np.ndarray, initial: np.ndarray, optimized: np.ndarray) -> np.ndarray:
     """Four panels side by side, RGB float: target, initial, optimised, error map."""
-    h, w = target.shape[:2]
+    return panels_image([target, initial, optimized, error_map(optimized, target)])
+
+
+def panels_image(images: list[np.ndarray]) -> np.ndarray:
+    """RGB float images side by side, each scaled to the first one's panel size (its
+    longest side at most PANEL_MAX), GAP white pixels between them."""
+    h, w = images[0].shape[:2]
     scale = min(1.0, PANEL_MAX / max(h, w))
     size = (max(1, round(w * scale)), max(1, round(h * scale)))
-    panels = [_panel(target, size), _panel(initial, size), _panel(optimized, size),
-              _panel(error_map(optimized, target), size)]
     pw, ph = size
-    out = np.ones((ph, 4 * pw + 3 * GAP, 3), dtype=np.float32)
-    for i, p in enumerate(panels):
-        out[:, i * (pw + GAP):i * (pw + GAP) + pw] = p
+    out = np.ones((ph, len(images) * pw + (len(images) - 1) * GAP, 3), dtype=np.float32)
+    for i, image in enumerate(images):
+        out[:, i * (pw + GAP):i * (pw + GAP) + pw] = _panel(image, size)
+    return out
+
+
+def side_by_side(images: list[np.ndarray]) -> np.ndarray:
+    """RGB float images of different sizes side by side at one scale (the tallest panel at
+    most PANEL_MAX high and the widest at most PANEL_MAX wide), top-aligned on white."""
+    scale = min(1.0, PANEL_MAX / max(max(i.shape[0], i.shape[1]) for i in images))
+    sizes = [(max(1, round(i.shape[1] * scale)), max(1, round(i.shape[0] * scale))) for i in images]
+    out = np.ones((max(h for _, h in sizes), sum(w for w, _ in sizes) + GAP * (len(images) - 1), 3),
+                  dtype=np.float32)
+    x = 0
+    for image, (w, h) in zip(images, sizes):
+        out[:h, x:x + w] = _panel(image, (w, h))
+        x += w + GAP
     return out
 
 
 def save_comparison(path, target, initial, optimized) -> None:
-    pixels = to_uint8(comparison_image(target, initial, optimized))
+    save_panels(path, comparison_image(target, initial, optimized))
+
+
+def save_panels(path, image: np.ndarray) -> None:
+    """An RGB float picture (panels_image) as a PNG, atomically."""
+    pixels = to_uint8(image)
     atomic_write(path, lambda tmp: Image.fromarray(pixels, "RGB").save(tmp, format="PNG"))
 
 

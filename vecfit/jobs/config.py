@@ -78,7 +78,7 @@ def _checked(value, expected, name: str, source: str):
 
 def resolve(command: str, *, preset: str | None = None, config_file=None,
             overrides: dict | None = None) -> dict:
-    """The settings of ``command`` (refine, trace, paint): defaults, its file, a preset,
+    """The settings of ``command`` (refine, trace, paint, edit, retarget): defaults, its file, a preset,
     the user's file and the overrides (a nested dict like the files), in that order."""
     root = configs_dir()
     settings = read_toml(root / "refine.toml")
@@ -123,6 +123,14 @@ def validate(settings: dict) -> None:
     if "paint" in settings:
         from vecfit.initial.strokes import PaintSettings
         settings_of(PaintSettings, settings["paint"], seed=seed).check()
+    if "edit" in settings:
+        from vecfit.editing.settings import EditSettings
+        settings_of(EditSettings, settings["edit"]).check()
+        from vecfit.fitting import losses
+        losses.weighted(settings["optimize"]["loss"])
+    if "retarget" in settings:
+        from vecfit.editing.settings import RetargetSettings
+        settings_of(RetargetSettings, settings["retarget"]).check()
 
 
 def settings_of(cls, table: dict, **fixed):

@@ -237,12 +237,16 @@ class _Document:
 
 # -------------------------------------------------------------------------- writer
 
-def write_svg(scene: Scene, source_path, out_path, *, full: bool = False, background=None) -> None:
+def write_svg(scene: Scene, source_path, out_path, *, full: bool = False, background=None,
+              canvas: tuple[float, float] | None = None) -> None:
     """Write ``scene``'s values into a copy of the SVG at ``source_path`` (which the scene
     was read from) and save it atomically at ``out_path``.
 
     background: an RGB(A) colour to put behind everything as a first ``<rect>`` covering
     the viewBox (for scenes optimised over a background they do not cover themselves).
+
+    canvas: a new (width, height) in pixels for the root element (`vecfit retarget`); its
+    viewBox is resized with it, so a user unit keeps its size in pixels.
 
     Raises VecfitError for non-finite values (nothing is written then) or a scene that
     does not match the source file.
@@ -304,6 +308,8 @@ def write_svg(scene: Scene, source_path, out_path, *, full: bool = False, backgr
                     writer.gradient(p, before)
                 written.add(p.source)
 
+    if canvas is not None:
+        _set_canvas(root, canvas, (original.width, original.height))
     if background is not None:
         _add_background(root, background)
     text = ET.tostring(root, encoding="unicode")
@@ -316,6 +322,21 @@ def write_svg(scene: Scene, source_path, out_path, *, full: bool = False, backgr
             f.write(payload)
 
     atomic_write(out_path, write)
+
+
+def _set_canvas(root, size, before) -> None:
+    """The root's width and height set to ``size`` (px) and its viewBox scaled alike, from
+    its origin: content keeps its scale, the canvas grows or shrinks to the right and
+    bottom."""
+    (w, h), (w0, h0) = size, before
+    if not all(v > 0 and np.isfinite(v) for v in (w, h, w0, h0)):
+        raise VecfitError(f"cannot set the canvas to {w}x{h}")
+    box = parse_viewbox(root.get("viewBox"))
+    if box is not None and box[2] > 0 and box[3] > 0:
+        x, y, bw, bh = box
+        root.set("viewBox", f"{fmt(x)} {fmt(y)} {fmt(bw * w / w0)} {fmt(bh * h / h0)}")
+    root.set("width", fmt(w))
+    root.set("height", fmt(h))
 
 
 def _add_background(root, color) -> None:

@@ -1,0 +1,54 @@
+"""Settings of `vecfit edit` ([edit] in configs/edit.toml) and `vecfit retarget`
+([retarget] in configs/retarget.toml)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from vecfit.errors import VecfitError
+
+
+@dataclass
+class EditSettings:
+    changed_weight: float = 10.0  # loss weight of a changed pixel (an unchanged one: 1)
+    anchor: float = 100.0         # penalty on changing what acts only outside the changed region
+    anchor_free: float = 10.0      # ... and lengths acting inside it (see vecfit.fitting.anchor)
+    anchor_free_colors: float = 100.0  # ... and colours acting inside it
+    threshold: float = 0.1        # a pixel changed where a channel differs by more than this
+    min_area: int = 4             # changed specks smaller than this (pixels) are no edit
+    grow: int = 2                 # the changed region grown by this many pixels
+    reach: int = 2                # elements acting this close to the changed region are free
+
+    def check(self) -> None:
+        for name in ("changed_weight", "anchor", "anchor_free", "anchor_free_colors", "threshold"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise VecfitError(f"edit.{name} must be a number >= 0, not {value}")
+        if self.changed_weight < 1:
+            raise VecfitError(f"edit.changed_weight must be at least 1, not {self.changed_weight}")
+        if self.threshold >= 1:
+            raise VecfitError(f"edit.threshold must be below 1, not {self.threshold}")
+        for name in ("min_area", "grow", "reach"):
+            if getattr(self, name) < 0:
+                raise VecfitError(f"edit.{name} must be 0 or more, not {getattr(self, name)}")
+
+
+@dataclass
+class RetargetSettings:
+    steps: int = 6                 # carve-and-fit rounds
+    iterations_per_step: int = 40  # Adam iterations fitting each round's carved image
+    final_iterations: int = 60     # more at the end, against the last carved image
+    work_size: int = 512           # carve and fit at this longest side (0: the SVG's size)
+    foreground: float = 1.0        # seam energy added per pixel unlike the bare canvas
+
+
+    def check(self) -> None:
+        if self.steps < 1:
+            raise VecfitError(f"retarget.steps must be at least 1, not {self.steps}")
+        for name in ("iterations_per_step", "final_iterations", "work_size"):
+            if getattr(self, name) < 0:
+                raise VecfitError(f"retarget.{name} must be 0 or more, not {getattr(self, name)}")
+        if not (math.isfinite(self.foreground) and self.foreground >= 0):
+            raise VecfitError(f"retarget.foreground must be a number >= 0, not {self.foreground}")
+        if 0 < self.work_size < 32:
+            raise VecfitError(f"retarget.work_size must be 0 or at least 32, not {self.work_size}")

@@ -1,0 +1,201 @@
+"""`vecfit edit` (Li et al. 2020, section 6.2): an edit made on the raster render of an SVG
+brought back into the SVG. The SVG's own parameters are fitted to the edited image with
+the shared loop, the changed region weighted in the loss and a penalty on moving the
+parameters that act only outside it; the SVG keeps its elements, ids and groups."""
+from __future__ import annotations
+
+import math
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from vecfit import __version__
+from vecfit.editing.mask import changed_region, grown, load_mask
+from vecfit.editing.settings import EditSettings
+from vecfit.errors import VecfitError
+from vecfit.fitting.anchor import acting_on, anchors
+from vecfit.fitting.loop import Settings, Target, optimize
+from vecfit.fitting.metrics import compare, to_rgb
+from vecfit.fitting.rates import learning_rate_scales
+from vecfit.io.images import downscaled, downscaled_weight
+from vecfit.io.report import error_map, panels_image, save_panels, save_report
+from vecfit.renderer import device as devices
+from vecfit.renderer.scene import Scene
+from vecfit.svg.numbers import hex_color
+from vecfit.svg.read import load_svg
+from vecfit.svg.write import write_svg
+
+from .config import settings_of
+from .fit import Outputs, _render_full, background_for, load_target
+
+MOVED_PX = 0.1        # an element counts as changed when a length moved this many pixels
+RECOLOURED = 1.5 / 255  # ... or a colour channel more than a step of #rrggbb
+
+
+def fit_canvas(scene: Scene, image: np.ndarray, svg_path, image_path) -> None:
+    """The image must be the SVG's canvas at some scale (to a pixel either way). The scene's
+    canvas is then set to the image's size at one scale, taken from the longer side: a
+    renderer asked for a width rounds the height (resvg up, `vecfit render` to the
+    nearest), and fitting the image stretched to the canvas would move every shape by up
+    to half a pixel. The written SVG keeps its own size."""
+    h, w = image.shape[:2]
+    if scene.width <= 0 or scene.height <= 0:
+        raise VecfitError(f"{svg_path}: the SVG has no size")
+    expected_h = scene.height * w / scene.width
+    expected_w = scene.width * h / scene.height
+    if abs(h - expected_h) > 1 and abs(w - expected_w) > 1:
+        raise VecfitError(f"{image_path} is {w}x{h} pixels, which is not the canvas of {svg_path} "
+                          f"({scene.width:g}x{scene.height:g}) at any scale (at width {w} it would "
+                          f"be {w}x{round(expected_h)})")
+    scale = w / scene.width if scene.width >= scene.height else h / scene.height
+    scene.width, scene.height = w / scale, h / scale
+
+
+def seen(rgba: np.ndarray, background) -> np.ndarray:
+    """The channels the loss compares (loop.Target.compared): RGB over an opaque background,
+    else premultiplied RGBA."""
+    a = rgba[..., 3:]
+    if background is not None:
+        return rgba[..., :3] * a + np.asarray(background[:3], np.float32) * (1 - a)
+    return np.concatenate([rgba[..., :3] * a, a], axis=2)
+
+
+def region_psnr(result: np.ndarray, target: np.ndarray, region: np.ndarray) -> float | None:
+    """PSNR (dB) over the pixels of ``region`` (None where it has none; inf for a match)."""
+    if not region.any():
+        return None
+    mse = float(np.mean((result[region] - target[region]) ** 2))
+    return math.inf if mse == 0 else 10 * math.log10(1 / mse)
+
+
+def changed_elements(scene: Scene, before: dict, width: int, height: int) -> list[dict]:
+    """The shapes whose values moved: their element, the largest move of a length in
+    pixels of the full-size image and the largest change of a colour channel (0-255)."""
+    units = learning_rate_scales(scene, width, height)  # units per pixel
+    out = []
+    for shape in scene.shapes:
+        moved = recoloured = 0.0
+        for kind, tensors in Scene(scene.width, scene.height, [shape]).parameters().items():
+            for t in tensors:
+                if id(t) not in before:
+                    continue
+                delta = float((t.detach() - before[id(t)]).abs().max()) if t.numel() else 0.0
+                if kind == "colors":
+                    recoloured = max(recoloured, delta)
+                elif id(t) in units:
+                    moved = max(moved, delta / units[id(t)])
+        if moved > MOVED_PX or recoloured > RECOLOURED:
+            out.append({"element": shape.source, "moved_px": round(moved, 3),
+                        "color_change": round(recoloured * 255, 2)})
+    return out
+
+
+def run(edited_path, svg_path, config: dict, outputs: Outputs, progress=None, mask=None) -> dict:
+    """`vecfit edit`: fit SVG_PATH to EDITED_PATH, changing as little as it can outside the
+    changed region (computed, or ``mask``, a PNG where white marks it). Writes the SVG, the
+    comparison picture (original | edited | result | difference) and the report (last)."""
+    started = time.perf_counter()
+    edited_path, svg_path = Path(edited_path), Path(svg_path)
+    outputs.check_against(edited_path, svg_path, mask)
+    outputs.report.unlink(missing_ok=True)  # a report marks a finished run
+    target = load_target(edited_path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        scene = load_svg(svg_path)
+    if not scene.shapes:
+        raise VecfitError(f"{svg_path}: the SVG has no shapes to optimise")
+    fit_canvas(scene, target, svg_path, edited_path)
+    edit = settings_of(EditSettings, config["edit"])
+    edit.check()
+    opt = {**config["optimize"], "device": devices.device_name(devices.resolve(config["optimize"]["device"]))}
+    settings = Settings.from_config(opt)
+    kinds = [k for k, v in scene.parameters().items() if v and settings.lr.get(k, 0) > 0]
+    if not kinds:
+        raise VecfitError(f"{svg_path}: nothing to optimise (no parameter kind has a learning rate above 0)")
+    background = background_for(target, opt["background"])
+    h, w = target.shape[:2]
+
+    original_image = _render_full(scene, w, h, opt).numpy()
+    if mask is not None:
+        region = load_mask(mask, (w, h))
+    else:
+        region = changed_region(seen(original_image, background), seen(target, background),
+                                edit.threshold, edit.min_area, edit.grow)
+    if not region.any():
+        raise VecfitError(f"{edited_path} does not differ from the render of {svg_path}"
+                          + (f" inside {mask}" if mask is not None else
+                             f" (no pixel changed by more than {edit.threshold:g}): nothing to edit"))
+
+    small = downscaled(target, opt["max_size"])
+    sh, sw = small.shape[:2]
+    weight = downscaled_weight(np.where(region, edit.changed_weight, 1.0).astype(np.float32), (sh, sw))
+    region_small = downscaled_weight(region.astype(np.float32), (sh, sw)) > 0
+    reach = max(0, round(edit.reach * sh / h))
+    free = acting_on(scene, grown(region_small, reach), kinds, samples=settings.samples,
+                     seed=settings.seed, threads=settings.threads, background=background,
+                     device=opt["device"])
+    penalty = anchors(scene, free, kinds, edit.anchor, edit.anchor_free, edit.anchor_free_colors, sw, sh,
+                      3 if background is not None else 4)
+    before = {id(t): t.detach().clone() for k in kinds for t in scene.parameters()[k]}
+
+    goal = Target(torch.from_numpy(small), background, torch.from_numpy(weight))
+    result = optimize(scene, goal, settings, progress=progress, penalty=penalty)
+    final_image = original_image if result.iterations == 0 else _render_full(scene, w, h, opt).numpy()
+
+    target_rgb = to_rgb(target, background)
+    original_rgb, final_rgb = to_rgb(original_image, background), to_rgb(final_image, background)
+    initial, final = compare(original_rgb, target_rgb), compare(final_rgb, target_rgb)
+    if not all(math.isfinite(final[k]) or (k == "psnr" and final["mse"] == 0) for k in final):
+        raise VecfitError(f"the optimised image has non-finite values ({final}); nothing written")
+    changed = changed_elements(scene, before, w, h)
+
+    # The SVG keeps its elements: no background rect is added (an uncovered canvas stays
+    # transparent, which over the background looks as optimised).
+    write_svg(scene, svg_path, outputs.svg)
+    save_panels(outputs.comparison, panels_image(
+        [original_rgb, target_rgb, final_rgb, error_map(final_rgb, target_rgb)]))
+    seconds = time.perf_counter() - started
+    report = {
+        "vecfit": __version__,
+        "command": "edit",
+        "target": str(edited_path),
+        "init": str(svg_path),
+        "mask": None if mask is None else str(mask),
+        "output": str(outputs.svg),
+        "comparison": str(outputs.comparison),
+        "report": str(outputs.report),
+        "size": [w, h],
+        "optimized_size": [sw, sh],
+        "background": None if background is None else hex_color(background),
+        "changed_region": {"pixels": int(region.sum()), "fraction": float(region.mean()),
+                           "from": "mask" if mask is not None else "renders"},
+        "initial": initial,
+        "optimized": final,
+        "psnr_gain_db": final["psnr"] - initial["psnr"],
+        "psnr_inside": {"before": region_psnr(original_rgb, target_rgb, region),
+                        "after": region_psnr(final_rgb, target_rgb, region)},
+        "psnr_outside": {"before": region_psnr(original_rgb, target_rgb, ~region),
+                         "after": region_psnr(final_rgb, target_rgb, ~region)},
+        "elements": {"total": len(scene.shapes), "changed": changed,
+                     "unchanged": len(scene.shapes) - len(changed)},
+        "parameters_free": penalty.free,        # act on the changed region
+        "parameters_anchored": penalty.anchored,  # held by the penalty
+        "iterations": result.iterations,
+        "coarse_iterations": result.coarse_iterations,
+        "interrupted": result.interrupted,
+        "skipped_steps": result.skipped_steps,
+        "seconds": {"total": seconds, "optimize": result.seconds,
+                    "per_iteration": result.seconds / max(result.iterations, 1)},
+        "shapes": len(scene.shapes),
+        "parameters": {**result.parameters, "total": sum(result.parameters.values())},
+        "loss": settings.loss,
+        "loss_curve": result.losses,
+        "seed": opt["seed"],
+        "device": opt["device"],
+        "config": config,
+    }
+    save_report(outputs.report, report)
+    return report

@@ -1,0 +1,200 @@
+"""`vecfit retarget` (Li et al. 2020, section 6.2): content-aware resizing of a vector
+graphic. The SVG's render (at ``work_size``) is seam-carved to the new size; the seams are
+divided into rounds, and each round moves the SVG's points as its seams move the pixels
+under them (a point's x goes left by the seams removed to its left in its row), narrows
+the canvas and fits the points, colours and widths to that round's carved image with the
+shared loop. The SVG keeps every element, id and group; its width, height and viewBox
+take the new size.
+
+The seams are found on the render of the input, carved one after another (each on what
+the previous left), not on each round's fitted render: the targets stay crisp, and a
+round's fit cannot steer later seams into content it blurred."""
+from __future__ import annotations
+
+import math
+import re
+import time
+import warnings
+from pathlib import Path
+
+import cv2
+import numpy as np
+import torch
+
+from vecfit import __version__
+from vecfit.editing.points import carve_points
+from vecfit.editing.seams import carve, foreground, remove_seam
+from vecfit.editing.settings import RetargetSettings
+from vecfit.errors import VecfitError
+from vecfit.fitting.loop import Settings, Target, optimize
+from vecfit.fitting.metrics import compare, to_rgb
+from vecfit.io.report import save_panels, save_report, side_by_side
+from vecfit.renderer import device as devices
+from vecfit.renderer.raster import render
+from vecfit.svg.numbers import hex_color
+from vecfit.svg.read import load_svg
+from vecfit.svg.write import write_svg
+
+from .config import settings_of
+from .edit import seen
+from .fit import Outputs, background_for
+
+MIN_SIDE = 11
+_SIZE = re.compile(r"\s*(\d+(?:\.\d*)?|\.\d+)\s*(%|px)?\s*$")
+
+
+def parse_size(text, native: float, name: str) -> float:
+    """'120' or '120px' (pixels) or '65%' (of ``native``) -> pixels."""
+    m = _SIZE.match(str(text))
+    if not m:
+        raise VecfitError(f"{name} must be pixels (120, 120px) or a percentage (65%), not {text!r}")
+    value = float(m.group(1))
+    return value * native / 100 if m.group(2) == "%" else value
+
+
+def _rounds(total: int, steps: int) -> list[int]:
+    """``total`` seams divided into at most ``steps`` rounds, as evenly as can be."""
+    steps = max(1, min(steps, total))
+    return [total // steps + (1 if i < total % steps else 0) for i in range(steps)] if total else []
+
+
+def run(svg_path, config: dict, outputs: Outputs, progress=None, width=None, height=None) -> dict:
+    """`vecfit retarget`: writes the resized SVG, the comparison picture (input | plain
+    scaling | retargeted) and the report (last)."""
+    started = time.perf_counter()
+    svg_path = Path(svg_path)
+    outputs.check_against(svg_path)
+    outputs.report.unlink(missing_ok=True)  # a report marks a finished run
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        scene = load_svg(svg_path)
+    if not scene.shapes:
+        raise VecfitError(f"{svg_path}: the SVG has no shapes to optimise")
+    w0, h0 = scene.width, scene.height
+    if not (w0 > 0 and h0 > 0):
+        raise VecfitError(f"{svg_path}: the SVG has no size")
+    new_w = parse_size(width, w0, "--width") if width is not None else w0
+    new_h = parse_size(height, h0, "--height") if height is not None else h0
+    if new_w > w0 + 0.5 or new_h > h0 + 0.5:
+        raise VecfitError(f"{svg_path} is {w0:g}x{h0:g}: retarget removes seams, it cannot enlarge "
+                          f"to {new_w:g}x{new_h:g}")
+    if min(new_w, new_h) < MIN_SIDE:
+        raise VecfitError(f"{new_w:g}x{new_h:g} is too small (at least {MIN_SIDE}x{MIN_SIDE} pixels)")
+    if round(new_w) == round(w0) and round(new_h) == round(h0):
+        raise VecfitError(f"{svg_path} is already {w0:g}x{h0:g}: nothing to retarget")
+    retarget = settings_of(RetargetSettings, config["retarget"])
+    retarget.check()
+    opt = {**config["optimize"], "device": devices.device_name(devices.resolve(config["optimize"]["device"]))}
+    settings = Settings.from_config(opt)
+    if not any(v and settings.lr.get(k, 0) > 0 for k, v in scene.parameters().items()):
+        raise VecfitError(f"{svg_path}: nothing to optimise (no parameter kind has a learning rate above 0)")
+
+    # Work at one scale s (pixels of the working image per pixel of the canvas).
+    s = retarget.work_size / max(w0, h0) if retarget.work_size > 0 else 1.0
+    ww, wh = max(1, round(w0 * s)), max(1, round(h0 * s))
+    s_x, s_y = ww / w0, wh / h0
+
+    def draw(w, h, samples):
+        with torch.no_grad():
+            return render(scene, w, h, samples=samples, seed=opt["seed"], threads=opt["threads"],
+                          device=opt["device"]).numpy()
+
+    original = draw(ww, wh, opt["eval_samples"])
+    background = background_for(original, opt["background"])
+    goal_w, goal_h = min(ww, max(1, round(new_w * s_x))), min(wh, max(1, round(new_h * s_y)))
+    # Vertical seams first (width), then horizontal ones (height, on the transposed image).
+    empty = seen(np.zeros((1, 1, 4), np.float32), background)[0, 0]  # the bare canvas
+    look = seen(original, background)
+    carved_w, seams_w = carve(original, ww - goal_w, seen=look,
+                              salience=retarget.foreground * foreground(look, empty))
+    look = seen(carved_w, background).transpose(1, 0, 2)
+    _, seams_h = carve(carved_w.transpose(1, 0, 2), wh - goal_h, seen=look,
+                       salience=retarget.foreground * foreground(look, empty))
+    plan = [(0, chunk) for chunk in _rounds(len(seams_w), retarget.steps)]
+    plan += [(1, chunk) for chunk in _rounds(len(seams_h), retarget.steps)]
+
+    loop = Settings(**{**settings.__dict__, "iterations": retarget.iterations_per_step})
+    cur_w, cur_h = ww, wh
+    image = original
+    used = {0: 0, 1: 0}
+    losses, interrupted, skipped, iterations = [], False, 0, 0
+    for axis, count in plan:
+        seams = (seams_w if axis == 0 else seams_h)[used[axis]:used[axis] + count]
+        used[axis] += count
+        carve_points(scene, seams, cur_w, cur_h, axis)
+        image = _apply(image, seams, axis)
+        if axis == 0:
+            cur_w -= count
+        else:
+            cur_h -= count
+        scene.width, scene.height = cur_w / s_x, cur_h / s_y
+        result = optimize(scene, Target(torch.from_numpy(np.ascontiguousarray(image)), background), loop,
+                          progress=progress)
+        losses += result.losses
+        iterations += result.iterations
+        skipped += result.skipped_steps
+        if result.interrupted:
+            interrupted = True
+            break
+    if not interrupted and retarget.final_iterations > 0:
+        final_loop = Settings(**{**settings.__dict__, "iterations": retarget.final_iterations})
+        result = optimize(scene, Target(torch.from_numpy(np.ascontiguousarray(image)), background),
+                          final_loop, progress=progress)
+        losses += result.losses
+        iterations += result.iterations
+        skipped += result.skipped_steps
+        interrupted = result.interrupted
+
+    # The canvas: the new size exactly, unless Ctrl-C stopped at a round's size.
+    done = not interrupted
+    out_w, out_h = (new_w, new_h) if done else (cur_w / s_x, cur_h / s_y)
+    scene.width, scene.height = out_w, out_h
+    final = draw(cur_w, cur_h, opt["eval_samples"])
+    final_rgb, goal_rgb = to_rgb(final, background), to_rgb(image, background)
+    fit = compare(final_rgb, goal_rgb)
+    if not all(math.isfinite(fit[k]) or (k == "psnr" and fit["mse"] == 0) for k in fit):
+        raise VecfitError(f"the retargeted image has non-finite values ({fit}); nothing written")
+    write_svg(scene, svg_path, outputs.svg, canvas=(out_w, out_h))
+    original_rgb = to_rgb(original, background)
+    scaled_rgb = cv2.resize(original_rgb.astype(np.float32), (cur_w, cur_h), interpolation=cv2.INTER_AREA)
+    save_panels(outputs.comparison, side_by_side([original_rgb, scaled_rgb, final_rgb]))
+    plain = compare(scaled_rgb.astype(np.float64), goal_rgb) if scaled_rgb.shape == goal_rgb.shape else None
+    seconds = time.perf_counter() - started
+    report = {
+        "vecfit": __version__,
+        "command": "retarget",
+        "init": str(svg_path),
+        "output": str(outputs.svg),
+        "comparison": str(outputs.comparison),
+        "report": str(outputs.report),
+        "size_before": [w0, h0],
+        "size": [out_w, out_h],
+        "working_size": {"before": [ww, wh], "after": [cur_w, cur_h]},
+        "seams": {"vertical": used[0], "horizontal": used[1]},
+        "rounds": len(plan),
+        "background": None if background is None else hex_color(background),
+        # against the seam-carved render of the input (what was fitted): plain scaling of
+        # the input's render, and the retargeted SVG's render
+        "initial": plain,
+        "optimized": fit,
+        "shapes": len(scene.shapes),
+        "iterations": iterations,
+        "interrupted": interrupted,
+        "skipped_steps": skipped,
+        "seconds": {"total": seconds, "per_iteration": seconds / max(iterations, 1)},
+        "loss_curve": losses,
+        "seed": opt["seed"],
+        "device": opt["device"],
+        "config": config,
+    }
+    save_report(outputs.report, report)
+    return report
+
+
+def _apply(image: np.ndarray, seams: list, axis: int) -> np.ndarray:
+    """``image`` less ``seams`` (vertical for axis 0, horizontal for axis 1)."""
+    if axis == 1:
+        image = image.transpose(1, 0, 2)
+    for seam in seams:
+        image = remove_seam(image, seam)
+    return image.transpose(1, 0, 2) if axis == 1 else image
