@@ -1,17 +1,37 @@
 """vecfit: vectorize raster images and refine vector graphics against them.
 
-The public API: load_svg, render, the Scene and its parts, and the device queries."""
+The public API: load_svg, render, the Scene and its parts, and the device queries.
+They are imported on first use: importing vecfit (and so starting the command line)
+does not import torch, so that a Ctrl-C in the first second is handled by the command
+(exit 130) rather than interrupting an import."""
+from __future__ import annotations
+
+import importlib
+
 from .errors import SvgError, VecfitError
-from .renderer.device import cuda_device_count, has_cuda
-from .renderer.raster import render
-from .renderer.scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient, Rect,
-                             Scene, Shape, Solid)
 
 __version__ = "0.1.0"
 
 __all__ = ["Circle", "Ellipse", "Group", "LinearGradient", "Path", "RadialGradient", "Rect", "Scene",
            "Shape", "Solid", "SvgError", "VecfitError", "cuda_device_count", "has_cuda", "load_svg",
            "render", "__version__"]
+
+_LAZY = {"render": ".renderer.raster", "cuda_device_count": ".renderer.device",
+         "has_cuda": ".renderer.device",
+         **{name: ".renderer.scene" for name in ("Circle", "Ellipse", "Group", "LinearGradient", "Path",
+                                                 "RadialGradient", "Rect", "Scene", "Shape", "Solid")}}
+
+
+def __getattr__(name):
+    if name not in _LAZY:
+        raise AttributeError(f"module 'vecfit' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_LAZY[name], __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))
 
 
 def load_svg(path) -> Scene:

@@ -153,8 +153,8 @@ VF_HD void boundary_sample(const SceneView& sc, const TileView& bins, const Boun
         for (int i = 0; i < 4; ++i) delta[i] = c_in[i] - c_out[i];
     }
     if (delta[0] == 0 && delta[1] == 0 && delta[2] == 0 && delta[3] == 0) return;
-    int x0 = vmax(0, (int)std::floor(p.x - R)), x1 = vmin(W - 1, (int)std::floor(p.x + R));
-    int y0 = vmax(0, (int)std::floor(p.y - R)), y1 = vmin(H - 1, (int)std::floor(p.y + R));
+    int x0 = clamp_to_int(std::floor(p.x - R), 0, W), x1 = clamp_to_int(std::floor(p.x + R), -1, W - 1);
+    int y0 = clamp_to_int(std::floor(p.y - R), 0, H), y1 = clamp_to_int(std::floor(p.y + R), -1, H - 1);
     double total = 0;
     for (int py = y0; py <= y1; ++py)
         for (int px = x0; px <= x1; ++px) {

@@ -5,12 +5,15 @@
 #include <pybind11/stl.h>
 
 #include <atomic>
+#include <chrono>
+#include <future>
 #include <initializer_list>
 #include <stdexcept>
 #include <string>
 #include <utility>
 
 #include "backward/backward.h"
+#include "common/cancel.h"
 #include "common/phase_clock.h"
 #include "common/thread_pool.h"
 #include "forward/forward.h"
@@ -129,6 +132,26 @@ RenderOptions render_options(int width, int height, int samples, const std::stri
     return o;
 }
 
+// Runs the core's work on another thread and, every 50 ms, lets Python run its signal
+// handlers: a Ctrl-C cancels the work (the thread pool skips the tasks not started, see
+// common/cancel.h) and raises KeyboardInterrupt here, instead of waiting, deaf, for a
+// render that may take minutes. Called with the GIL held; releases it while waiting.
+template <class Work>
+void interruptible(Work&& work) {
+    std::future<void> done = std::async(std::launch::async, std::forward<Work>(work));
+    py::gil_scoped_release release;
+    while (done.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+        py::gil_scoped_acquire gil;
+        if (PyErr_CheckSignals() != 0) {
+            cancel_requested().store(true);
+            done.wait();
+            cancel_requested().store(false);
+            throw py::error_already_set();
+        }
+    }
+    done.get();  // the core's exceptions, rethrown here
+}
+
 PreparedScene timed_prepare(const SceneArrays& a) {
     PhaseTimer timer(PHASE_PREPARE);
     return prepare_scene(a);
@@ -143,12 +166,11 @@ py::array_t<float> render(const py::dict& scene, int width, int height, int samp
     o.brute_force = brute_force;
     py::array_t<float> image({height, width, 4});
     float* out = image.mutable_data();
-    {
-        py::gil_scoped_release release;
+    interruptible([&] {
         PreparedScene prepared = timed_prepare(a);
         if (device >= 0) gpu::render_forward(prepared, o, device, out);
         else render_forward(prepared, o, out);
-    }
+    });
     return image;
 }
 
@@ -165,8 +187,7 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
     if (image.size() != (py::ssize_t)width * height * 4 || d_image.size() != image.size())
         throw std::invalid_argument("image and its gradient must be height x width x 4");
     SceneGrads g;
-    {
-        py::gil_scoped_release release;
+    interruptible([&] {
         PreparedScene prepared = timed_prepare(a);
         // On the GPU when asked, unless a sample there needs longer lists than a thread
         // holds: then on the CPU. emulate_gpu_lists runs the CPU lanes with a GPU thread's
@@ -178,7 +199,7 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
             done = render_backward(prepared, a, o, image.data(), d_image.data(), boundary_density, g, &GPU_LISTS);
         if (fixed && !done) ++backward_fallbacks;
         if (!done) render_backward(prepared, a, o, image.data(), d_image.data(), boundary_density, g);
-    }
+    });
     auto out = [](const std::vector<double>& v, py::ssize_t cols) {
         py::array_t<float> arr({(py::ssize_t)(cols > 0 ? v.size() / cols : v.size()), cols});
         float* p = arr.mutable_data();
