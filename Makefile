@@ -6,7 +6,7 @@ STAMP := $(VENV)/.vecfit-installed
 # A CPU build of torch: an unpinned torch would pull gigabytes of CUDA packages.
 TORCH := torch==2.13.0
 
-.PHONY: install demo test bench gpu-carry clean
+.PHONY: install demo test fuzz sanitize bench gpu-carry clean
 
 install: $(STAMP)
 
@@ -26,6 +26,13 @@ demo: install
 
 test: install
 	$(PY) -m pytest -q
+
+# A long fuzzing campaign (tests/fuzzing.py): N cases from SEED, a summary table; failures
+# are kept under tests/failures/fuzz/.
+N ?= 2000
+SEED ?= 1
+fuzz: install
+	$(PY) tests/fuzzing.py -n $(N) --seed $(SEED)
 
 bench: install
 	$(PY) benchmarks/render.py
