@@ -24,8 +24,11 @@ PHOTO = ROOT / "examples" / "chelsea.png"  # 240 x 160
 
 
 def start(*args, cwd):
+    # (SIGINT back to its default: a shell starts background jobs with it ignored, and
+    # Python then installs no handler, which would make these tests depend on how they run)
     return subprocess.Popen([sys.executable, "-m", "vecfit", *map(str, args)], cwd=cwd,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
 
 def finish(proc, timeout=60):

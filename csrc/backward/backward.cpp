@@ -7,6 +7,7 @@
 #include <optional>
 #include <vector>
 
+#include "common/cancel.h"
 #include "common/phase_clock.h"
 #include "common/thread_pool.h"
 
@@ -156,7 +157,7 @@ bool render_backward(const PreparedScene& prepared, const SceneArrays& a, const 
         SampleScratch w = lists.scratch();
         for (int tile = lane; tile < n_tiles; tile += lanes) {
             int tx = tile % bins.nx, ty = tile / bins.nx;
-            for (int y = ty * TILE; y < std::min(H, (ty + 1) * TILE); ++y)
+            for (int y = ty * TILE; y < std::min(H, (ty + 1) * TILE) && !cancelled(); ++y)
                 for (int x = tx * TILE; x < std::min(W, (tx + 1) * TILE); ++x)
                     pixel_backward(sc, bins, plan.options, plan.gpix.data() + 4 * ((size_t)y * W + x), x, y, w, g);
         }
@@ -170,7 +171,7 @@ bool render_backward(const PreparedScene& prepared, const SceneArrays& a, const 
             const GradView g = grads[lane].view();
             std::vector<Hit> hit_list(sizes.hits);  // (the boundary term needs no tape)
             Buffer<Hit> hits{hit_list.data(), (int)hit_list.size()};
-            for (size_t k = lane; k < plan.pieces.size(); k += lanes) {
+            for (size_t k = lane; k < plan.pieces.size() && !cancelled(); k += lanes) {
                 const Piece& pc = plan.pieces[k];
                 for (int j = 0; j < pc.count; ++j) boundary_sample(sc, bins, pass, pc, j, (uint64_t)k, plan.boundary, hits, g);
             }

@@ -12,4 +12,8 @@ inline std::atomic<bool>& cancel_requested() {
     return flag;
 }
 
+// Checked by the pool between tasks and by loops whose tasks are long (a row of pixels,
+// a boundary piece): a pathological tile can take seconds.
+inline bool cancelled() { return cancel_requested().load(std::memory_order_relaxed); }
+
 }  // namespace vf

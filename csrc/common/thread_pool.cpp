@@ -43,7 +43,7 @@ void ThreadPool::worker_loop(int id) {
         int n = n_tasks_;
         lock.unlock();
         for (int t; (t = next_.fetch_add(1)) < n;)
-            if (!cancel_requested().load(std::memory_order_relaxed)) (*job)(t, id);
+            if (!cancelled()) (*job)(t, id);
         lock.lock();
         if (--running_ == 0) done_.notify_all();
     }
@@ -54,7 +54,7 @@ void ThreadPool::parallel_for(int n, int threads, const std::function<void(int, 
     if (threads <= 0) threads = hardware_threads();
     threads = std::min(threads, n);
     if (threads == 1) {
-        for (int t = 0; t < n && !cancel_requested().load(std::memory_order_relaxed); ++t) fn(t, 0);
+        for (int t = 0; t < n && !cancelled(); ++t) fn(t, 0);
         return;
     }
     std::lock_guard<std::mutex> call(call_mutex_);
@@ -70,7 +70,7 @@ void ThreadPool::parallel_for(int n, int threads, const std::function<void(int, 
     }
     wake_.notify_all();
     for (int t; (t = next_.fetch_add(1)) < n;)
-        if (!cancel_requested().load(std::memory_order_relaxed)) fn(t, 0);
+        if (!cancelled()) fn(t, 0);
     std::unique_lock<std::mutex> lock(mutex_);
     done_.wait(lock, [&] { return running_ == 0 && next_ >= n; });
     job_ = nullptr;
