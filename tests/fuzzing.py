@@ -205,7 +205,8 @@ _NUMBER_RE = re.compile(rb"-?\d+(?:\.\d+)?(?:e-?\d+)?")
 def mutated_svg(rng: random.Random, seeds: list[Path]) -> bytes:
     data = seeds[rng.randrange(len(seeds))].read_bytes()
     for _ in range(rng.randint(1, 4)):
-        kind = rng.randrange(8)
+        # (truncation, byte flips and encodings mostly end at the XML parser: rarer)
+        kind = rng.choice([0, 0, 0, 3, 3, 5, 6, 6, 7, 1, 2, 4])
         if kind == 0:  # a number replaced by a hostile one
             matches = list(_NUMBER_RE.finditer(data))
             if matches:

@@ -150,3 +150,11 @@ def test_huge_arcs_load(tmp_path):
     scene = quiet_load(Path(__file__).parent / "hostile" / "arc-huge-numbers.svg")
     pts = torch.cat([t.detach().reshape(-1) for t in scene.parameters()["points"]])
     assert torch.isfinite(pts).all() and math.isfinite(float(np.abs(pts.numpy()).max()))
+
+
+def test_root_in_another_namespace_says_so(tmp_path):
+    """The fuzzer's mutation of xmlns gave "the root element is <svg>, not <svg>"."""
+    svg = tmp_path / "ns.svg"
+    svg.write_text('<svg xmlns="999http://www.w3.org/2000/svg" width="9" height="9"/>')
+    r = run("info", svg)
+    assert r.exit_code == 1 and "namespace '999http://www.w3.org/2000/svg', not SVG's" in r.stderr
