@@ -6,7 +6,7 @@ STAMP := $(VENV)/.vecfit-installed
 # A CPU build of torch: an unpinned torch would pull gigabytes of CUDA packages.
 TORCH := torch==2.13.0
 
-.PHONY: install demo test bench gpu-carry clean
+.PHONY: install demo test fuzz sanitize bench gpu-carry clean
 
 install: $(STAMP)
 
@@ -26,6 +26,30 @@ demo: install
 
 test: install
 	$(PY) -m pytest -q
+
+# A long fuzzing campaign (tests/fuzzing.py): N cases from SEED, a summary table; failures
+# are kept under tests/failures/fuzz/.
+N ?= 2000
+SEED ?= 1
+fuzz: install
+	$(PY) tests/fuzzing.py -n $(N) --seed $(SEED)
+
+# The core built with AddressSanitizer and UndefinedBehaviorSanitizer in its own folder,
+# then the core's tests, the conformance corpus and the fuzzer's quick run through it
+# (tests/sanitize/sitecustomize.py loads that build in place of the installed one; ASan
+# must be preloaded into Python, and leak checking is off: Python itself "leaks").
+SANITIZE_BUILD := build/sanitize
+SANITIZE_TESTS := tests/test_render_basics.py tests/test_degenerate.py tests/test_render_vs_reference.py \
+	tests/test_gradients.py tests/test_point_widths.py tests/test_golden.py tests/test_conformance.py \
+	tests/test_hostile.py tests/test_fuzz.py
+sanitize: install
+	$(PY) -m pip install -q pybind11
+	cmake -S . -B $(SANITIZE_BUILD) -DVECFIT_SANITIZE=ON -DCMAKE_BUILD_TYPE=Release \
+		-DPython_EXECUTABLE=$(abspath $(PY)) -Dpybind11_DIR=$$($(PY) -m pybind11 --cmakedir)
+	cmake --build $(SANITIZE_BUILD) -j
+	LD_PRELOAD="$$(gcc -print-file-name=libasan.so) $$(gcc -print-file-name=libubsan.so)" \
+	ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 PYTHONPATH=tests/sanitize \
+	VECFIT_CORE="$$(ls $(abspath $(SANITIZE_BUILD))/_core*.so)" $(PY) -m pytest -q -p no:cacheprovider $(SANITIZE_TESTS)
 
 bench: install
 	$(PY) benchmarks/render.py

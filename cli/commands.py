@@ -34,7 +34,30 @@ def _print_version(ctx, param, value):
     ctx.exit()
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+class _Main(click.Group):
+    """The command group. A Ctrl-C anywhere (while torch is imported, too) ends the
+    command with "interrupted" and exit code 130, as a shell expects, where click would
+    print "Aborted!" and exit 1."""
+
+    def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
+        if not standalone_mode:
+            return super().main(args, prog_name, complete_var, False, **extra)
+        try:
+            rv = super().main(args, prog_name, complete_var, False, **extra)
+        except KeyboardInterrupt:
+            rv = EXIT_INTERRUPTED
+        except click.exceptions.Abort as e:  # click's wrapping of Ctrl-C, or of end of input
+            rv = EXIT_INTERRUPTED if isinstance(e.__cause__, KeyboardInterrupt) else EXIT_FAILED
+        except click.ClickException as e:
+            e.show()
+            sys.exit(e.exit_code)
+        else:
+            sys.exit(rv if isinstance(rv, int) else 0)
+        _echo_err("interrupted" if rv == EXIT_INTERRUPTED else "Aborted!")
+        sys.exit(rv)
+
+
+@click.group(cls=_Main, context_settings={"help_option_names": ["-h", "--help"]})
 @click.option("--version", is_flag=True, expose_value=False, is_eager=True, callback=_print_version,
               help="Show the version and the compiled core's build, then exit.")
 def main():
@@ -53,7 +76,7 @@ def main():
               help="N: N x N samples per pixel.")
 @click.option("--mode", type=click.Choice(["mc", "analytic"]), default="mc", show_default=True,
               help="Anti-aliasing: Monte Carlo samples or the analytical prefilter.")
-@click.option("--filter", "filter_", type=click.Choice(["box", "tent", "gaussian"]), default="box",
+@click.option("--filter", "filter_", type=click.Choice(["box", "tent", "gaussian", "parabolic", "hann"]), default="box",
               show_default=True, help="Pixel filter.")
 @click.option("--filter-radius", type=click.FloatRange(min=0.5), default=0.5, show_default=True,
               help="Pixel filter radius in pixels (tent, gaussian).")

@@ -739,10 +739,10 @@ def test_deep_nesting_and_use_bombs_are_errors(tmp_path, monkeypatch):
     with pytest.raises(SvgError, match="nested too deeply"):
         load_svg(deep)
     import vecfit.svg.read as read
-    monkeypatch.setattr(read, "MAX_INSTANCED", 1000)
+    monkeypatch.setattr(read, "MAX_ELEMENTS", 1000)
     body = '<defs><rect id="a0" width="1" height="1"/>' + "".join(
         f'<g id="a{i}">' + f'<use href="#a{i - 1}"/>' * 10 + "</g>" for i in range(1, 5)) + "</defs>"
-    with pytest.raises(SvgError, match="expand to more than 1000"):
+    with pytest.raises(SvgError, match="expands to more than 1000"):
         load_svg(write(tmp_path, body + '<use href="#a4"/>'))
 
 

@@ -1,7 +1,15 @@
 """vecfit: vectorize raster images and refine vector graphics against them.
 
-The public API: load_svg, render, the Scene and its parts, and the device queries."""
+The public API: load_svg, render, render_batch, the Scene and its parts, and the device
+queries. They are imported on first use: importing vecfit (and so starting the command
+line) does not import torch, so that a Ctrl-C in the first second is handled by the
+command (exit 130) rather than interrupting an import."""
+from __future__ import annotations
+
+import importlib
 import os
+
+from .errors import SvgError, VecfitError
 
 # Before torch loads its OpenMP runtime: idle OpenMP threads sleep instead of spinning.
 # Spinning, they took a quarter of the CPU from the core's own threads between torch's
@@ -9,18 +17,28 @@ import os
 # them spinning, on 2 busy cores; see benchmarks/RESULTS.md). A user's own setting wins.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
-from .errors import SvgError, VecfitError
-from .renderer.device import cuda_device_count, has_cuda
-from .renderer.batch import render_batch
-from .renderer.raster import render
-from .renderer.scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient, Rect,
-                             Scene, Shape, Solid)
-
 __version__ = "0.1.0"
 
 __all__ = ["Circle", "Ellipse", "Group", "LinearGradient", "Path", "RadialGradient", "Rect", "Scene",
            "Shape", "Solid", "SvgError", "VecfitError", "cuda_device_count", "has_cuda", "load_svg",
            "render", "render_batch", "__version__"]
+
+_LAZY = {"render": ".renderer.raster", "render_batch": ".renderer.batch",
+         "cuda_device_count": ".renderer.device", "has_cuda": ".renderer.device",
+         **{name: ".renderer.scene" for name in ("Circle", "Ellipse", "Group", "LinearGradient", "Path",
+                                                 "RadialGradient", "Rect", "Scene", "Shape", "Solid")}}
+
+
+def __getattr__(name):
+    if name not in _LAZY:
+        raise AttributeError(f"module 'vecfit' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_LAZY[name], __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))
 
 
 def load_svg(path) -> Scene:

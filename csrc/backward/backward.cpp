@@ -7,6 +7,7 @@
 #include <optional>
 #include <vector>
 
+#include "common/cancel.h"
 #include "common/phase_clock.h"
 #include "common/thread_pool.h"
 
@@ -52,9 +53,15 @@ void pixel_adjoints(const RenderOptions& o, const float* image, const float* d_i
 // of length). A segment's length is its control polygon's, which exceeds its arc length
 // most where the speed along it varies most, i.e. where samples uniform in t are noisiest:
 // counting by arc length instead lost 0.05-0.25 dB on the demo (3 seeds).
-std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_) {
+//
+// A piece's count is capped at what its length inside the canvas can need (a cubic crosses
+// the canvas at most a few times: 4 (W + H) pixels of length): a segment 1e9 pixels long
+// would otherwise ask for billions of samples, nearly all off the canvas. The cap keeps the
+// estimate unbiased (each sample is weighted by length / count), only noisier there.
+std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_, int width, int height) {
     std::vector<Piece> out;
-    auto count = [&](double len) { return std::max(1, (int)std::ceil(density_ * len)); };
+    const double cap = std::ceil(density_ * 4.0 * ((double)width + height));
+    auto count = [&](double len) { return clamp_to_int(std::ceil(std::min(density_ * len, cap)), 1, 1 << 30); };
     for (int di = 0; di < (int)sc_.draws.size(); ++di) {
         const PreparedDraw& d = sc_.draws[di];
         if (!valid(d.box)) continue;
@@ -104,7 +111,7 @@ BackwardPlan plan_backward(const PreparedScene& prepared, const RenderOptions& o
     plan.bins = bin_draws(prepared, o.width, o.height, (o.mode == MODE_ANALYTIC ? 2 * R : R) + 4 * EPS_NORMAL, false);
     pixel_adjoints(o, image, d_image, plan.gpix);
     const SceneView sc = prepared.view();
-    if (o.mode == MODE_MC) plan.pieces = boundary_pieces(sc, boundary_density);
+    if (o.mode == MODE_MC) plan.pieces = boundary_pieces(sc, boundary_density, o.width, o.height);
     BoundaryContext& bc = plan.boundary;
     bc.width = o.width;
     bc.height = o.height;
@@ -160,7 +167,7 @@ bool render_backward(const PreparedScene& prepared, const SceneArrays& a, const 
         SampleScratch w = lists.scratch();
         for (int tile = lane; tile < n_tiles; tile += lanes) {
             int tx = tile % bins.nx, ty = tile / bins.nx;
-            for (int y = ty * TILE; y < std::min(H, (ty + 1) * TILE); ++y)
+            for (int y = ty * TILE; y < std::min(H, (ty + 1) * TILE) && !cancelled(); ++y)
                 for (int x = tx * TILE; x < std::min(W, (tx + 1) * TILE); ++x)
                     pixel_backward(sc, bins, plan.options, plan.gpix.data() + 4 * ((size_t)y * W + x), x, y, w, g);
         }
@@ -174,7 +181,7 @@ bool render_backward(const PreparedScene& prepared, const SceneArrays& a, const 
             const GradView g = grads[lane].view();
             std::vector<Hit> hit_list(sizes.hits);  // (the boundary term needs no tape)
             Buffer<Hit> hits{hit_list.data(), (int)hit_list.size()};
-            for (size_t k = lane; k < plan.pieces.size(); k += lanes) {
+            for (size_t k = lane; k < plan.pieces.size() && !cancelled(); k += lanes) {
                 const Piece& pc = plan.pieces[k];
                 for (int j = 0; j < pc.count; ++j) boundary_sample(sc, bins, pass, pc, j, (uint64_t)k, plan.boundary, hits, g);
             }

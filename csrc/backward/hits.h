@@ -24,8 +24,8 @@ struct Hit {
 };
 
 VF_HD int tile_of(const TileView& bins, Vec2 p) {
-    int tx = vclamp((int)std::floor(p.x / TILE), 0, bins.nx - 1);
-    int ty = vclamp((int)std::floor(p.y / TILE), 0, bins.ny - 1);
+    int tx = clamp_to_int(std::floor(p.x / TILE), 0, bins.nx - 1);
+    int ty = clamp_to_int(std::floor(p.y / TILE), 0, bins.ny - 1);
     return ty * bins.nx + tx;
 }
 

@@ -158,10 +158,11 @@ VF_HD bool boundary_support(Vec2 p, Vec2 outside, double R, int W, int H, Bounda
     if (!(o.x >= lo && o.x < W - lo && o.y >= lo && o.y < H - lo)) return false;
     s.at = {p.x + NUDGE, p.y + NUDGE};
     s.R = R;
-    s.x0 = vmax(0, (int)std::floor(s.at.x - R));
-    s.x1 = vmin(W - 1, (int)std::floor(s.at.x + R));
-    s.y0 = vmax(0, (int)std::floor(s.at.y - R));
-    s.y1 = vmin(H - 1, (int)std::floor(s.at.y + R));
+    // (clamped before the conversion: coordinates of 1e15 px and more overflow an int)
+    s.x0 = clamp_to_int(std::floor(s.at.x - R), 0, W);
+    s.x1 = clamp_to_int(std::floor(s.at.x + R), -1, W - 1);
+    s.y0 = clamp_to_int(std::floor(s.at.y - R), 0, H);
+    s.y1 = clamp_to_int(std::floor(s.at.y + R), -1, H - 1);
     return true;
 }
 

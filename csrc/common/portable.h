@@ -56,6 +56,13 @@ template <class T>
 VF_HD T vmax(T a, T b) { return a < b ? b : a; }
 template <class T>
 VF_HD T vclamp(T v, T lo, T hi) { return v < lo ? lo : (hi < v ? hi : v); }
+// A double as an int in [lo, hi]: converting a double outside int's range is undefined
+// (x86 gives INT_MIN), and scenes may hold coordinates of 1e30 pixels. NaN gives lo.
+VF_HD int clamp_to_int(double v, int lo, int hi) {
+    if (!(v > lo)) return lo;
+    if (!(v < hi)) return hi;
+    return (int)v;
+}
 template <class T>
 VF_HD void vswap(T& a, T& b) {
     T t = a;

@@ -1,5 +1,7 @@
 #include "common/thread_pool.h"
 
+#include "common/cancel.h"
+
 namespace vf {
 
 ThreadPool& ThreadPool::instance() {
@@ -40,7 +42,8 @@ void ThreadPool::worker_loop(int id) {
         const auto* job = job_;
         int n = n_tasks_;
         lock.unlock();
-        for (int t; (t = next_.fetch_add(1)) < n;) (*job)(t, id);
+        for (int t; (t = next_.fetch_add(1)) < n;)
+            if (!cancelled()) (*job)(t, id);
         lock.lock();
         if (--running_ == 0) done_.notify_all();
     }
@@ -51,7 +54,7 @@ void ThreadPool::parallel_for(int n, int threads, const std::function<void(int, 
     if (threads <= 0) threads = hardware_threads();
     threads = std::min(threads, n);
     if (threads == 1) {
-        for (int t = 0; t < n; ++t) fn(t, 0);
+        for (int t = 0; t < n && !cancelled(); ++t) fn(t, 0);
         return;
     }
     std::lock_guard<std::mutex> call(call_mutex_);
@@ -66,7 +69,8 @@ void ThreadPool::parallel_for(int n, int threads, const std::function<void(int, 
         ++generation_;
     }
     wake_.notify_all();
-    for (int t; (t = next_.fetch_add(1)) < n;) fn(t, 0);
+    for (int t; (t = next_.fetch_add(1)) < n;)
+        if (!cancelled()) fn(t, 0);
     std::unique_lock<std::mutex> lock(mutex_);
     done_.wait(lock, [&] { return running_ == 0 && next_ >= n; });
     job_ = nullptr;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "common/cancel.h"
 #include "common/phase_clock.h"
 #include "common/thread_pool.h"
 #include "forward/forward.h"
@@ -44,7 +45,7 @@ void render_forward(const PreparedScene& prepared, const RenderOptions& o, float
     PhaseTimer timer(PHASE_FORWARD);
     ThreadPool::instance().parallel_for(bins.nx * bins.ny, o.threads, [&](int tile, int) {
         int tx = tile % bins.nx, ty = tile / bins.nx;
-        for (int y = ty * TILE; y < std::min(H, (ty + 1) * TILE); ++y)
+        for (int y = ty * TILE; y < std::min(H, (ty + 1) * TILE) && !cancelled(); ++y)
             for (int x = tx * TILE; x < std::min(W, (tx + 1) * TILE); ++x)
                 pixel_forward(sc, bins, plan.options, plan.background, x, y, out + 4 * ((size_t)y * W + x));
     });

@@ -5,7 +5,9 @@
 #include <pybind11/stl.h>
 
 #include <atomic>
+#include <chrono>
 #include <exception>
+#include <future>
 #include <vector>
 #include <initializer_list>
 #include <stdexcept>
@@ -13,6 +15,7 @@
 #include <utility>
 
 #include "backward/backward.h"
+#include "common/cancel.h"
 #include "common/phase_clock.h"
 #include "common/thread_pool.h"
 #include "forward/forward.h"
@@ -133,6 +136,26 @@ RenderOptions render_options(int width, int height, int samples, const std::stri
     return o;
 }
 
+// Runs the core's work on another thread and, every 50 ms, lets Python run its signal
+// handlers: a Ctrl-C cancels the work (the thread pool skips the tasks not started, see
+// common/cancel.h) and raises KeyboardInterrupt here, instead of waiting, deaf, for a
+// render that may take minutes. Called with the GIL held; releases it while waiting.
+template <class Work>
+void interruptible(Work&& work) {
+    std::future<void> done = std::async(std::launch::async, std::forward<Work>(work));
+    py::gil_scoped_release release;
+    while (done.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+        py::gil_scoped_acquire gil;
+        if (PyErr_CheckSignals() != 0) {
+            cancel_requested().store(true);
+            done.wait();
+            cancel_requested().store(false);
+            throw py::error_already_set();
+        }
+    }
+    done.get();  // the core's exceptions, rethrown here
+}
+
 PreparedScene timed_prepare(const SceneArrays& a) {
     PhaseTimer timer(PHASE_PREPARE);
     return prepare_scene(a);
@@ -147,12 +170,11 @@ py::array_t<float> render(const py::dict& scene, int width, int height, int samp
     o.brute_force = brute_force;
     py::array_t<float> image({height, width, 4});
     float* out = image.mutable_data();
-    {
-        py::gil_scoped_release release;
+    interruptible([&] {
         PreparedScene prepared = timed_prepare(a);
         if (device >= 0) gpu::render_forward(prepared, o, device, out);
         else render_forward(prepared, o, out);
-    }
+    });
     return image;
 }
 
@@ -204,8 +226,7 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
     if (image.size() != (py::ssize_t)width * height * 4 || d_image.size() != image.size())
         throw std::invalid_argument("image and its gradient must be height x width x 4");
     SceneGrads g;
-    {
-        py::gil_scoped_release release;
+    interruptible([&] {
         PreparedScene prepared = timed_prepare(a);
         // On the GPU when asked, unless a sample there needs longer lists than a thread
         // holds: then on the CPU. emulate_gpu_lists runs the CPU lanes with a GPU thread's
@@ -217,7 +238,7 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
             done = render_backward(prepared, a, o, image.data(), d_image.data(), boundary_density, g, &GPU_LISTS);
         if (fixed && !done) ++backward_fallbacks;
         if (!done) render_backward(prepared, a, o, image.data(), d_image.data(), boundary_density, g);
-    }
+    });
     return grads_dict(g);
 }
 
@@ -257,15 +278,14 @@ py::array_t<float> render_batch(const py::list& scenes, int width, int height, i
     const size_t pixels = (size_t)width * height;
     py::array_t<float> images({(py::ssize_t)n, (py::ssize_t)height, (py::ssize_t)width, (py::ssize_t)4});
     float* out = images.mutable_data();
-    {
-        py::gil_scoped_release release;
+    interruptible([&] {
         for_each_scene(n, threads, [&](int b) {
             SceneArrays a = inputs[b].arrays();
             RenderOptions ob = o;
             ob.seed = seeds[b];
             render_forward(timed_prepare(a), ob, out + 4 * pixels * b);
         });
-    }
+    });
     return images;
 }
 
@@ -283,8 +303,7 @@ py::list render_grad_batch(const py::list& scenes, Array<float> images, Array<fl
     if (images.size() != (py::ssize_t)(4 * pixels * n) || d_images.size() != images.size())
         throw std::invalid_argument("images and their gradients must be batch x height x width x 4");
     std::vector<SceneGrads> grads(n);
-    {
-        py::gil_scoped_release release;
+    interruptible([&] {
         for_each_scene(n, threads, [&](int b) {
             SceneArrays a = inputs[b].arrays();
             RenderOptions ob = o;
@@ -292,7 +311,7 @@ py::list render_grad_batch(const py::list& scenes, Array<float> images, Array<fl
             render_backward(timed_prepare(a), a, ob, images.data() + 4 * pixels * b, d_images.data() + 4 * pixels * b,
                             boundary_density, grads[b]);
         });
-    }
+    });
     py::list out;
     for (const SceneGrads& g : grads) out.append(grads_dict(g));
     return out;

@@ -120,7 +120,7 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
         // 256 random strokes: forward 4x (256 px) to 7x (512 px) faster.
         double len = 0;
         for (int i = 0; i < s.degree; ++i) len += distance(s.p[i], s.p[i + 1]);
-        int pieces = s.degree == 1 ? 1 : std::clamp((int)std::ceil(len / 8.0), 1, 16);
+        int pieces = s.degree == 1 ? 1 : clamp_to_int(std::ceil(len / 8.0), 1, 16);
         for (int k = 0; k < pieces; ++k) {
             StrokeSegment ss;
             ss.t0 = (double)k / pieces;

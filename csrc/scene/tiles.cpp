@@ -20,10 +20,11 @@ TileRange tiles_of(const Box& b, double margin, const TileRange& clip) {
     if (!valid(b)) return r;
     double x0 = std::floor((b.x0 - margin) / TILE), x1 = std::floor((b.x1 + margin) / TILE);
     double y0 = std::floor((b.y0 - margin) / TILE), y1 = std::floor((b.y1 + margin) / TILE);
-    r.x0 = (int)std::max<double>(clip.x0, x0);
-    r.y0 = (int)std::max<double>(clip.y0, y0);
-    r.x1 = (int)std::min<double>(clip.x1, x1);
-    r.y1 = (int)std::min<double>(clip.y1, y1);
+    // (clamped as doubles: a box may lie 1e30 pixels away)
+    r.x0 = clamp_to_int(x0, clip.x0, clip.x1 + 1);
+    r.y0 = clamp_to_int(y0, clip.y0, clip.y1 + 1);
+    r.x1 = clamp_to_int(x1, clip.x0 - 1, clip.x1);
+    r.y1 = clamp_to_int(y1, clip.y0 - 1, clip.y1);
     return r;
 }
 
@@ -96,8 +97,8 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
         row_crossings.resize(h);
         for (int k = 0; k < d.n_items; ++k) {
             const PreparedSegment& s = sc.fill_items[d.first_item + k];
-            int r0 = std::max(range.y0, (int)std::ceil((s.box.y0 + bins.margin) / TILE));
-            int r1 = std::min(range.y1, (int)std::floor((s.box.y1 + bins.margin) / TILE));
+            int r0 = clamp_to_int(std::ceil((s.box.y0 + bins.margin) / TILE), range.y0, range.y1 + 1);
+            int r1 = clamp_to_int(std::floor((s.box.y1 + bins.margin) / TILE), range.y0 - 1, range.y1);
             for (int ty = r0; ty <= r1; ++ty) {
                 double y = ty * (double)TILE - bins.margin;
                 for (int j = 0; j + 1 < s.n_split; ++j) {

@@ -12,6 +12,7 @@ import torch
 from PIL import Image, UnidentifiedImageError
 
 from vecfit.errors import VecfitError
+from vecfit.limits import MAX_IMAGE_PIXELS
 
 
 def to_uint8(image: torch.Tensor | np.ndarray) -> np.ndarray:
@@ -60,13 +61,19 @@ def load_rgba(path: str | os.PathLike) -> np.ndarray:
         raise VecfitError(f"{path}: no such file")
     if path.is_dir():
         raise VecfitError(f"{path}: is a folder, not an image")
+    too_large = f"{path}: the image is larger than {MAX_IMAGE_PIXELS // 1_000_000} million pixels (the limit)"
     try:
         with Image.open(path) as im:
+            if im.width * im.height > MAX_IMAGE_PIXELS:  # from the header, before decoding
+                raise VecfitError(f"{path}: the image is {im.width}x{im.height} pixels; at most "
+                                  f"{MAX_IMAGE_PIXELS // 1_000_000} million pixels (the limit)")
             im.load()
             rgba = im.convert("RGBA")
+    except Image.DecompressionBombError:  # Pillow's own limit, met before ours
+        raise VecfitError(too_large) from None
     except UnidentifiedImageError:
         raise VecfitError(f"{path}: not an image file (or a format that cannot be read)") from None
-    except (OSError, ValueError, Image.DecompressionBombError) as e:
+    except (OSError, ValueError) as e:
         raise VecfitError(f"{path}: cannot read the image ({e})") from None
     return np.asarray(rgba, dtype=np.float32) / 255.0
 

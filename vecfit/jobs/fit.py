@@ -123,7 +123,7 @@ def generated_source(svg_text: str, name: str):
 # --------------------------------------------------------------------------- run
 
 def _render_full(scene, w, h, config) -> torch.Tensor:
-    """The scene at the target's size, without background (straight RGBA)."""
+    """The scene at w x h pixels, without background (straight RGBA)."""
     with torch.no_grad():
         return render(scene, w, h, samples=config["eval_samples"], seed=config["seed"],
                       threads=config["threads"], device=config["device"])
@@ -148,15 +148,17 @@ def fit_and_write(scene: Scene, source_svg, target: np.ndarray, config: dict, ou
     small = downscaled(target, opt["max_size"])
     sh, sw = small.shape[:2]
     goal = Target(torch.from_numpy(small), background)
-    target_rgb = to_rgb(target, background)  # (metrics of a transparent target: over white)
+    # Measured at the optimised size: a 12-megapixel photo's full-size renders, SSIM and
+    # comparison took a minute and 3 GB around a loop of seconds (--max-size 0: full size).
+    target_rgb = to_rgb(small, background)  # (metrics of a transparent target: over white)
 
     # Rendered bare and composited here (the same arithmetic as the core's background):
     # the alpha then also says whether the shapes cover the canvas.
-    initial_image = _render_full(scene, w, h, opt)
+    initial_image = _render_full(scene, sw, sh, opt)
     initial_rgb = to_rgb(initial_image.numpy(), background)
     initial = compare(initial_rgb, target_rgb)
     result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
-    final_image = initial_image if result.iterations == 0 else _render_full(scene, w, h, opt)
+    final_image = initial_image if result.iterations == 0 else _render_full(scene, sw, sh, opt)
     final_rgb = to_rgb(final_image.numpy(), background)
     final = compare(final_rgb, target_rgb)
     if not all(math.isfinite(final[k]) or (k == "psnr" and final["mse"] == 0) for k in final):
@@ -176,7 +178,7 @@ def fit_and_write(scene: Scene, source_svg, target: np.ndarray, config: dict, ou
         "comparison": str(outputs.comparison),
         "report": str(outputs.report),
         "size": [w, h],
-        "optimized_size": [sw, sh],
+        "optimized_size": [sw, sh],  # the metrics and the comparison picture are at this size
         "background": None if background is None else hex_color(background),
         "initial": initial,
         "optimized": final,

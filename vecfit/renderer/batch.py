@@ -16,10 +16,10 @@ import torch
 
 from vecfit import _core
 from vecfit.errors import VecfitError
+from vecfit.limits import MAX_PIXELS
 
 from . import device as devices
-from .raster import (FLOAT_INPUTS, MAX_PIXELS, background_rgba, check_options, packed_for_core,
-                     render)
+from .raster import FLOAT_INPUTS, background_rgba, check_options, packed_for_core, render
 from .scene import Scene
 from .stopwatch import add_core_phases, phase
 

@@ -11,6 +11,7 @@ import torch
 
 from vecfit import _core
 from vecfit.errors import NonFiniteScene, VecfitError
+from vecfit.limits import MAX_PIXELS
 
 from . import device as devices
 from .pack import pack_scene
@@ -19,19 +20,23 @@ from .stopwatch import add_core_phases, phase
 
 MODES = ("mc", "analytic")
 FILTERS = ("box", "tent", "gaussian", "parabolic", "hann")
-MAX_PIXELS = 64_000_000  # a float RGBA image of that size already takes 1 GB
 
 
 def output_size(scene: Scene, width: int | None, height: int | None) -> tuple[int, int]:
     """Pixel size to render at: the scene's own size, or the given width and/or height
-    (given only one, the other keeps the scene's aspect ratio, rounded to a pixel)."""
-    if width is None and height is None:
-        return max(1, round(scene.width)), max(1, round(scene.height))
-    if width is None:
-        width = max(1, round(height * scene.width / scene.height))
-    if height is None:
-        height = max(1, round(width * scene.height / scene.width))
-    return int(width), int(height)
+    (given only one, the other keeps the scene's aspect ratio, rounded to a pixel).
+    VecfitError for a scene without a finite positive size, or a size over MAX_PIXELS."""
+    sw, sh = float(scene.width), float(scene.height)
+    if not (0 < sw < math.inf and 0 < sh < math.inf):
+        raise VecfitError(f"the canvas size {sw:g} x {sh:g} is not a positive finite size")
+    w = float(sw if width is None and height is None else width if width is not None else height * sw / sh)
+    h = float(sh if width is None and height is None else height if height is not None else width * sh / sw)
+    if math.isfinite(w * h):
+        w, h = max(1.0, float(round(w))), max(1.0, float(round(h)))  # floats: printed with :g
+    if not w * h <= MAX_PIXELS:
+        raise VecfitError(f"{w:.10g} x {h:.10g} pixels is too large to render "
+                          f"(at most {MAX_PIXELS // 1_000_000} million pixels)")
+    return int(w), int(h)
 
 
 FLOAT_INPUTS = ("points", "point_widths", "ellipses", "draw_params", "brush_params", "stop_offsets",
@@ -147,9 +152,6 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     """
     check_options(samples, mode, filter, filter_radius)
     width, height = output_size(scene, width, height)
-    if width * height > MAX_PIXELS:
-        raise VecfitError(f"{width} x {height} pixels is too large to render "
-                          f"(at most {MAX_PIXELS // 1_000_000} million pixels)")
     background = background_rgba(background)
     structure, floats = packed_for_core(scene, width, height)
     settings = dict(width=width, height=height, samples=int(samples), mode=mode, filter=filter,

@@ -56,6 +56,9 @@ def read_root(path) -> ET.Element:
         raise SvgError(path, f"not valid XML ({e})") from None
     except Exception as e:  # expat's other complaints: encodings, entity limits, ...
         raise SvgError(path, f"cannot parse the XML ({e})") from None
-    if local_name(root.tag) != "svg" or not is_svg(root):
+    if local_name(root.tag) == "svg" and not is_svg(root):
+        namespace = root.tag[1:].split("}", 1)[0]
+        raise SvgError(path, f"the root element <svg> is in the namespace {namespace!r}, not SVG's ({SVG_NS})")
+    if local_name(root.tag) != "svg":
         raise SvgError(path, f"the root element is <{local_name(root.tag) or root.tag}>, not <svg>")
     return root

@@ -30,11 +30,13 @@ class Subpath:
 
 
 class PathDataError(ValueError):
-    """Path data with an error; ``subpaths`` holds what was read before it."""
+    """Path data with an error; ``subpaths`` holds what was read before it. ``too_long``:
+    the path has more segments than the limit it was read with."""
 
-    def __init__(self, subpaths):
+    def __init__(self, subpaths, too_long: bool = False):
         super().__init__("invalid path data")
         self.subpaths = subpaths
+        self.too_long = too_long
 
 
 class _Builder:
@@ -48,6 +50,7 @@ class _Builder:
         self.point = (0.0, 0.0)
         self.last_cubic_ctrl = None  # second control point of the previous C/S
         self.last_quad_ctrl = None   # control point of the previous Q/T
+        self.segments = 0
 
     def move(self, p):
         self.current = Subpath(points=[p])
@@ -64,6 +67,7 @@ class _Builder:
         self.last_cubic_ctrl = self.last_quad_ctrl = None
 
     def segment(self, degree, pts):
+        self.segments += 1
         self._open()
         self.current.points.extend(pts)
         self.current.degrees.append(degree)
@@ -98,12 +102,18 @@ class _Builder:
         return (2 * self.point[0] - ctrl[0], 2 * self.point[1] - ctrl[1])
 
 
-def parse_path_data(d: str) -> list[Subpath]:
+def parse_path_data(d: str, max_segments: int | None = None) -> list[Subpath]:
     """Subpaths of ``d`` (empty ones, a moveto alone, are dropped). Raises PathDataError,
-    carrying the subpaths read so far, at the first error."""
+    carrying the subpaths read so far, at the first error; with too_long set when ``d``
+    has more than ``max_segments`` segments."""
     b = _Builder()
     tokens = _TOKEN.findall(d or "")
     i, n = 0, len(tokens)
+    # Cheap bounds first: a path with more than 8 tokens (numbers and commands) per
+    # allowed segment is refused before it is built (movetos count, as they cost as much).
+    if max_segments is not None and n > 8 * (max_segments + 1):
+        raise PathDataError([], too_long=True)
+    budget = max_segments if max_segments is not None else math.inf
     cmd = None
     try:
         while i < n:
@@ -127,12 +137,16 @@ def parse_path_data(d: str) -> list[Subpath]:
                 args = [float(t) for t in tokens[i:i + count]]
                 i += count
             _apply(b, cmd, args)
+            if len(b.subpaths) + b.segments > budget:
+                raise PathDataError([], too_long=True)
             # After a moveto, further coordinate pairs are implicit linetos.
             if cmd == "M":
                 cmd = "L"
             elif cmd == "m":
                 cmd = "l"
-    except (ValueError, IndexError):
+    except PathDataError:
+        raise
+    except (ValueError, IndexError, OverflowError):
         raise PathDataError(_drop_empty(b.subpaths)) from None
     return _drop_empty(b.subpaths)
 
@@ -203,7 +217,7 @@ def _arc(b: _Builder, rx, ry, angle, large, sweep, end) -> None:
     x1p = cos_p * dx + sin_p * dy
     y1p = -sin_p * dx + cos_p * dy
     # Radii too small to reach the end point are scaled up (F.6.6).
-    lam = (x1p / rx) ** 2 + (y1p / ry) ** 2
+    lam = (x1p / rx) * (x1p / rx) + (y1p / ry) * (y1p / ry)  # (** raises on overflow)
     if lam > 1:
         s = math.sqrt(lam)
         rx, ry = rx * s, ry * s

@@ -20,6 +20,7 @@ from collections import Counter
 import numpy as np
 import torch
 
+from vecfit import limits
 from vecfit.errors import SvgError
 from vecfit.renderer.scene import Group, Scene, Shape
 
@@ -46,10 +47,13 @@ CAPS = ("butt", "round", "square")
 JOINS = {"miter": "miter", "miter-clip": "miter", "arcs": "miter", "round": "round",
          "bevel": "bevel"}
 DEFAULT_SIZE = 100.0  # resvg's size for a root with neither width/height nor viewBox
-# Elements drawn inside <use> instances: a guard against reference bombs (uses of groups
-# of uses ...) that would take hours and all memory. The file's own elements are bounded
-# by its size.
-MAX_INSTANCED = 100_000
+# Elements, counting what entities and <use> instances expand to: a guard against
+# reference and entity bombs (uses of groups of uses ..., entities of entities) that would
+# take hours and all memory. (Module-level names so that tests can lower them.)
+MAX_ELEMENTS = limits.MAX_ELEMENTS
+MAX_SEGMENTS = limits.MAX_SEGMENTS
+# Elements nested in each other (Python's recursion would fail around 300).
+MAX_NESTING = 200
 
 
 def load_svg(path) -> Scene:
@@ -64,7 +68,7 @@ def load_svg(path) -> Scene:
     try:
         scene = reader.read()
     except RecursionError:
-        raise SvgError(path, "elements nested too deeply") from None
+        raise SvgError(path, f"elements nested too deeply (at most {MAX_NESTING} levels)") from None
     reader.skips.warn(path)
     return scene
 
@@ -99,7 +103,11 @@ class Reader:
         self.skips = Skips()
         self.ids: dict[str, object] = {}
         self.parents: dict[int, object] = {}
-        for element in root.iter():
+        self._elements = 0  # elements walked so far, <use> instances included
+        self._segments = 0
+        for n, element in enumerate(root.iter()):
+            if n >= MAX_ELEMENTS:  # entity expansion can make millions from a small file
+                self._too_many_elements()
             i = element.get("id")
             if i is not None:
                 self.ids.setdefault(i, element)  # the first of duplicated ids wins
@@ -112,7 +120,6 @@ class Reader:
         self.shapes: list[Shape] = []
         self.groups: list[Group] = []
         self._styles: dict[int, dict] = {}
-        self._instanced = 0
 
     # --------------------------------------------------------------- document
 
@@ -131,6 +138,8 @@ class Reader:
         percentages refer to."""
         root = self.root
         vb = parse_viewbox(root.get("viewBox"))
+        if vb is not None and not all(math.isfinite(v) for v in vb):
+            raise SvgError(self.path, f"invalid viewBox {root.get('viewBox')!r} (not finite)")
         if vb is not None and (vb[2] <= 0 or vb[3] <= 0):
             raise SvgError(self.path, f"invalid viewBox {root.get('viewBox')!r} (zero or negative size)")
         # Percentages (the default 100%) have no outer viewport to refer to: as not given.
@@ -145,9 +154,16 @@ class Reader:
             w = h * vb[2] / vb[3] if vb else DEFAULT_SIZE
         elif h is None:
             h = w * vb[3] / vb[2] if vb else DEFAULT_SIZE
+        if not (limits.MIN_CANVAS <= w <= limits.MAX_CANVAS and limits.MIN_CANVAS <= h <= limits.MAX_CANVAS):
+            raise SvgError(self.path, f"the canvas is {w:g} x {h:g} px; each side must be between "
+                                      f"{limits.MIN_CANVAS:g} and {limits.MAX_CANVAS:g} px")
         view = view_transform(vb, w, h, root.get("preserveAspectRatio")) if vb else np.eye(3)
         viewport = (vb[2], vb[3]) if vb else (w, h)
         return float(w), float(h), view, viewport
+
+    def _too_many_elements(self):
+        raise SvgError(self.path, f"the SVG expands to more than {MAX_ELEMENTS} elements "
+                                  f"(entities or <use> references; the limit is {MAX_ELEMENTS})")
 
     def read(self) -> Scene:
         style = self.cascade.computed(self.root, None)
@@ -168,21 +184,21 @@ class Reader:
 
     # ------------------------------------------------------------------- walk
 
-    def _children(self, element, style, group, stack):
+    def _children(self, element, style, group, stack, depth=0):
+        if depth >= MAX_NESTING:
+            raise SvgError(self.path, f"elements nested too deeply (at most {MAX_NESTING} levels)")
         for child in element:
-            self._element(child, style, group, stack)
+            self._element(child, style, group, stack, depth + 1)
 
-    def _element(self, element, parent_style, group, stack):
+    def _element(self, element, parent_style, group, stack, depth=0):
         if not is_svg(element):
             return  # comments, and other namespaces (editor metadata)
         tag = local_name(element.tag)
         if tag in NOT_DRAWN:
             return
-        if stack:
-            self._instanced += 1
-            if self._instanced > MAX_INSTANCED:
-                raise SvgError(self.path, f"<use> references expand to more than "
-                                          f"{MAX_INSTANCED} elements")
+        self._elements += 1
+        if self._elements > MAX_ELEMENTS:
+            self._too_many_elements()
         if tag not in SHAPES and tag not in CONTAINERS and tag not in ("use", "svg", "switch"):
             self.skips.add(tag, _name(element))  # text, image, foreignObject, unknown, ...
             return
@@ -195,16 +211,16 @@ class Reader:
         self._note_layer_effects(element, style)
         if tag in CONTAINERS:
             g = self._group(transform, parse_opacity(style.get("opacity")), group, element)
-            self._children(element, style, g, stack)
+            self._children(element, style, g, stack, depth)
         elif tag == "switch":
             g = self._group(transform, parse_opacity(style.get("opacity")), group, element)
             child = _switch_choice(element)
             if child is not None:
-                self._element(child, style, g, stack)
+                self._element(child, style, g, stack, depth + 1)
         elif tag == "use":
-            self._use(element, style, transform, group, stack)
+            self._use(element, style, transform, group, stack, depth)
         elif tag == "svg":
-            self._nested_svg(element, element, style, transform, group, stack)
+            self._nested_svg(element, element, style, transform, group, stack, depth)
         else:
             self._shape(tag, element, style, transform, group)
 
@@ -225,7 +241,7 @@ class Reader:
 
     # ------------------------------------------------------------- references
 
-    def _use(self, element, style, transform, group, stack):
+    def _use(self, element, style, transform, group, stack, depth):
         name = _name(element)
         ref = href_id(element)
         target = self.ids.get(ref) if ref else None
@@ -245,11 +261,11 @@ class Reader:
             # The use's width and height, when given, set the viewport of the instance.
             target_style = self.cascade.computed(target, style)
             if (target_style.get("display") or "").strip() != "none":
-                self._nested_svg(target, element, target_style, None, g, stack)
+                self._nested_svg(target, element, target_style, None, g, stack, depth + 1)
         else:
-            self._element(target, style, g, stack)
+            self._element(target, style, g, stack, depth + 1)
 
-    def _nested_svg(self, element, sizer, style, transform, group, stack):
+    def _nested_svg(self, element, sizer, style, transform, group, stack, depth):
         """A nested <svg> or an instanced <symbol>: a group mapping its viewBox onto its
         viewport (width and height from ``sizer``, the element or the <use>)."""
         vw, vh = self.viewport
@@ -269,7 +285,7 @@ class Reader:
         if (style.get("overflow") or "hidden").strip() in ("hidden", "scroll"):
             self.skips.add("svg viewport clipping", _name(element))
         g = self._group(m, parse_opacity(style.get("opacity")), group, element)
-        self._children(element, style, g, stack)
+        self._children(element, style, g, stack, depth)
 
     def _style_at(self, element) -> dict:
         """Computed properties of any element, from its ancestors (for gradient stops)."""
@@ -285,8 +301,11 @@ class Reader:
     def _shape(self, tag, element, style, transform, group):
         name = _name(element)
         lim = Limiter()
-        reader = ShapeReader(self.viewport, lim)
+        reader = ShapeReader(self.viewport, lim, max_segments=MAX_SEGMENTS - self._segments)
         geometry = reader.build(tag, element)
+        self._segments += reader.segments
+        if reader.too_many_segments or self._segments > MAX_SEGMENTS:
+            raise SvgError(self.path, f"more than {MAX_SEGMENTS} path segments (the limit)")
         if reader.problem:
             self.skips.add(reader.problem, name)
         if geometry is None or (style.get("visibility") or "").strip() in ("hidden", "collapse"):

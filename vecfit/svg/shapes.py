@@ -37,18 +37,24 @@ class ShapeReader:
     """Builds geometry for one element; ``problem`` names what was wrong with it, if
     anything was (e.g. path data with an error, drawn up to the error)."""
 
-    def __init__(self, viewport: tuple[float, float], limiter: Limiter):
+    def __init__(self, viewport: tuple[float, float], limiter: Limiter, max_segments: int | None = None):
         vw, vh = viewport
         self.refs = {"x": vw, "y": vh, "r": math.sqrt((vw * vw + vh * vh) / 2)}
         self.lim = limiter
         self.problem: str | None = None
+        self.max_segments = max_segments  # paths with more are not built
+        self.too_many_segments = False
+        self.segments = 0  # of what was built (basic shapes count as 4)
 
     def length(self, element, name: str, axis: str, default=None):
         value = parse_length(element.get(name), self.refs[axis])
         return default if value is None else value
 
     def build(self, tag: str, element):
-        return getattr(self, "_" + tag)(element)
+        geometry = getattr(self, "_" + tag)(element)
+        if geometry is not None and not self.segments:
+            self.segments = 4
+        return geometry
 
     # ---------------------------------------------------------------- shapes
 
@@ -110,6 +116,9 @@ class ShapeReader:
     def _points(self, text: str) -> list[tuple[float, float]]:
         """Coordinate pairs up to the first invalid number (an odd one out is dropped)."""
         values = []
+        if self.max_segments is not None and text.count(",") + text.count(" ") > 4 * self.max_segments + 4:
+            self.too_many_segments = True  # far too many numbers: not worth reading
+            return values
         for item in _LIST_SPLIT.split(text.strip()):
             if not item:
                 continue
@@ -122,8 +131,11 @@ class ShapeReader:
 
     def _path(self, element):
         try:
-            subpaths = parse_path_data(element.get("d") or "")
+            subpaths = parse_path_data(element.get("d") or "", self.max_segments)
         except PathDataError as e:
+            if e.too_long:
+                self.too_many_segments = True
+                return None
             self.problem = "invalid path data"
             subpaths = e.subpaths
         return self._path_from(subpaths)
@@ -132,4 +144,8 @@ class ShapeReader:
         if not subpaths:
             return None
         points, degrees, table = to_arrays(subpaths)
+        self.segments = len(degrees)
+        if self.max_segments is not None and self.segments > self.max_segments:
+            self.too_many_segments = True
+            return None
         return Path(points=self.lim.tensor(points), degrees=degrees, subpaths=table)

@@ -1,0 +1,29 @@
+"""The resource limits vecfit enforces, in one place (the README's "Limits and
+guarantees" lists them). Inputs past a limit are refused with one line naming it, so that
+no input can make a command crash, hang or take all memory."""
+
+# Canvas: the root <svg>'s width and height in px. Beyond 1e7 px coordinates lose
+# float32 precision (vecfit.svg.units.LIMIT clamps numbers to the same range); below
+# 1e-3 px the scale to any pixel size overflows.
+MAX_CANVAS = 1e7
+MIN_CANVAS = 1e-3
+
+# A render: width x height pixels (a float RGBA image of that size is already 1 GB).
+MAX_PIXELS = 64_000_000
+
+# Elements of an SVG, counting what entities and <use> references expand to: a guard
+# against reference and entity bombs (a few kilobytes that expand to millions of elements).
+MAX_ELEMENTS = 100_000
+
+# Path segments in a whole scene (arcs count as the cubics they become). Rendering time
+# grows with the segments crossing each tile: 10^6 lines across a 64 px canvas ran past
+# 40 s; 99,000 take 57 s (mc) to 230 s (analytic) on 2 cores, the worst case allowed.
+MAX_SEGMENTS = 100_000
+
+# Groups with opacity nested in each other (each is composited as a layer); the core's
+# MAX_LAYER_DEPTH in csrc/scene/layers.h.
+MAX_LAYER_DEPTH = 64
+
+# Target images for refine, trace and paint (and batch): width x height pixels, checked
+# from the header before the pixels are decoded.
+MAX_IMAGE_PIXELS = 100_000_000
