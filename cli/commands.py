@@ -3,7 +3,9 @@ done by the vecfit package. Exit codes: 0 ok, 1 a runtime failure (some inputs c
 not be processed), 2 bad usage."""
 from __future__ import annotations
 
+import signal
 import sys
+import threading
 import time
 import warnings
 from pathlib import Path
@@ -34,10 +36,32 @@ def _print_version(ctx, param, value):
     ctx.exit()
 
 
+def _import_torch_holding_ctrl_c() -> None:
+    """Imports torch with Ctrl-C held back until the import is done, then raised as a
+    KeyboardInterrupt. Raised inside torch's own import, in its C++ module set-up, a
+    KeyboardInterrupt aborts the process (SIGABRT, "terminate called after throwing an
+    instance of 'pybind11::error_already_set'"), seen with a Ctrl-C 0.4 s after start."""
+    if "torch" in sys.modules or threading.current_thread() is not threading.main_thread():
+        return
+    pending = []
+    previous = signal.signal(signal.SIGINT, lambda *_: pending.append(True))
+    try:
+        import torch  # noqa: F401
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if pending:
+        raise KeyboardInterrupt
+
+
 class _Main(click.Group):
     """The command group. A Ctrl-C anywhere (while torch is imported, too) ends the
     command with "interrupted" and exit code 130, as a shell expects, where click would
     print "Aborted!" and exit 1."""
+
+    def invoke(self, ctx):
+        if not any(a in ("-h", "--help") for a in ctx.protected_args + ctx.args):
+            _import_torch_holding_ctrl_c()
+        return super().invoke(ctx)
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
         if not standalone_mode:
