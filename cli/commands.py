@@ -58,8 +58,12 @@ class _Main(click.Group):
     command with "interrupted" and exit code 130, as a shell expects, where click would
     print "Aborted!" and exit 1."""
 
+    def parse_args(self, ctx, args):
+        ctx.meta["vecfit.help"] = any(a in ("-h", "--help") for a in args)  # (help needs no torch)
+        return super().parse_args(ctx, args)
+
     def invoke(self, ctx):
-        if not any(a in ("-h", "--help") for a in ctx.protected_args + ctx.args):
+        if not ctx.meta.get("vecfit.help"):
             _import_torch_holding_ctrl_c()
         return super().invoke(ctx)
 
