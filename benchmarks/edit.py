@@ -9,7 +9,7 @@ Usage: python benchmarks/edit.py [--threads T] [--scenes cat,ice_cream,tiger]
 """
 from __future__ import annotations
 
-from common import ROOT, SCENES, resvg_rgb  # first: it sets the process up before torch loads
+from common import ROOT, SCENES, parse_sets, resvg_rgb  # first: it sets the process up before torch loads
 
 import argparse
 import math
@@ -38,21 +38,6 @@ CASES = {
     "ice_cream": (700, [(10, "#8a2be2"), (40, "#ff7f50"), (90, "#2e8b57")], 60, 6.0, 4.0),
     "tiger": (495, [(30, "#2060c0"), (120, "#30a050"), (200, "#c03070")], 150, 3.0, 2.0),
 }
-
-
-def parse_sets(items) -> dict:
-    out: dict = {}
-    for item in items:
-        key, _, value = item.partition("=")
-        *path, last = key.split(".")
-        d = out
-        for p in path:
-            d = d.setdefault(p, {})
-        try:
-            d[last] = int(value)
-        except ValueError:
-            d[last] = float(value) if value.replace(".", "", 1).replace("e-", "", 1).isdigit() else value
-    return out
 
 
 def main() -> None:

@@ -89,8 +89,10 @@ VF_HD void pixel_backward(const SceneView& sc, const TileView& bins, const Rende
     const int N = o.samples;
     const double R = o.filter_radius;
     uint64_t pixel = (uint64_t)y * o.width + x;
-    double wsum = 0;
-    for (int s = 0; s < N * N; ++s) {
+    // The weights' sum; the box filter's weights are all 1, so its sum needs no positions
+    // (which would cost more than the one sample interior_samples = 1 visits).
+    double wsum = o.filter == FILTER_BOX ? N * N : 0;
+    for (int s = 0; o.filter != FILTER_BOX && s < N * N; ++s) {
         double fx = ((s % N) + 0.5) / N, fy = ((s / N) + 0.5) / N;
         if (o.mode == MODE_MC) sample_position(o.seed, pixel, s, N, fx, fy);
         wsum += filter_weight(o.filter, R, R * (2 * fx - 1), R * (2 * fy - 1));

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import math
 import time
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -25,11 +24,10 @@ from vecfit.io.report import error_map, panels_image, save_panels, save_report
 from vecfit.renderer import device as devices
 from vecfit.renderer.scene import Scene
 from vecfit.svg.numbers import hex_color
-from vecfit.svg.read import load_svg
 from vecfit.svg.write import write_svg
 
 from .config import settings_of
-from .fit import Outputs, _render_full, background_for, load_target
+from .fit import Outputs, _render_full, background_for, load_scene_to_fit, load_target
 
 MOVED_PX = 0.1        # an element counts as changed when a length moved this many pixels
 RECOLOURED = 1.5 / 255  # ... or a colour channel more than a step of #rrggbb
@@ -102,11 +100,7 @@ def run(edited_path, svg_path, config: dict, outputs: Outputs, progress=None, ma
     outputs.check_against(edited_path, svg_path, mask)
     outputs.report.unlink(missing_ok=True)  # a report marks a finished run
     target = load_target(edited_path)
-    with warnings.catch_warnings():
-        warnings.simplefilter("always")
-        scene = load_svg(svg_path)
-    if not scene.shapes:
-        raise VecfitError(f"{svg_path}: the SVG has no shapes to optimise")
+    scene = load_scene_to_fit(svg_path)
     fit_canvas(scene, target, svg_path, edited_path)
     edit = settings_of(EditSettings, config["edit"])
     edit.check()

@@ -96,6 +96,17 @@ def background_for(image: np.ndarray, setting: str) -> tuple | None:
     return fitting_background(setting)
 
 
+def load_scene_to_fit(svg_path) -> Scene:
+    """The user's SVG as a Scene (its warnings shown every time), refused when it has no
+    shapes: what refine, edit and retarget start from."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        scene = load_svg(svg_path)
+    if not scene.shapes:
+        raise VecfitError(f"{svg_path}: the SVG has no shapes to optimise")
+    return scene
+
+
 def check_sizes(scene: Scene, target: np.ndarray, svg_path, target_path) -> None:
     h, w = target.shape[:2]
     if scene.width <= 0 or scene.height <= 0:

@@ -2,13 +2,9 @@
 vecfit.jobs.fit)."""
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 
-from vecfit.errors import VecfitError
-from vecfit.svg.read import load_svg
-
-from .fit import Outputs, check_sizes, fit_and_write, load_target
+from .fit import Outputs, check_sizes, fit_and_write, load_scene_to_fit, load_target
 
 
 def run(target_path, svg_path, config: dict, outputs: Outputs, progress=None) -> dict:
@@ -16,11 +12,7 @@ def run(target_path, svg_path, config: dict, outputs: Outputs, progress=None) ->
     target_path, svg_path = Path(target_path), Path(svg_path)
     outputs.check_against(target_path, svg_path)
     target = load_target(target_path)
-    with warnings.catch_warnings():
-        warnings.simplefilter("always")
-        scene = load_svg(svg_path)
-    if not scene.shapes:
-        raise VecfitError(f"{svg_path}: the SVG has no shapes to optimise")
+    scene = load_scene_to_fit(svg_path)
     check_sizes(scene, target, svg_path, target_path)
     return fit_and_write(scene, svg_path, target, config, outputs, progress,
                inputs={"command": "refine", "target": str(target_path), "init": str(svg_path)})

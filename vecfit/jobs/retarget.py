@@ -14,7 +14,6 @@ from __future__ import annotations
 import math
 import re
 import time
-import warnings
 from pathlib import Path
 
 import cv2
@@ -32,12 +31,11 @@ from vecfit.io.report import save_panels, save_report, side_by_side
 from vecfit.renderer import device as devices
 from vecfit.renderer.raster import render
 from vecfit.svg.numbers import hex_color
-from vecfit.svg.read import load_svg
 from vecfit.svg.write import write_svg
 
 from .config import settings_of
 from .edit import seen
-from .fit import Outputs, background_for
+from .fit import Outputs, background_for, load_scene_to_fit
 
 MIN_SIDE = 11
 _SIZE = re.compile(r"\s*(\d+(?:\.\d*)?|\.\d+)\s*(%|px)?\s*$")
@@ -65,11 +63,7 @@ def run(svg_path, config: dict, outputs: Outputs, progress=None, width=None, hei
     svg_path = Path(svg_path)
     outputs.check_against(svg_path)
     outputs.report.unlink(missing_ok=True)  # a report marks a finished run
-    with warnings.catch_warnings():
-        warnings.simplefilter("always")
-        scene = load_svg(svg_path)
-    if not scene.shapes:
-        raise VecfitError(f"{svg_path}: the SVG has no shapes to optimise")
+    scene = load_scene_to_fit(svg_path)
     w0, h0 = scene.width, scene.height
     if not (w0 > 0 and h0 > 0):
         raise VecfitError(f"{svg_path}: the SVG has no size")

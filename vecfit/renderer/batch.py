@@ -98,7 +98,4 @@ def render_batch(scenes: Sequence[Scene], width: int, height: int, *, samples: i
                     filter_radius=float(filter_radius), seeds=seeds, threads=int(threads or 0),
                     background=background_rgba(background))
     backward_settings = dict(boundary_density=float(boundary_samples), interior_samples=int(interior_samples))
-    if torch.is_grad_enabled() and any(t.requires_grad for t in floats):
-        return _RenderBatch.apply(settings, backward_settings, structures, *floats)
-    with torch.no_grad():
-        return _RenderBatch.apply(settings, backward_settings, structures, *floats)
+    return _RenderBatch.apply(settings, backward_settings, structures, *floats)  # (no graph without grads)
