@@ -239,4 +239,69 @@ VF_HD double monotone_root(const double* a, double value, double t0, double t1, 
     return t;
 }
 
+
+// Whether the crossing of a piece monotone in y (as in monotone_root: f0 and f1, the
+// values of y - value at t0 and t1, bracket zero) with the line y = value lies in
+// (x_lo, x_hi]; ax, ay: the power-basis coefficients of x(t) and y(t).
+// Why not monotone_root, then x: a Monte Carlo sample only needs the side of the
+// crossing, and samples lie pixels away from it far more often than within 1e-9 px of
+// it. The root is bracketed from both sides (Newton steps, each with two probes just
+// around its result), and x over the bracket [lo, hi] lies between x(lo) and x(hi) give
+// or take (hi - lo)^2 / 8 max|x''|; once that range lies on one side the answer is
+// known (typically after one or two steps, where the full solve took 4-5). Near the
+// crossing the answer is the solved root's, as before.
+VF_HD bool monotone_crossing_within(const double* ax, const double* ay, double value, double t0, double t1,
+                                    double f0, double f1, double x_lo, double x_hi) {
+    auto X = [&](double t) { return ((ax[3] * t + ax[2]) * t + ax[1]) * t + ax[0]; };
+    auto inside = [&](double x) { return x > x_lo && x <= x_hi; };
+    if (f0 == 0) return inside(X(t0));
+    if (f1 == 0) return inside(X(t1));
+    const double curve = 0.125 * vmax(std::fabs(2 * ax[2]), std::fabs(2 * ax[2] + 6 * ax[3]));
+    const double tol =
+        1e-11 * (std::fabs(ay[0]) + std::fabs(ay[1]) + std::fabs(ay[2]) + std::fabs(ay[3]) + std::fabs(value) + 1);
+    double lo = t0, hi = t1, f_lo = f0, x_at_lo = X(t0), x_at_hi = X(t1);
+    // Narrows the bracket to s (inside it); false where s is the root itself.
+    auto narrow = [&](double s, double fs) {
+        if (fs == 0) return false;
+        if ((fs < 0) == (f_lo < 0)) {
+            lo = s;
+            f_lo = fs;
+            x_at_lo = X(s);
+        } else {
+            hi = s;
+            x_at_hi = X(s);
+        }
+        return true;
+    };
+    double t = t0 + (t1 - t0) * f0 / (f0 - f1);
+    for (int it = 0; it < 40; ++it) {
+        double w = hi - lo, dev = curve * w * w;
+        double x_min = vmin(x_at_lo, x_at_hi) - dev, x_max = vmax(x_at_lo, x_at_hi) + dev;
+        if (x_min > x_lo && x_max <= x_hi) return true;
+        if (x_max <= x_lo || x_min > x_hi) return false;
+        double f = ((ay[3] * t + ay[2]) * t + ay[1]) * t + ay[0] - value;
+        if (std::fabs(f) <= tol || w <= 1e-14 || !narrow(t, f)) return inside(X(t));
+        double df = (3 * ay[3] * t + 2 * ay[2]) * t + ay[1];
+        double step = df != 0 ? -f / df : 0;
+        double next = t + step;
+        if (!(next > lo && next < hi)) {
+            t = 0.5 * (lo + hi);
+            continue;
+        }
+        // Probes an eighth of the step either side of the Newton point: once Newton
+        // converges they straddle the root, and the bracket shrinks to a quarter step.
+        double eta = 0.125 * std::fabs(step), a = next - eta, b = next + eta;
+        if (a > lo && b < hi) {
+            double fa = ((ay[3] * a + ay[2]) * a + ay[1]) * a + ay[0] - value;
+            if (!narrow(a, fa)) return inside(X(a));
+            if (b < hi) {
+                double fb = ((ay[3] * b + ay[2]) * b + ay[1]) * b + ay[0] - value;
+                if (!narrow(b, fb)) return inside(X(b));
+            }
+        }
+        t = next > lo && next < hi ? next : 0.5 * (lo + hi);
+    }
+    return inside(X(t));
+}
+
 }  // namespace vf

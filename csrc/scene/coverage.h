@@ -79,9 +79,23 @@ VF_HD int ray_crossings(const PreparedSegment& s, Vec2 p, double x_max = 1e300) 
             w += dir;
             continue;
         }
-        double t = monotone_root(s.ay, p.y, s.split[k], s.split[k + 1], ya - p.y, yb - p.y);
-        double x = ((s.ax[3] * t + s.ax[2]) * t + s.ax[1]) * t + s.ax[0];
-        if (x > p.x && x <= x_max) w += dir;
+        // The sub-piece at height p.y (on the piece's half-open range, as above).
+        const double* sy = s.sub_y[k];
+        int j = 0;
+        if (dir > 0) while (j + 1 < s.n_sub && sy[j + 1] <= p.y) ++j;
+        else while (j + 1 < s.n_sub && p.y < sy[j + 1]) ++j;
+        double fa = sy[j] - p.y, fb = sy[j + 1] - p.y;
+        if ((fa < 0) == (fb < 0) && fa != 0 && fb != 0) {  // cuts not monotone to rounding: the whole piece
+            if (monotone_crossing_within(s.ax, s.ay, p.y, s.split[k], s.split[k + 1], ya - p.y, yb - p.y, p.x, x_max))
+                w += dir;
+            continue;
+        }
+        if (s.sub_x1[k][j] <= p.x || s.sub_x0[k][j] > x_max) continue;
+        if (s.sub_x0[k][j] > p.x && s.sub_x1[k][j] <= x_max) {
+            w += dir;
+            continue;
+        }
+        if (monotone_crossing_within(s.ax, s.ay, p.y, s.sub_t(k, j), s.sub_t(k, j + 1), fa, fb, p.x, x_max)) w += dir;
     }
     return w;
 }

@@ -39,6 +39,32 @@ PreparedSegment prepare_segment(const Segment& s, const int32_t* idx) {
         Box b = seg_bbox(s, ps.split[k], ps.split[k + 1], tx, nx, nullptr, 0);  // (no y-extrema inside)
         ps.piece_x0[k] = b.x0;
         ps.piece_x1[k] = b.x1;
+        ps.n_sub = s.degree == 1 ? 1 : PreparedSegment::SUB;
+        for (int j = 0; j <= ps.n_sub; ++j) {
+            double t = ps.sub_t(k, j);
+            // the ends are the piece's own values, the cuts those monotone_crossing_within sees
+            ps.sub_y[k][j] = j == 0 ? ps.split_y[k] : j == ps.n_sub ? ps.split_y[k + 1] :
+                             ((ps.ay[3] * t + ps.ay[2]) * t + ps.ay[1]) * t + ps.ay[0];
+        }
+        // x ranges from the power basis (cheaper than de Casteljau; this runs on every
+        // call), widened as seg_bbox widens boxes so that rounding cannot shrink them.
+        auto X = [&](double t) { return ((ps.ax[3] * t + ps.ax[2]) * t + ps.ax[1]) * t + ps.ax[0]; };
+        double grow = 1e-9 * (1 + vmax(vmax(std::fabs(ps.box.x0), std::fabs(ps.box.x1)),
+                                       vmax(std::fabs(ps.box.y0), std::fabs(ps.box.y1))));
+        double x_next = X(ps.sub_t(k, 0));
+        for (int j = 0; j < ps.n_sub; ++j) {
+            double t0 = ps.sub_t(k, j), t1 = ps.sub_t(k, j + 1), x_first = x_next;
+            x_next = X(t1);
+            double lo = vmin(x_first, x_next), hi = vmax(x_first, x_next);
+            for (int i = 0; i < nx; ++i)
+                if (tx[i] > t0 && tx[i] < t1) {
+                    double x = X(tx[i]);
+                    lo = vmin(lo, x);
+                    hi = vmax(hi, x);
+                }
+            ps.sub_x0[k][j] = lo - grow;
+            ps.sub_x1[k][j] = hi + grow;
+        }
     }
     return ps;
 }
@@ -284,6 +310,7 @@ PreparedScene prepare_scene(const SceneArrays& a) {
         check(sc.layer_depth[l] < MAX_LAYER_DEPTH, "groups with opacity nested too deeply");
     }
 
+    sc.fill_items.reserve(a.n_segments + a.n_subpaths);  // (at most: every segment, a closing line each)
     for (int di = 0; di < a.n_draws; ++di) {
         const int32_t* row = a.draws + DRAW_COLS * di;
         const float* f = a.draw_params + DRAW_FCOLS * di;

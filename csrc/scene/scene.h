@@ -67,6 +67,18 @@ struct PreparedSegment {
     double piece_x0[3], piece_x1[3];  // x range of each piece (of the curve, see seg_bbox)
     double ax[4], ay[4];    // power-basis coefficients of x(t) and y(t)
     int n_split = 2;
+    // Each y-monotone piece cut into n_sub sub-pieces of equal parameter length (curves;
+    // lines keep one; see sub_t), with their y (from ax, ay) and x ranges: a ray crossing
+    // is decided by the one sub-piece at the ray's height, whose x range is a few times
+    // narrower than the piece's (no root to solve for most samples) and whose parameter
+    // range brackets the root tightly (ray_crossings).
+    static constexpr int SUB = 4;
+    int n_sub = 1;
+    double sub_y[3][SUB + 1];
+    double sub_x0[3][SUB], sub_x1[3][SUB];
+    VF_HD double sub_t(int k, int j) const {
+        return j == n_sub ? split[k + 1] : split[k] + (split[k + 1] - split[k]) * j / n_sub;
+    }
 };
 
 // Stroke geometry at a segment's end: the join with the next segment, or the cap.
