@@ -1,6 +1,7 @@
 // Forward pass on the CPU: the tiles are shared out between threads; each pixel is
 // shaded by pixel_forward (forward/pixel.h), which a CUDA build runs on the GPU as well.
 #include <algorithm>
+#include <array>
 #include <vector>
 
 #include "common/cancel.h"
@@ -37,17 +38,150 @@ ForwardPlan plan_forward(const PreparedScene& sc, const RenderOptions& o) {
     return plan;
 }
 
+namespace {
+
+// A tile's samples for tile_forward, reused from tile to tile by a worker.
+struct TileSamples {
+    std::vector<Vec2> p;
+    std::vector<double> weight;
+    std::vector<std::array<double, 4>> colour;  // premultiplied, composited front to back
+    std::vector<int> active, winding;            // samples not yet opaque; winding per active sample
+    std::vector<int> row_begin;                  // active[row_begin[r]...]: those of pixel row r onwards
+};
+
+// The Monte Carlo forward pass of one tile, draw by draw rather than sample by sample
+// (scenes without layers, on the CPU): a tile entry's crossings are counted for all the
+// tile's samples in one loop per segment, so that the segment's data stays at hand and
+// the branches on where samples lie repeat from sample to sample, where pixel_forward
+// goes through every entry's segments once per sample. Same samples, same integer
+// windings, the same compositing operations in the same order per sample: the image is
+// pixel_forward's bit for bit (the GPU runs pixel_forward).
+void tile_forward(const SceneView& sc, const TileView& bins, const RenderOptions& o, const double bg[4], int tile,
+                  float* out, TileSamples& ts) {
+    const int N = o.samples, per_pixel = N * N, W = o.width, H = o.height;
+    const double R = o.filter_radius;
+    const int tx = tile % bins.nx, ty = tile / bins.nx;
+    const int x0 = tx * TILE, y0 = ty * TILE, x1 = std::min(W, x0 + TILE), y1 = std::min(H, y0 + TILE);
+    const size_t n = (size_t)(x1 - x0) * (y1 - y0) * per_pixel;
+    ts.p.resize(n);
+    ts.weight.resize(n);
+    ts.colour.assign(n, {0, 0, 0, 0});
+    ts.active.clear();
+    ts.winding.resize(n);
+    size_t i = 0;
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+            uint64_t pixel = (uint64_t)y * W + x;
+            for (int s = 0; s < per_pixel; ++s, ++i) {  // pixel_forward's samples, in its order
+                double fx, fy;
+                sample_position(o.seed, pixel, s, N, fx, fy);
+                double dx = R * (2 * fx - 1), dy = R * (2 * fy - 1);
+                ts.weight[i] = filter_weight(o.filter, R, dx, dy);
+                ts.p[i] = {x + 0.5 + dx, y + 0.5 + dy};
+                if (ts.weight[i] > 0) ts.active.push_back((int)i);
+            }
+        }
+    const TileEntry* entries = bins.begin(tile);
+    const Box region = bins.region(tile);
+    const int rows = y1 - y0, row_size = (x1 - x0) * per_pixel;
+    ts.row_begin.resize(rows + 1);
+    auto index_rows = [&] {  // (active stays in row order)
+        int a = 0, n_active = (int)ts.active.size();
+        for (int r = 0; r <= rows; ++r) {
+            while (a < n_active && ts.active[a] / row_size < r) ++a;
+            ts.row_begin[r] = a;
+        }
+    };
+    index_rows();
+    for (int k = bins.count(tile) - 1; k >= 0 && !ts.active.empty(); --k) {
+        const TileEntry& e = entries[k];
+        const PreparedDraw& d = sc.draws[e.draw];
+        const PreparedBrush& brush = sc.brushes[d.brush];
+        const bool solid = brush.kind == BRUSH_SOLID;
+        double c[4];
+        if (solid) {
+            brush_color(sc, brush, {0, 0}, c);
+            if (c[3] <= 0) continue;
+        }
+        const Box near = grown(d.box, R);
+        const bool counted = d.kind == DRAW_FILL && !d.is_ellipse;  // windings counted here
+        const int n_active = (int)ts.active.size();
+        if (counted) {
+            for (int a = 0; a < n_active; ++a) ts.winding[a] = e.winding;
+            const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
+            const LocalItem* items = bins.items.data() + e.first;
+            for (int li = 0; li < e.count; ++li) {
+                const LocalItem& item = items[li];
+                const PreparedSegment& seg = segs[item.item];
+                // Only the rows whose samples (within R of their row's centre line) can lie
+                // in the segment's height range can cross it.
+                int r0 = std::max(0, (int)std::ceil(seg.box.y0 - 0.5 - R) - y0);
+                int r1 = std::min(rows - 1, (int)std::floor(seg.box.y1 - 0.5 + R) - y0);
+                if (r0 <= r1)
+                    for (int a = ts.row_begin[r0]; a < ts.row_begin[r1 + 1]; ++a)
+                        ts.winding[a] += ray_crossings(seg, ts.p[ts.active[a]], region.x1);
+                for (int j = 0; j < item.n_cross; ++j)  // the vertical leg: every sample at or below
+                    for (int a = 0; a < n_active; ++a)
+                        if (item.cross_y[j] <= ts.p[ts.active[a]].y) ts.winding[a] += item.cross_dir[j];
+            }
+        }
+        int kept = 0;
+        for (int a = 0; a < n_active; ++a) {
+            const int si = ts.active[a];
+            const Vec2 q = ts.p[si];
+            bool opaque = false;
+            if (q.x >= near.x0 && q.x <= near.x1 && q.y >= near.y0 && q.y <= near.y1 &&
+                (counted ? winding_inside(ts.winding[a], d.fill_rule) : entry_covers(sc, bins, e, region, q))) {
+                if (!solid) brush_color(sc, brush, q, c);
+                if (c[3] > 0) {
+                    std::array<double, 4>& f = ts.colour[si];
+                    double under = (1 - f[3]) * 1.0;  // FrontToBackCompositor::under, coverage 1
+                    for (int ch = 0; ch < 4; ++ch) f[ch] += under * c[ch];
+                    opaque = f[3] >= 1 - 1e-12;
+                }
+            }
+            if (!opaque) ts.active[kept++] = si;
+        }
+        if (kept < n_active) {
+            ts.active.resize(kept);
+            index_rows();
+        }
+    }
+    i = 0;
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+            double acc[4] = {0, 0, 0, 0}, wsum = 0;
+            for (int s = 0; s < per_pixel; ++s, ++i) {
+                double w = ts.weight[i];
+                if (w <= 0) continue;
+                for (int ch = 0; ch < 4; ++ch) acc[ch] += w * ts.colour[i][ch];
+                wsum += w;
+            }
+            pixel_output(acc, wsum, bg, out + 4 * ((size_t)y * W + x));
+        }
+}
+
+}  // namespace
+
 void render_forward(const PreparedScene& prepared, const RenderOptions& o, float* out) {
     ForwardPlan plan = plan_forward(prepared, o);
     const SceneView sc = prepared.view();
     const TileView bins = plan.bins.view();
     const int W = o.width, H = o.height;
+    const RenderOptions& s = plan.options;
+    const bool by_entry = s.mode == MODE_MC && !s.brute_force && sc.layer_parent.size() <= 1;
+    const int threads = std::max(1, o.threads > 0 ? o.threads : ThreadPool::hardware_threads());
+    std::vector<TileSamples> scratch(threads);
     PhaseTimer timer(PHASE_FORWARD);
-    ThreadPool::instance().parallel_for(bins.nx * bins.ny, o.threads, [&](int tile, int) {
+    ThreadPool::instance().parallel_for(bins.nx * bins.ny, threads, [&](int tile, int worker) {
+        if (by_entry) {
+            if (!cancelled()) tile_forward(sc, bins, s, plan.background, tile, out, scratch[worker]);
+            return;
+        }
         int tx = tile % bins.nx, ty = tile / bins.nx;
         for (int y = ty * TILE; y < std::min(H, (ty + 1) * TILE) && !cancelled(); ++y)
             for (int x = tx * TILE; x < std::min(W, (tx + 1) * TILE); ++x)
-                pixel_forward(sc, bins, plan.options, plan.background, x, y, out + 4 * ((size_t)y * W + x));
+                pixel_forward(sc, bins, s, plan.background, x, y, out + 4 * ((size_t)y * W + x));
     });
 }
 

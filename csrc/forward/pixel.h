@@ -65,6 +65,18 @@ VF_HD void sample_forward(const SceneView& sc, const TileView& bins, int tile, V
     comp.finish(out);
 }
 
+// A pixel's filtered premultiplied colour (acc / wsum), the background under it, written
+// as straight RGBA.
+VF_HD void pixel_output(const double acc[4], double wsum, const double bg[4], float* px) {
+    double k = wsum > 0 ? 1 / wsum : 0, c[4];
+    for (int i = 0; i < 4; ++i) c[i] = acc[i] * k;
+    double rest = 1 - c[3];
+    for (int i = 0; i < 4; ++i) c[i] += rest * bg[i];
+    double a = c[3];
+    for (int i = 0; i < 3; ++i) px[i] = a > 0 ? (float)vclamp(c[i] / a, 0.0, 1.0) : 0.0f;
+    px[3] = (float)vclamp(a, 0.0, 1.0);
+}
+
 // One output pixel: its samples filtered, the background under them, as straight RGBA.
 // o is the plan's options (filter radius settled); bg the premultiplied background.
 VF_HD void pixel_forward(const SceneView& sc, const TileView& bins, const RenderOptions& o, const double bg[4], int x,
@@ -86,14 +98,7 @@ VF_HD void pixel_forward(const SceneView& sc, const TileView& bins, const Render
         for (int i = 0; i < 4; ++i) acc[i] += w * c[i];
         wsum += w;
     }
-    // Filtered premultiplied colour, the background under it, then straight RGBA.
-    double k = wsum > 0 ? 1 / wsum : 0, c[4];
-    for (int i = 0; i < 4; ++i) c[i] = acc[i] * k;
-    double rest = 1 - c[3];
-    for (int i = 0; i < 4; ++i) c[i] += rest * bg[i];
-    double a = c[3];
-    for (int i = 0; i < 3; ++i) px[i] = a > 0 ? (float)vclamp(c[i] / a, 0.0, 1.0) : 0.0f;
-    px[3] = (float)vclamp(a, 0.0, 1.0);
+    pixel_output(acc, wsum, bg, px);
 }
 
 }  // namespace vf
