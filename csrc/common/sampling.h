@@ -40,14 +40,37 @@ VF_HD uint32_t permute_index(uint32_t i, uint32_t n, uint64_t key) {
     return rank;
 }
 
+VF_HD uint64_t pixel_permutation_key(uint64_t seed, uint64_t pixel) {
+    return mix64(seed ^ mix64(pixel + 0x5851f42d4c957f2dull));
+}
+
 VF_HD void sample_position(uint64_t seed, uint64_t pixel, int s, int n, double& x, double& y) {
     double u, v;
     sample_uniform2(seed, pixel, (uint64_t)s, u, v);
     int sx = s % n, sy = s / n;
-    uint64_t key = mix64(seed ^ mix64(pixel + 0x5851f42d4c957f2dull));
+    uint64_t key = pixel_permutation_key(seed, pixel);
     uint32_t px = permute_index(sx, n, key), py = permute_index(sy, n, key ^ 0xa511e9b3ull);
     x = (sx + (py + u) / n) / n;
     y = (sy + (px + v) / n) / n;
+}
+
+// All n x n sample positions of a pixel, as sample_position gives them one by one (the
+// permutations, O(n^2) hashes each, drawn once per pixel instead of once per sample);
+// n <= 64.
+inline void pixel_sample_positions(uint64_t seed, uint64_t pixel, int n, double* xs, double* ys) {
+    uint64_t key = pixel_permutation_key(seed, pixel);
+    uint32_t px[64], py[64];
+    for (int i = 0; i < n; ++i) {
+        px[i] = permute_index(i, n, key);
+        py[i] = permute_index(i, n, key ^ 0xa511e9b3ull);
+    }
+    for (int s = 0; s < n * n; ++s) {
+        double u, v;
+        sample_uniform2(seed, pixel, (uint64_t)s, u, v);
+        int sx = s % n, sy = s / n;
+        xs[s] = (sx + (py[sy] + u) / n) / n;
+        ys[s] = (sy + (px[sx] + v) / n) / n;
+    }
 }
 
 enum FilterKind : int { FILTER_BOX = 0, FILTER_TENT = 1, FILTER_GAUSSIAN = 2, FILTER_PARABOLIC = 3, FILTER_HANN = 4 };

@@ -47,6 +47,8 @@ struct TileSamples {
     std::vector<std::array<double, 4>> colour;  // premultiplied, composited front to back
     std::vector<int> active, winding;            // samples not yet opaque; winding per active sample
     std::vector<int> row_begin;                  // active[row_begin[r]...]: those of pixel row r onwards
+    std::vector<int> row_of;                     // pixel row of each sample
+    std::vector<double> fx, fy;                  // one pixel's sample positions
 };
 
 // The Monte Carlo forward pass of one tile, draw by draw rather than sample by sample
@@ -68,27 +70,29 @@ void tile_forward(const SceneView& sc, const TileView& bins, const RenderOptions
     ts.colour.assign(n, {0, 0, 0, 0});
     ts.active.clear();
     ts.winding.resize(n);
+    ts.row_of.resize(n);
+    ts.fx.resize(per_pixel);
+    ts.fy.resize(per_pixel);
     size_t i = 0;
     for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) {
-            uint64_t pixel = (uint64_t)y * W + x;
+            pixel_sample_positions(o.seed, (uint64_t)y * W + x, N, ts.fx.data(), ts.fy.data());
             for (int s = 0; s < per_pixel; ++s, ++i) {  // pixel_forward's samples, in its order
-                double fx, fy;
-                sample_position(o.seed, pixel, s, N, fx, fy);
-                double dx = R * (2 * fx - 1), dy = R * (2 * fy - 1);
+                double dx = R * (2 * ts.fx[s] - 1), dy = R * (2 * ts.fy[s] - 1);
                 ts.weight[i] = filter_weight(o.filter, R, dx, dy);
                 ts.p[i] = {x + 0.5 + dx, y + 0.5 + dy};
+                ts.row_of[i] = y - y0;
                 if (ts.weight[i] > 0) ts.active.push_back((int)i);
             }
         }
     const TileEntry* entries = bins.begin(tile);
     const Box region = bins.region(tile);
-    const int rows = y1 - y0, row_size = (x1 - x0) * per_pixel;
+    const int rows = y1 - y0;
     ts.row_begin.resize(rows + 1);
     auto index_rows = [&] {  // (active stays in row order)
         int a = 0, n_active = (int)ts.active.size();
         for (int r = 0; r <= rows; ++r) {
-            while (a < n_active && ts.active[a] / row_size < r) ++a;
+            while (a < n_active && ts.row_of[ts.active[a]] < r) ++a;
             ts.row_begin[r] = a;
         }
     };
@@ -169,7 +173,7 @@ void render_forward(const PreparedScene& prepared, const RenderOptions& o, float
     const TileView bins = plan.bins.view();
     const int W = o.width, H = o.height;
     const RenderOptions& s = plan.options;
-    const bool by_entry = s.mode == MODE_MC && !s.brute_force && sc.layer_parent.size() <= 1;
+    const bool by_entry = s.mode == MODE_MC && !s.brute_force && sc.layer_parent.size() <= 1 && s.samples <= 64;
     const int threads = std::max(1, o.threads > 0 ? o.threads : ThreadPool::hardware_threads());
     std::vector<TileSamples> scratch(threads);
     PhaseTimer timer(PHASE_FORWARD);
