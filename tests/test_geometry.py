@@ -378,6 +378,36 @@ def test_winding_number_known():
     assert core.winding_number(diamond, np.ones(4, dtype=np.int32), one, (-1.0, 4.0)) == 0
 
 
+def test_winding_number_beside_curves():
+    """Points a hair from a curve, on both sides: the core decides a crossing's side from a
+    bracket of its root and sub-pieces' x ranges (csrc/common/bezier.h,
+    monotone_crossing_within) rather than a full solve; down to 1e-6 px from the curve
+    it must still tell inside from outside. Closed shapes of cubics: a circle's four arcs
+    and a lopsided blob with a long flat side, along every segment, ends included."""
+    k = 0.5522847498
+    circle = np.array([[5, 0], [5, 5 * k], [5 * k, 5], [0, 5], [-5 * k, 5], [-5, 5 * k], [-5, 0],
+                       [-5, -5 * k], [-5 * k, -5], [0, -5], [5 * k, -5], [5, -5 * k]], dtype=np.float64)
+    blob = np.array([[6, 0], [6, 9], [-7, 3], [-6, 0], [-5, -2], [-1, -2.5], [1, -2.4],
+                     [3, -2.3], [6, -6], [6, 0.0]], dtype=np.float64)[:-1]
+    for shape, center in ((circle + [0.3, 0.2], np.array([0.3, 0.2])), (blob, np.array([0.0, 0.5]))):
+        n = len(shape) // 3
+        degrees = np.full(n, 3, dtype=np.int32)
+        subpaths = np.array([[0, n, 1]], dtype=np.int32)
+        closed = np.concatenate([shape, shape[:1]])
+        for g in range(n):
+            ctrl = closed[3 * g:3 * g + 4]
+            for t in (1e-9, 0.01, 0.125, 0.25, 0.3, 0.5, 0.75, 0.9, 1 - 1e-9):
+                b = bezier_eval(ctrl, np.array([t]))[0]
+                d = bezier_eval(ctrl, np.array([t + 1e-7]))[0] - bezier_eval(ctrl, np.array([t - 1e-7]))[0]
+                normal = np.array([d[1], -d[0]]) / np.hypot(*d)
+                if np.dot(normal, b - center) < 0:
+                    normal = -normal  # outward (both shapes are star-shaped about `center`)
+                for delta in (1e-2, 1e-4, 1e-6):
+                    inside = core.winding_number(shape, degrees, subpaths, tuple(b - delta * normal))
+                    outside = core.winding_number(shape, degrees, subpaths, tuple(b + delta * normal))
+                    assert (abs(inside), outside) == (1, 0), (g, t, delta, inside, outside)
+
+
 # ==================================================================== polynomial roots
 #
 # Tolerance. For a simple root r of p = sum c_i t^i, perturbing the coefficients by a relative
