@@ -50,6 +50,51 @@ VF_HD bool draw_covers_at(const SceneView& sc, const TileView& bins, int draw, V
     return covers(sc, bins, es[lo], region, p);
 }
 
+// Whether draw `draw` covers each of two points a hair apart (either side of one of its
+// boundaries): draw_covers_at for both, with the entry looked up once and the crossings of
+// both points counted in one pass over its segments when they share a tile (fills).
+VF_HD void draw_covers_pair(const SceneView& sc, const TileView& bins, int draw, Vec2 a, Vec2 b, bool& in_a,
+                            bool& in_b) {
+    int tile = tile_of(bins, a);
+    const PreparedDraw& d = sc.draws[draw];
+    if (tile != tile_of(bins, b) || d.kind != DRAW_FILL || d.is_ellipse) {
+        in_a = draw_covers_at(sc, bins, draw, a);
+        in_b = draw_covers_at(sc, bins, draw, b);
+        return;
+    }
+    in_a = in_b = false;
+    Box region = bins.region(tile);
+    auto reached = [&](Vec2 p) {
+        return p.x >= region.x0 && p.x <= region.x1 && p.y >= region.y0 && p.y <= region.y1 && p.x >= d.box.x0 &&
+               p.x <= d.box.x1 && p.y >= d.box.y0 && p.y <= d.box.y1;
+    };
+    bool ra = reached(a), rb = reached(b);
+    if (!ra && !rb) return;
+    const TileEntry* es = bins.begin(tile);
+    int n = bins.count(tile);
+    int lo = 0, hi = n;  // entries are sorted by draw index (paint order)
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (es[mid].draw < draw) lo = mid + 1; else hi = mid;
+    }
+    if (lo >= n || es[lo].draw != draw) return;
+    const TileEntry& e = es[lo];
+    const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
+    const LocalItem* items = bins.items.data() + e.first;
+    int wa = e.winding, wb = e.winding;
+    for (int i = 0; i < e.count; ++i) {
+        const LocalItem& li = items[i];
+        wa += ray_crossings(segs[li.item], a, region.x1);
+        wb += ray_crossings(segs[li.item], b, region.x1);
+        for (int c = 0; c < li.n_cross; ++c) {
+            if (li.cross_y[c] <= a.y) wa += li.cross_dir[c];
+            if (li.cross_y[c] <= b.y) wb += li.cross_dir[c];
+        }
+    }
+    in_a = ra && winding_inside(wa, d.fill_rule);
+    in_b = rb && winding_inside(wb, d.fill_rule);
+}
+
 // Draws covering p, front to back, with their premultiplied colours; `forced` (if >= 0)
 // counts as covering. Returns the count.
 VF_HD int collect_hits(const SceneView& sc, const TileView& bins, Vec2 p, int forced, Buffer<Hit>& hits) {

@@ -182,8 +182,11 @@ VF_HD void boundary_sample(const SceneView& sc, const TileView& bins, const Boun
     // Just inside a stroke piece is inside the stroke by construction (within w/2 of the
     // curve along its normal); fills need both sides for orientation.
     bool fill_piece = pc.kind == Piece::FILL_SEGMENT || (pc.kind == Piece::ELLIPSE && pc.side == 0);
-    bool in_minus = !fill_piece || draw_covers_at(sc, bins, bs.draw, nudged(p, -EPS_NORMAL, bs.n));
-    bool in_plus = draw_covers_at(sc, bins, bs.draw, nudged(p, EPS_NORMAL, bs.n));
+    bool in_minus = true, in_plus;
+    if (fill_piece)
+        draw_covers_pair(sc, bins, bs.draw, nudged(p, -EPS_NORMAL, bs.n), nudged(p, EPS_NORMAL, bs.n), in_minus, in_plus);
+    else
+        in_plus = draw_covers_at(sc, bins, bs.draw, nudged(p, EPS_NORMAL, bs.n));
     if (pc.kind == Piece::FILL_SEGMENT && !in_minus && in_plus) {
         bs.n = -bs.n;  // the segment runs the other way round
         for (int i = 0; i < bs.nv; ++i) bs.v[i].value = -bs.v[i].value;
