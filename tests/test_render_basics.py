@@ -86,16 +86,18 @@ def test_output_size_keeps_aspect():
     assert output_size(scene, None, 33) == (66, 33)
 
 
-@pytest.mark.parametrize("mode", ["mc", "analytic"])
-def test_tiles_match_brute_force(mode):
+@pytest.mark.parametrize("mode,samples,filter", [("mc", 2, "box"), ("mc", 3, "tent"), ("analytic", 2, "box")])
+def test_tiles_match_brute_force(mode, samples, filter):
     """The per-tile segment lists and corner windings give exactly what testing every
-    segment of every draw gives (tiger: fills with even-odd holes, thin strokes)."""
+    segment of every draw gives (tiger: fills with even-odd holes, thin strokes). In MC
+    mode this also pins the CPU's draw-by-draw forward pass (tile_forward) to the
+    sample-by-sample one (pixel_forward, which brute force runs), bit for bit."""
     import warnings
     from pathlib import Path as FilePath
     tiger = FilePath(__file__).resolve().parents[1] / "examples" / "tiger.svg"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         scene = vecfit.load_svg(tiger)
-    fast = vecfit.render(scene, 248, 255, samples=2, mode=mode)
-    brute = vecfit.render(scene, 248, 255, samples=2, mode=mode, _brute_force=True)
+    fast = vecfit.render(scene, 248, 255, samples=samples, mode=mode, filter=filter)
+    brute = vecfit.render(scene, 248, 255, samples=samples, mode=mode, filter=filter, _brute_force=True)
     assert torch.equal(fast, brute)
