@@ -8,6 +8,7 @@
 #include <chrono>
 #include <exception>
 #include <future>
+#include <memory>
 #include <vector>
 #include <initializer_list>
 #include <stdexcept>
@@ -161,9 +162,15 @@ PreparedScene timed_prepare(const SceneArrays& a) {
     return prepare_scene(a);
 }
 
-py::array_t<float> render(const py::dict& scene, int width, int height, int samples, const std::string& mode,
-                          const std::string& filter, double filter_radius, uint64_t seed, int threads,
-                          py::object background, bool brute_force, int device) {
+// A scene prepared by a forward pass, handed to Python (render_keeping) so that the
+// backward pass of the same arrays (render_grad's `prepared`) need not prepare it again.
+struct KeptScene {
+    std::shared_ptr<const PreparedScene> scene;
+};
+
+py::array_t<float> render_into(const py::dict& scene, int width, int height, int samples, const std::string& mode,
+                               const std::string& filter, double filter_radius, uint64_t seed, int threads,
+                               py::object background, bool brute_force, int device, KeptScene* keep) {
     SceneInput in = scene_input(scene);
     SceneArrays a = in.arrays();
     RenderOptions o = render_options(width, height, samples, mode, filter, filter_radius, seed, threads, background);
@@ -171,11 +178,28 @@ py::array_t<float> render(const py::dict& scene, int width, int height, int samp
     py::array_t<float> image({height, width, 4});
     float* out = image.mutable_data();
     interruptible([&] {
-        PreparedScene prepared = timed_prepare(a);
-        if (device >= 0) gpu::render_forward(prepared, o, device, out);
-        else render_forward(prepared, o, out);
+        auto prepared = std::make_shared<const PreparedScene>(timed_prepare(a));
+        if (device >= 0) gpu::render_forward(*prepared, o, device, out);
+        else render_forward(*prepared, o, out);
+        if (keep) keep->scene = prepared;
     });
     return image;
+}
+
+py::array_t<float> render(const py::dict& scene, int width, int height, int samples, const std::string& mode,
+                          const std::string& filter, double filter_radius, uint64_t seed, int threads,
+                          py::object background, bool brute_force, int device) {
+    return render_into(scene, width, height, samples, mode, filter, filter_radius, seed, threads, background,
+                       brute_force, device, nullptr);
+}
+
+py::tuple render_keeping(const py::dict& scene, int width, int height, int samples, const std::string& mode,
+                         const std::string& filter, double filter_radius, uint64_t seed, int threads,
+                         py::object background, int device) {
+    KeptScene keep;
+    py::array_t<float> image = render_into(scene, width, height, samples, mode, filter, filter_radius, seed,
+                                           threads, background, false, device, &keep);
+    return py::make_tuple(image, keep);
 }
 
 // The gradients of a scene's float arrays, as numpy arrays by the names render() takes.
@@ -217,7 +241,7 @@ std::atomic<long> backward_fallbacks{0};
 py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_image, int width, int height,
                      int samples, const std::string& mode, const std::string& filter, double filter_radius,
                      uint64_t seed, int threads, py::object background, double boundary_density, int device,
-                     bool emulate_gpu_lists, int interior_samples) {
+                     bool emulate_gpu_lists, int interior_samples, const KeptScene* kept) {
     SceneInput in = scene_input(scene);
     SceneArrays a = in.arrays();
     RenderOptions o = render_options(width, height, samples, mode, filter, filter_radius, seed, threads, background);
@@ -227,7 +251,10 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
         throw std::invalid_argument("image and its gradient must be height x width x 4");
     SceneGrads g;
     interruptible([&] {
-        PreparedScene prepared = timed_prepare(a);
+        // (kept: the forward pass's preparation of these same arrays)
+        std::shared_ptr<const PreparedScene> own;
+        if (!kept || !kept->scene) own = std::make_shared<const PreparedScene>(timed_prepare(a));
+        const PreparedScene& prepared = own ? *own : *kept->scene;
         // On the GPU when asked, unless a sample there needs longer lists than a thread
         // holds: then on the CPU. emulate_gpu_lists runs the CPU lanes with a GPU thread's
         // lists first, to see on the CPU what a GPU run would do.
@@ -358,12 +385,19 @@ PYBIND11_MODULE(_core, m) {
           py::arg("scene"), py::arg("width"), py::arg("height"), py::arg("samples"), py::arg("mode"),
           py::arg("filter"), py::arg("filter_radius"), py::arg("seed"), py::arg("threads"), py::arg("background"),
           py::arg("brute_force") = false, py::arg("device") = -1);
+    py::class_<KeptScene>(m, "KeptScene", "A scene prepared by render_keeping, for render_grad's `prepared`");
+    m.def("render_keeping", &render_keeping,
+          "render, returning (image, the prepared scene) for render_grad of the same arrays",
+          py::arg("scene"), py::arg("width"), py::arg("height"), py::arg("samples"), py::arg("mode"),
+          py::arg("filter"), py::arg("filter_radius"), py::arg("seed"), py::arg("threads"), py::arg("background"),
+          py::arg("device") = -1);
     m.def("render_grad", &render_grad,
           "Gradients of the scene arrays given the forward image and dL/d(image)",
           py::arg("scene"), py::arg("image"), py::arg("d_image"), py::arg("width"), py::arg("height"),
           py::arg("samples"), py::arg("mode"), py::arg("filter"), py::arg("filter_radius"), py::arg("seed"),
           py::arg("threads"), py::arg("background"), py::arg("boundary_density"), py::arg("device") = -1,
-          py::arg("emulate_gpu_lists") = false, py::arg("interior_samples") = 0);
+          py::arg("emulate_gpu_lists") = false, py::arg("interior_samples") = 0,
+          py::arg("prepared") = nullptr);
     m.def("render_batch", &render_batch,
           "Render a list of scene dicts at one size into [B, H, W, 4] straight RGBA, in parallel over the scenes",
           py::arg("scenes"), py::arg("width"), py::arg("height"), py::arg("samples"), py::arg("mode"),

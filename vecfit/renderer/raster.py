@@ -43,16 +43,20 @@ FLOAT_INPUTS = ("points", "point_widths", "ellipses", "draw_params", "brush_para
                 "stop_colors", "layer_opacity")
 
 
-def _core_render(settings: dict, structure: dict, floats, brute_force: bool = False):
-    """The core's forward pass on the packed arrays: (the arrays it saw, image)."""
+def _core_render(settings: dict, structure: dict, floats, brute_force: bool = False, keep: bool = False):
+    """The core's forward pass on the packed arrays: (the arrays it saw, image), and with
+    ``keep`` the scene as the core prepared it, for the backward pass of these arrays."""
     scene = dict(structure)
     for name, t in zip(FLOAT_INPUTS, floats):
         scene[name] = t.detach().cpu().numpy()
     try:
         with phase("call forward"):
-            image = _core.render(scene, **settings, brute_force=brute_force)
+            if keep:
+                image, prepared = _core.render_keeping(scene, **settings)
+            else:
+                image = _core.render(scene, **settings, brute_force=brute_force)
         add_core_phases()
-        return scene, image
+        return (scene, image, prepared) if keep else (scene, image)
     except ValueError as e:  # the core refused the scene (e.g. layers nested too deeply)
         raise VecfitError(str(e)) from None
     except RuntimeError as e:  # the GPU failed (out of memory, driver)
@@ -100,7 +104,7 @@ class _Render(torch.autograd.Function):
 
     @staticmethod
     def forward(ctx, settings, boundary_density, interior_samples, emulate_gpu_lists, structure, *floats):
-        ctx.scene, ctx.image = _core_render(settings, structure, floats)
+        ctx.scene, ctx.image, ctx.prepared = _core_render(settings, structure, floats, keep=True)
         ctx.settings, ctx.boundary_density = settings, boundary_density
         ctx.interior_samples = interior_samples
         ctx.emulate_gpu_lists = emulate_gpu_lists
@@ -116,7 +120,8 @@ class _Render(torch.autograd.Function):
                                           s["width"], s["height"], s["samples"], s["mode"], s["filter"],
                                           s["filter_radius"], s["seed"], s["threads"], s["background"],
                                           ctx.boundary_density, s["device"], ctx.emulate_gpu_lists,
-                                          ctx.interior_samples)
+                                          ctx.interior_samples, ctx.prepared)
+            ctx.prepared = None  # (its memory, before the next forward pass)
             add_core_phases()
         except RuntimeError as e:  # the GPU failed (out of memory, driver)
             raise VecfitError(f"gradients on {devices.device_name(s['device'])} failed: {e}") from None
