@@ -399,16 +399,31 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
     """Content-aware resizing of SVG (seam carving brought into the vector file): seams of
     least energy are carved out of its render in rounds, and its points are fitted to each
     round's carved image. Writes NAME.vecfit.svg at the new size (every element, id and
-    group kept), a report and a comparison picture (input | plain scaling | retargeted)."""
+    group kept), a report and a comparison picture (input | plain scaling | retargeted).
+    --iterations N sets the Adam iterations of the whole run, divided between the rounds
+    and the final fit as configs/retarget.toml divides them."""
     from vecfit.jobs.fit import Outputs
     from vecfit.jobs.retarget import run as run_retarget
 
-    config = _resolve_config("retarget", None, config_file, options)
+    config = _resolve_config("retarget", None, config_file, options,
+                             extra={"retarget": {"width": width, "height": height}})
     outputs = Outputs.beside(Path(svg), output, report, comparison)
     r = config["retarget"]
     rounds = r["steps"] * (2 if height is not None else 1)
+    if options["iterations"] is not None:
+        _divide_iterations(r, rounds, options["iterations"])
     _run_job("retarget", rounds * r["iterations_per_step"] + r["final_iterations"], quiet,
-             lambda bar: run_retarget(svg, config, outputs, progress=bar, width=width, height=height))
+             lambda bar: run_retarget(svg, config, outputs, progress=bar))
+
+
+def _divide_iterations(r: dict, rounds: int, total: int) -> None:
+    """retarget --iterations N: N Adam iterations in all, divided between the rounds and the
+    final fit in the proportions of the config (40 a round and 60 at the end by default: 150
+    gives 20 a round and 30 at the end)."""
+    planned = rounds * r["iterations_per_step"] + r["final_iterations"]
+    per_round = total * r["iterations_per_step"] // planned if planned else 0
+    r["iterations_per_step"] = per_round
+    r["final_iterations"] = total - rounds * per_round
 
 
 # ------------------------------------------------------------------------------ batch
@@ -417,8 +432,10 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
 @click.argument("in_dir", type=click.Path(exists=True, file_okay=False))
 @click.option("-o", "--out-dir", required=True, type=click.Path(file_okay=False),
               help="Folder for the outputs and the summary (not IN_DIR).")
-@click.option("--mode", required=True, type=click.Choice(["trace", "refine", "paint", "edit"]),
-              help="The command run on each image.")
+@click.option("--mode", required=True, type=click.Choice(["trace", "refine", "paint", "edit", "retarget"]),
+              help="The command run on each image (retarget: on each SVG).")
+@click.option("--width", metavar="W|P%", help="retarget: the new width, pixels or a percentage (70%).")
+@click.option("--height", metavar="H|P%", help="retarget: the new height (default: unchanged).")
 @click.option("--config", "config_file", type=click.Path(dir_okay=False),
               help="TOML file overriding the defaults in configs/.")
 @click.option("--preset", help="A preset of the mode's file in configs/.")
@@ -436,10 +453,11 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
                    "'distributed' package; paths must be the same on the workers).")
 @click.option("--device", **DEVICE_OPTION)
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar or per-image lines.")
-def batch(in_dir, out_dir, mode, config_file, preset, init_dir, jobs, threads, resume, scheduler,
-          device, quiet):
+def batch(in_dir, out_dir, mode, width, height, config_file, preset, init_dir, jobs, threads, resume,
+          scheduler, device, quiet):
     """Run refine, trace, paint or edit on every image in IN_DIR (*.png, *.jpg, *.jpeg,
-    *.bmp, *.tif, *.tiff, *.webp; not recursive), writing NAME.svg, NAME.report.json and
+    *.bmp, *.tif, *.tiff, *.webp; not recursive), or retarget on every SVG there (*.svg,
+    *.svgz; --width and/or --height give the new size), writing NAME.svg, NAME.report.json and
     NAME.compare.png per image, and summary.csv, summary.json and index.html (with
     thumbs/) into OUT_DIR. For refine and edit, each image (for edit: the edited render)
     is paired with the SVG of the same name in IN_DIR (or --init-dir); an image without
@@ -462,7 +480,8 @@ def batch(in_dir, out_dir, mode, config_file, preset, init_dir, jobs, threads, r
         try:
             result = run_batch(in_dir, out_dir, mode, config_file=config_file, preset=preset,
                                jobs=jobs, threads=threads, resume=resume, init_dir=init_dir,
-                               scheduler=scheduler, reporter=reporter, device=device)
+                               scheduler=scheduler, reporter=reporter, device=device,
+                               width=width, height=height)
         except BatchUsageError as e:
             _echo_err(f"error: {e}")
             sys.exit(EXIT_USAGE)

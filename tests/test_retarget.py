@@ -181,3 +181,51 @@ def test_ctrl_c_writes_the_best_result_so_far(picture):
     assert width == pytest.approx(72)  # stopped in the first of two rounds: half the seams
     assert structure(outputs.svg) == structure(picture / "picture.svg")
     assert json.loads(outputs.report.read_text())["interrupted"] is True
+
+
+def test_iterations_sets_the_whole_runs_adam_steps(picture):
+    """--iterations N: N steps in all, divided like the config divides them (2 rounds of 15
+    and 15 at the end: 18 gives 2 rounds of 6 and 6 at the end)."""
+    out = picture / "short.svg"
+    r = run("retarget", picture / "picture.svg", "--width", "70%", "-o", out, "--config",
+            picture / "fast.toml", "--iterations", 18, "--threads", 2, "-q")
+    assert r.exit_code == 0, r.output
+    report = json.loads((picture / "short.report.json").read_text())
+    assert report["iterations"] == 18
+    assert report["config"]["retarget"]["iterations_per_step"] == 6
+    assert report["config"]["retarget"]["final_iterations"] == 6
+    assert report["config"]["retarget"]["width"] == "70%"  # the size is part of the settings
+
+
+def test_batch_retargets_every_svg_of_a_folder(picture):
+    folder = picture / "in"
+    folder.mkdir()
+    (folder / "a.svg").write_text(PICTURE)
+    (folder / "b.svg").write_text(PICTURE.replace('width="96" height="48"', 'width="80" height="40"'))
+    (folder / "notes.txt").write_text("not an SVG")
+    out = picture / "out"
+    def args(width):
+        return ("batch", folder, "-o", out, "--mode", "retarget", "--width", width, "--config",
+                picture / "fast.toml", "-q")
+
+    r = run(*args("75%"))
+    assert r.exit_code == 0, r.output
+    for name, (w, h) in (("a", (72, 48)), ("b", (60, 40))):
+        root = ET.parse(out / f"{name}.svg").getroot()
+        assert float(root.get("width")) == pytest.approx(w, abs=1) and float(root.get("height")) == h
+        assert structure(out / f"{name}.svg") == structure(folder / f"{name}.svg")
+    rows = json.loads((out / "summary.json").read_text())["images"]
+    assert [(row["file"], row["status"]) for row in rows] == [("a.svg", "done"), ("b.svg", "done")]
+    again = run(*args("75%"))  # finished with the same settings: skipped
+    assert again.exit_code == 0 and "2 skipped" in again.output, again.output
+    wider = run(*args("90%"))  # another size: done again
+    assert wider.exit_code == 0 and "2 done" in wider.output, wider.output
+
+
+@pytest.mark.parametrize("argv,words", [
+    (("--mode", "retarget"), "needs --width"),
+    (("--mode", "trace", "--width", "50%"), "for --mode retarget"),
+])
+def test_batch_size_options_are_checked(picture, argv, words):
+    r = run("batch", picture, "-o", picture / "out", *argv, "-q")
+    assert r.exit_code == 2 and words in r.output, r.output

@@ -19,11 +19,13 @@ from vecfit.jobs.fit import Outputs, same_path
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp")
 SVG_SUFFIXES = (".svg", ".svgz")
-MODES = ("refine", "trace", "paint", "edit")
+MODES = ("refine", "trace", "paint", "edit", "retarget")
 PAIRED = ("refine", "edit")  # modes that pair each image with the SVG of its name
+ON_SVGS = ("retarget",)      # modes whose inputs are the SVGs in IN_DIR, not images
 # The job function of each mode, as "module:function", imported where the task runs.
 JOBS = {"refine": "vecfit.jobs.refine:run", "trace": "vecfit.jobs.trace:run",
-        "paint": "vecfit.jobs.paint:run", "edit": "vecfit.jobs.edit:run"}
+        "paint": "vecfit.jobs.paint:run", "edit": "vecfit.jobs.edit:run",
+        "retarget": "vecfit.jobs.retarget:run"}
 
 # Statuses of a summary row.
 DONE = "done"
@@ -70,6 +72,12 @@ def find_images(folder: Path) -> list[Path]:
     """The images directly in ``folder`` (not recursive), sorted by file name."""
     return sorted((p for p in folder.iterdir()
                    if p.suffix.lower() in IMAGE_SUFFIXES and p.is_file()),
+                  key=lambda p: p.name)
+
+
+def find_svgs(folder: Path) -> list[Path]:
+    """The SVGs directly in ``folder`` (retarget's inputs), sorted by file name."""
+    return sorted((p for p in folder.iterdir() if p.suffix.lower() in SVG_SUFFIXES and p.is_file()),
                   key=lambda p: p.name)
 
 
@@ -169,7 +177,7 @@ def make_plan(in_dir: Path, out_dir: Path, mode: str, config: dict, *, init_dir:
     and the tasks left to run."""
     plan = Plan()
     previous = _previous_seconds(out_dir) if resume else {}
-    images = find_images(in_dir)
+    images = find_svgs(in_dir) if mode in ON_SVGS else find_images(in_dir)
     plan.order = [p.name for p in images]
     stems: dict[str, list[Path]] = {}
     for p in images:

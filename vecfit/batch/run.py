@@ -44,14 +44,17 @@ def available_cores() -> int:
         return max(1, os.cpu_count() or 1)
 
 
-def resolve_config(mode: str, preset: str | None = None, config_file=None, device: str | None = None) -> dict:
+def resolve_config(mode: str, preset: str | None = None, config_file=None, device: str | None = None,
+                   size: dict | None = None) -> dict:
     """The command's settings (vecfit.jobs.config.resolve, which also checks the values, the
-    device included); BatchUsageError when they are bad."""
+    device included); BatchUsageError when they are bad. size: retarget's width / height."""
     from vecfit.jobs.config import resolve
 
+    overrides = {"optimize": {"device": device}}
+    if size:
+        overrides["retarget"] = size
     try:
-        return resolve(mode, preset=preset, config_file=config_file,
-                       overrides={"optimize": {"device": device}})
+        return resolve(mode, preset=preset, config_file=config_file, overrides=overrides)
     except VecfitError as e:
         raise BatchUsageError(str(e)) from None
 
@@ -115,8 +118,10 @@ class _Silent:
 def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | None = None,
               jobs: int = 1, threads: int | None = None, resume: bool = True, init_dir=None,
               scheduler: str | None = None, client=None, job: str | None = None,
-              reporter=None, device: str | None = None) -> BatchResult:
-    """Runs ``mode`` (refine, trace, paint, edit) on every image directly in ``in_dir``, writing
+              reporter=None, device: str | None = None, width: str | None = None,
+              height: str | None = None) -> BatchResult:
+    """Runs ``mode`` (refine, trace, paint, edit) on every image directly in ``in_dir``, or
+    retarget on every SVG there (to ``width`` and/or ``height``: pixels or a percentage), writing
     NAME.svg, NAME.report.json and NAME.compare.png per image and the summary into
     ``out_dir``.
 
@@ -148,9 +153,14 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
         if d is not None and same_path(out_dir, d):
             raise BatchUsageError(f"the output folder must differ from {d} (the outputs would be "
                                   "taken for inputs)")
+    size = {k: v for k, v in (("width", width), ("height", height)) if v is not None}
+    if size and mode != "retarget":
+        raise BatchUsageError("--width and --height are for --mode retarget")
+    if mode == "retarget" and not size:
+        raise BatchUsageError("--mode retarget needs --width (and/or --height)")
     if jobs < 0 or (threads is not None and threads < 1):
         raise BatchUsageError("jobs must be >= 0 and threads >= 1")
-    config = resolve_config(mode, preset, config_file, device)
+    config = resolve_config(mode, preset, config_file, device, size)
     if scheduler is not None and client is None:
         from .execute import connect
         try:

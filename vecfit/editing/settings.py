@@ -35,6 +35,8 @@ class EditSettings:
 
 @dataclass
 class RetargetSettings:
+    width: str = ""                # new width: pixels or a percentage ("": unchanged)
+    height: str = ""               # new height, likewise
     steps: int = 6                 # carve-and-fit rounds
     iterations_per_step: int = 40  # Adam iterations fitting each round's carved image
     final_iterations: int = 60     # more at the end, against the last carved image

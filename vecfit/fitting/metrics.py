@@ -27,3 +27,12 @@ def compare(result: np.ndarray, target: np.ndarray) -> dict:
                                       gaussian_weights=True, sigma=1.5,
                                       use_sample_covariance=True))
     return {"mse": mse, "psnr": psnr, "ssim": ssim}
+
+
+def seen(rgba: np.ndarray, background) -> np.ndarray:
+    """The channels the loss compares (loop.Target.compared): RGB over an opaque background,
+    else premultiplied RGBA."""
+    a = rgba[..., 3:]
+    if background is not None:
+        return rgba[..., :3] * a + np.asarray(background[:3], np.float32) * (1 - a)
+    return np.concatenate([rgba[..., :3] * a, a], axis=2)

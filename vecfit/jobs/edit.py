@@ -17,7 +17,7 @@ from vecfit.editing.settings import EditSettings
 from vecfit.errors import VecfitError
 from vecfit.fitting.anchor import acting_on, anchors
 from vecfit.fitting.loop import Settings, Target, optimize
-from vecfit.fitting.metrics import compare, to_rgb
+from vecfit.fitting.metrics import compare, seen, to_rgb
 from vecfit.fitting.rates import learning_rate_scales
 from vecfit.io.images import downscaled, downscaled_weight
 from vecfit.io.report import error_map, panels_image, save_panels, save_report
@@ -52,13 +52,6 @@ def fit_canvas(scene: Scene, image: np.ndarray, svg_path, image_path) -> None:
     scene.width, scene.height = w / scale, h / scale
 
 
-def seen(rgba: np.ndarray, background) -> np.ndarray:
-    """The channels the loss compares (loop.Target.compared): RGB over an opaque background,
-    else premultiplied RGBA."""
-    a = rgba[..., 3:]
-    if background is not None:
-        return rgba[..., :3] * a + np.asarray(background[:3], np.float32) * (1 - a)
-    return np.concatenate([rgba[..., :3] * a, a], axis=2)
 
 
 def region_psnr(result: np.ndarray, target: np.ndarray, region: np.ndarray) -> float | None:

@@ -26,7 +26,7 @@ from vecfit.editing.seams import carve, foreground, remove_seam
 from vecfit.editing.settings import RetargetSettings
 from vecfit.errors import VecfitError
 from vecfit.fitting.loop import Settings, Target, optimize
-from vecfit.fitting.metrics import compare, to_rgb
+from vecfit.fitting.metrics import compare, seen, to_rgb
 from vecfit.io.report import save_panels, save_report, side_by_side
 from vecfit.renderer import device as devices
 from vecfit.renderer.raster import render
@@ -34,7 +34,6 @@ from vecfit.svg.numbers import hex_color
 from vecfit.svg.write import write_svg
 
 from .config import settings_of
-from .edit import seen
 from .fit import Outputs, background_for, load_scene_to_fit
 
 MIN_SIDE = 11
@@ -63,6 +62,13 @@ def run(svg_path, config: dict, outputs: Outputs, progress=None, width=None, hei
     svg_path = Path(svg_path)
     outputs.check_against(svg_path)
     outputs.report.unlink(missing_ok=True)  # a report marks a finished run
+    retarget = settings_of(RetargetSettings, config["retarget"])
+    retarget.check()
+    # (arguments win over the config's retarget.width / height, which batch runs use)
+    width = width if width is not None else (str(retarget.width).strip() or None)
+    height = height if height is not None else (str(retarget.height).strip() or None)
+    if width is None and height is None:
+        raise VecfitError("no new size: give --width (or --height), or retarget.width in the config")
     scene = load_scene_to_fit(svg_path)
     w0, h0 = scene.width, scene.height
     if not (w0 > 0 and h0 > 0):
@@ -76,8 +82,6 @@ def run(svg_path, config: dict, outputs: Outputs, progress=None, width=None, hei
         raise VecfitError(f"{new_w:g}x{new_h:g} is too small (at least {MIN_SIDE}x{MIN_SIDE} pixels)")
     if round(new_w) == round(w0) and round(new_h) == round(h0):
         raise VecfitError(f"{svg_path} is already {w0:g}x{h0:g}: nothing to retarget")
-    retarget = settings_of(RetargetSettings, config["retarget"])
-    retarget.check()
     opt = {**config["optimize"], "device": devices.device_name(devices.resolve(config["optimize"]["device"]))}
     settings = Settings.from_config(opt)
     if not any(v and settings.lr.get(k, 0) > 0 for k, v in scene.parameters().items()):
