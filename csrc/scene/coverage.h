@@ -53,9 +53,10 @@ namespace vf {
 
 // Which piece a signed distance came from, for its gradient (analytical prefilter).
 struct SdfArg {
-    enum Kind { NONE, SEGMENT, ELLIPSE, SWEEP, BUTT, END } kind = NONE;
+    enum Kind { NONE, SEGMENT, ELLIPSE, SWEEP, BUTT, END, SEAM } kind = NONE;
     int item = -1;     // fill or stroke item (global index)
-    int side = 0;      // BUTT / END: 0 at the item's start, 1 at its end; SEGMENT on the
+    int side = 0;      // BUTT / END / SEAM: 0 at the item's start, 1 at its end (SEAM: the
+                       // bevel edge bounding the sweep, see bevel_edge); SEGMENT on the
                        // edge (see ON_EDGE): +1 / -1 where the inside lies along +/- the
                        // segment's left normal, 0 where it lies on both sides or neither
     double t = 0;      // SEGMENT / SWEEP: parameter of the closest point
@@ -135,6 +136,19 @@ VF_HD double join_polygon_sdf(const Vec2* v, int n, Vec2 q) {
         if (i != 0 && i != n - 1) outer = vmin(outer, d);
     }
     return convex_contains(v, n, q) ? -outer : all;
+}
+
+// The outer edge of a bevel join (or of a miter join's bevel fallback), nullptr for any
+// other end piece. Seam rule: the sweeps on either side of a bevel are no deeper than
+// their distance to this edge. A sweep's depth is its distance to its offset curves, the
+// bevel triangle's its distance to this edge, and on the seam between them (the sweep's
+// end normal, at s from the vertex) the two differ: hw - s against (hw - s) cos(turn / 2),
+// so the image jumped where a point crossed it. Bounded, the sweep is as deep as the
+// triangle on the seam (the edge is the closer there), and near the vertex its depth is
+// the true one (the bevel edge is the union's boundary). Round joins, miters within their
+// limit, caps and butt ends already agree with the sweep on their seams.
+VF_HD const Vec2* bevel_edge(const StrokeEnd& e) {
+    return e.kind == StrokeEnd::POLYGON && e.n_poly == 3 ? e.poly + 1 : nullptr;
 }
 
 // Local frame of a square cap: s along the outward tangent from the end point, u across.
@@ -292,8 +306,11 @@ VF_HD bool stroke_item_contains(const StrokeSegment& s, Vec2 q) {
 }
 
 // Signed distance (stroke space) to this item's pieces. The butt end lines of free ends
-// bound the sweep; other end normals are interior seams covered by a join or cap.
-VF_HD double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double limit, SdfArg* arg = nullptr) {
+// bound the sweep; other end normals are interior seams covered by a join or cap, and a
+// bevel join's outer edge bounds the sweeps on both its sides (bevel_edge). `items`: the
+// draw's stroke items, by global index (the join at this item's start is its prev's end).
+VF_HD double stroke_item_sdf(const StrokeSegment* items, const StrokeSegment& s, Vec2 q, double limit,
+                             SdfArg* arg = nullptr) {
     // Farther than hw + limit from the hull: the sweep cannot bring the distance under limit.
     double t = 0;
     double sd = near_segment(s, q, s.hw_max + limit) ? sweep_sdf(s, q, &t) : 1e300;
@@ -313,6 +330,14 @@ VF_HD double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double limit, SdfAr
         double combined = sd <= 0 ? vmax(sd, -dl) : vmin(sd, dl);
         if (combined != sd) { kind = SdfArg::BUTT; side = dl_side; }
         sd = combined;
+    }
+    if (sd <= 0) {  // the seam rule: inside the sweep, bevel edges at either end bound the depth
+        for (int k = 0; k < 2; ++k) {
+            const Vec2* edge = k == 0 ? (s.prev >= 0 ? bevel_edge(items[s.prev].end) : nullptr) : bevel_edge(s.end);
+            if (!edge) continue;
+            double e = -point_line_segment_distance(q, edge[0], edge[1]);
+            if (e > sd) { sd = e; kind = SdfArg::SEAM; side = k; }
+        }
     }
     double e0 = end_sdf(s.start, q), e1 = end_sdf(s.end, q);
     if (e0 < sd) { sd = e0; kind = SdfArg::END; side = 0; }
@@ -415,7 +440,8 @@ VF_HD double stroke_sdf(const SceneView& sc, const PreparedDraw& d, const Items&
         for (int i = 0; i < items.size(); ++i) {
             Box b = grown(all[items[i]].box, limit);
             if (p.x < b.x0 || p.x > b.x1 || p.y < b.y0 || p.y > b.y1) continue;
-            double v = stroke_item_sdf(all[items[i]], q, limit / d.metric_scale, arg ? &local : nullptr);
+            double v = stroke_item_sdf(sc.stroke_items.data(), all[items[i]], q, limit / d.metric_scale,
+                                       arg ? &local : nullptr);
             if (v < sd) {
                 sd = v;
                 if (arg) {

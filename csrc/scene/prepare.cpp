@@ -177,6 +177,7 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
             } else {
                 StrokeSegment& next = segs[last ? 0 : i + 1];
                 segs[i].next = (int)out.size() + (last ? 0 : i + 1);
+                next.prev = (int)out.size() + i;
                 if (var && !last && next.source == segs[i].source) {
                     // Pieces of one curve meet smoothly: no join (a disk of the local width
                     // could stick out of a sweep whose width changes fast).
