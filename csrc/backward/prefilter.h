@@ -48,17 +48,24 @@ VF_HD void fill_sdf_backward(const SceneView& sc, const PreparedDraw& d, const H
     if (arg.kind == SdfArg::SEGMENT) {
         // d sd / d(closest point): the inward direction, sign (closest - p) / dist off the
         // edge; on it, the unit normal on the inside's side (none where both or neither are).
-        const PreparedSegment& seg = sc.fill_items[arg.item];
-        Vec2 inward;
-        if (dist >= ON_EDGE) inward = (sign / dist) * (arg.closest - p);
-        else {
-            Vec2 tangent = seg_deriv(seg.seg, arg.t);
-            double speed = length(tangent);
-            if (arg.side == 0 || speed <= 0) return;
-            inward = (arg.side / speed) * perp(tangent);
+        // On a vertex (a second segment within ON_EDGE), half to each: the central derivative.
+        bool vertex = dist < ON_EDGE && arg.item2 >= 0;
+        for (int k = 0; k < (vertex ? 2 : 1); ++k) {
+            const PreparedSegment& seg = sc.fill_items[k == 0 ? arg.item : arg.item2];
+            double t = k == 0 ? arg.t : arg.t2;
+            int side = k == 0 ? arg.side : arg.side2;
+            Vec2 inward;
+            if (dist >= ON_EDGE) inward = (sign / dist) * (arg.closest - p);
+            else {
+                Vec2 tangent = seg_deriv(seg.seg, t);
+                double speed = length(tangent);
+                if (side == 0 || speed <= 0) continue;
+                inward = (side / speed) * perp(tangent);
+            }
+            double w = vertex ? 0.5 * g_sd : g_sd;
+            for (int i = 0; i <= seg.seg.degree; ++i)
+                add_point_grad(g, seg.point_index[i], (w * bernstein(seg.seg.degree, i, t)) * inward);
         }
-        for (int i = 0; i <= seg.seg.degree; ++i)
-            add_point_grad(g, seg.point_index[i], (g_sd * bernstein(seg.seg.degree, i, arg.t)) * inward);
         return;
     }
     if (dist <= 0) return;

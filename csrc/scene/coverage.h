@@ -61,6 +61,10 @@ struct SdfArg {
                        // segment's left normal, 0 where it lies on both sides or neither
     double t = 0;      // SEGMENT / SWEEP: parameter of the closest point
     Vec2 closest;      // SEGMENT / SWEEP / ELLIPSE: the closest point
+    // SEGMENT on the edge: a second segment also within ON_EDGE (the sample on a vertex,
+    // e.g. a rect's corner on a pixel centre), its parameter and inside side; -1: none
+    int item2 = -1, side2 = 0;
+    double t2 = 0;
 };
 
 // Signed crossings of the ray from p towards +x, up to and including x_max, with the
@@ -90,7 +94,10 @@ VF_HD int ray_crossings(const PreparedSegment& s, Vec2 p, double x_max = 1e300) 
 // A fill's signed distance is +-|closest - p|; within ON_EDGE (pixels) of the edge the
 // direction closest - p is lost to rounding (exactly 0 where a pixel centre lies on the
 // edge, as on mcseem2's 45-degree segments through integer points), so its gradient takes
-// the segment's normal, turned towards the inside (SdfArg::side).
+// the segment's normal, turned towards the inside (SdfArg::side). That is the two-sided
+// derivative: across one edge the signed distance is linear. On a vertex, within ON_EDGE
+// of two segments, it is a kink (the max or min of the two edges' signed distances), and
+// its central derivative is the mean of the two segments' (SdfArg::item2): half each.
 constexpr double ON_EDGE = 1e-7;
 
 // Parabolic prefilter kernel: coverage of a half-plane at signed distance d (in units of
@@ -380,7 +387,8 @@ VF_HD double fill_distance(const SceneView& sc, const PreparedDraw& d, const Ite
     double best = limit;
     for (int i = 0; i < items.size(); ++i) {
         const PreparedSegment& s = segs[items[i]];
-        if (distance2(s.box, p) >= best * best) continue;
+        double reach = best < ON_EDGE ? ON_EDGE : best;  // on an edge: look for a second one
+        if (distance2(s.box, p) >= reach * reach) continue;
         Closest c;
         if (s.seg.degree == 1) {
             Vec2 a = s.seg.p[0], e = s.seg.p[1] - a;
@@ -390,9 +398,23 @@ VF_HD double fill_distance(const SceneView& sc, const PreparedDraw& d, const Ite
         } else {
             c = seg_closest(s.seg, p);
         }
+        if (arg && c.dist < ON_EDGE && best < ON_EDGE) {  // a vertex: keep both segments
+            int keep = c.dist < best ? arg->item : d.first_item + items[i];
+            double keep_t = c.dist < best ? arg->t : c.t;
+            if (c.dist < best) {
+                best = c.dist;
+                arg->item = d.first_item + items[i];
+                arg->t = c.t;
+                arg->closest = seg_eval(s.seg, c.t);
+            }
+            arg->item2 = keep;
+            arg->t2 = keep_t;
+            continue;
+        }
         if (c.dist < best) {
             best = c.dist;
             if (arg) {
+                arg->item2 = -1;
                 arg->kind = SdfArg::SEGMENT;
                 arg->item = d.first_item + items[i];
                 arg->t = c.t;
