@@ -2,7 +2,7 @@
 
 The twin computes each pixel's coverage K(sd / r) from the same pieces as the core
 (scene/coverage.h: fill segments; per stroke segment its sweep, butt end lines, caps and
-joins, DESIGN.md "Strokes"), with the closest points found without gradients (the distance
+joins, and the bevel edges that bound the sweeps beside them, DESIGN.md "Strokes"), with the closest points found without gradients (the distance
 is stationary there) and autograd through the distance and the kernel. One scene per
 piece kind, each a single shape over white at 1 sample per pixel: the twin's image must
 equal the core's (so the twin is the same function), then every point's gradient and the

@@ -116,7 +116,7 @@ VF_HD void collect_hits_analytic(const SceneView& sc, const TileView& bins, Vec2
                     double speed = length(tangent);
                     a.closest = seg_eval(sg, a.t);
                     if (speed > 0) a.closest = a.closest + ((a.t < 0.5 ? 100 : -100) * ON_EDGE / speed) * tangent;
-                    (k == 0 ? h.arg.side : h.arg.side2) = entry_inside_side(sc, bins, e, region, a);
+                    (k == 0 ? h.arg.side : h.arg.side2) = (int8_t)entry_inside_side(sc, bins, e, region, a);
                 }
             }
         }

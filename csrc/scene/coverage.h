@@ -14,7 +14,8 @@
 // Pieces meet along internal seams (a sweep's end normal, a join polygon's sides from the
 // vertex, a cap's back edge). Signed distances treat seams as open: a point inside a piece
 // is as deep as its distance to the piece's real boundary, so the analytical prefilter
-// sees no lines inside a stroke.
+// sees no lines inside a stroke; where two pieces disagree on a seam (a sweep and a bevel
+// triangle) the image would jump there, which the seam rule prevents (bevel_edge).
 // Why this form: each piece has a simple inside test and a signed distance, and the
 // union's boundary is a set of curves with known normals (offset curves, disk arcs,
 // polygon edges, butt end lines), which is what boundary sampling needs for gradients.
@@ -52,20 +53,24 @@
 namespace vf {
 
 // Which piece a signed distance came from, for its gradient (analytical prefilter).
+// (Packed to 40 bytes: a Hit, which holds one, stays within two cache lines.)
 struct SdfArg {
-    enum Kind { NONE, SEGMENT, ELLIPSE, SWEEP, BUTT, END, SEAM } kind = NONE;
-    int item = -1;     // fill or stroke item (global index)
-    int side = 0;      // BUTT / END / SEAM: 0 at the item's start, 1 at its end (SEAM: the
+    enum Kind : int8_t { NONE, SEGMENT, ELLIPSE, SWEEP, BUTT, END, SEAM } kind = NONE;
+    int8_t side = 0;   // BUTT / END / SEAM: 0 at the item's start, 1 at its end (SEAM: the
                        // bevel edge bounding the sweep, see bevel_edge); SEGMENT on the
                        // edge (see ON_EDGE): +1 / -1 where the inside lies along +/- the
                        // segment's left normal, 0 where it lies on both sides or neither
+    // SEGMENT on the edge: a second segment also within ON_EDGE (the sample on a vertex,
+    // e.g. a rect's corner on a pixel centre), its inside side, index (-1: none) and
+    // parameter (a float: only its Bernstein weights use it)
+    int8_t side2 = 0;
+    int item = -1;     // fill or stroke item (global index)
+    int item2 = -1;
+    float t2 = 0;
     double t = 0;      // SEGMENT / SWEEP: parameter of the closest point
     Vec2 closest;      // SEGMENT / SWEEP / ELLIPSE: the closest point
-    // SEGMENT on the edge: a second segment also within ON_EDGE (the sample on a vertex,
-    // e.g. a rect's corner on a pixel centre), its parameter and inside side; -1: none
-    int item2 = -1, side2 = 0;
-    double t2 = 0;
 };
+static_assert(sizeof(SdfArg) == 40, "SdfArg grew: a Hit would span a third cache line");
 
 // Signed crossings of the ray from p towards +x, up to and including x_max, with the
 // segment; each y-monotone piece counts on the half-open range [y_low, y_high) so that
@@ -338,9 +343,10 @@ VF_HD double stroke_item_sdf(const StrokeSegment* items, const StrokeSegment& s,
         if (combined != sd) { kind = SdfArg::BUTT; side = dl_side; }
         sd = combined;
     }
-    if (sd <= 0) {  // the seam rule: inside the sweep, bevel edges at either end bound the depth
+    // the seam rule: inside the sweep, bevel edges at either end bound the depth
+    if (sd <= 0 && (s.bevel_start || s.end.kind == StrokeEnd::POLYGON)) {
         for (int k = 0; k < 2; ++k) {
-            const Vec2* edge = k == 0 ? (s.prev >= 0 ? bevel_edge(items[s.prev].end) : nullptr) : bevel_edge(s.end);
+            const Vec2* edge = k == 0 ? (s.bevel_start ? bevel_edge(items[s.prev].end) : nullptr) : bevel_edge(s.end);
             if (!edge) continue;
             double e = -point_line_segment_distance(q, edge[0], edge[1]);
             if (e > sd) { sd = e; kind = SdfArg::SEAM; side = k; }
@@ -400,7 +406,7 @@ VF_HD double fill_distance(const SceneView& sc, const PreparedDraw& d, const Ite
         }
         if (arg && c.dist < ON_EDGE && best < ON_EDGE) {  // a vertex: keep both segments
             int keep = c.dist < best ? arg->item : d.first_item + items[i];
-            double keep_t = c.dist < best ? arg->t : c.t;
+            double keep_t = c.dist < best ? arg->t : c.t;  // (stored as a float)
             if (c.dist < best) {
                 best = c.dist;
                 arg->item = d.first_item + items[i];
@@ -408,7 +414,7 @@ VF_HD double fill_distance(const SceneView& sc, const PreparedDraw& d, const Ite
                 arg->closest = seg_eval(s.seg, c.t);
             }
             arg->item2 = keep;
-            arg->t2 = keep_t;
+            arg->t2 = (float)keep_t;
             continue;
         }
         if (c.dist < best) {

@@ -190,6 +190,7 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
                 if (var && point_hw(k2) > point_hw(k)) k = k2;
                 segs[i].end = make_join(seg_end(segs[i].seg), seg_end_tangent(segs[i].seg, true),
                                         seg_end_tangent(next.seg, false), d.join, point_hw(k), d.miter_limit);
+                next.bevel_start = segs[i].end.kind == StrokeEnd::POLYGON && segs[i].end.n_poly == 3;
                 set_width(segs[i].end, k);
             }
         }
