@@ -393,8 +393,8 @@ VF_HD double fill_distance(const SceneView& sc, const PreparedDraw& d, const Ite
     double best = limit;
     for (int i = 0; i < items.size(); ++i) {
         const PreparedSegment& s = segs[items[i]];
-        double reach = best < ON_EDGE ? ON_EDGE : best;  // on an edge: look for a second one
-        if (distance2(s.box, p) >= reach * reach) continue;
+        double d2 = distance2(s.box, p);  // (on an edge, with arg: look for a second one)
+        if (d2 >= best * best && !(arg && best < ON_EDGE && d2 < ON_EDGE * ON_EDGE)) continue;
         Closest c;
         if (s.seg.degree == 1) {
             Vec2 a = s.seg.p[0], e = s.seg.p[1] - a;
