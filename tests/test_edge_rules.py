@@ -10,8 +10,9 @@ is a kink" and "Analytical prefilter").
   the CPU and a GPU (nvcc's fused multiply-adds round a sample point differently: tiger's
   background rect got 5.29, -1.69, ... on one and 0 on the other), and what these tests
   catch without one (the pixel rule is the core's own function, through a test hook).
-- Analytical: a pixel centre exactly on an edge takes the edge's normal.
-Cost: about 2 s.
+- Analytical: a pixel centre exactly on an edge takes the edge's normal; on a vertex, half
+  of each segment's (the central derivative of the kink).
+Cost: about 3 s.
 """
 from __future__ import annotations
 
@@ -130,3 +131,41 @@ def test_analytic_fill_with_pixel_centres_on_its_edges():
     with torch.no_grad():
         fd = float(loss(torch.tensor(h)) - loss(torch.tensor(-h))) / (2 * h)
     assert abs(dx.grad.item() - fd) <= 0.01 * abs(fd), (dx.grad.item(), fd)
+
+
+@pytest.mark.parametrize("samples", [1, 2])
+def test_analytic_rect_edges_on_sample_centres_and_pixel_lines(samples):
+    """Each edge coordinate of a rect against central differences, analytical mode, with
+    edges through sample centres (within ON_EDGE) and on a pixel line. Across one edge the
+    signed distance is linear (-+|d|, the sign flipping where |d| kinks), so the edge's
+    inward normal is its derivative from either side. On a corner it is a kink, the max of
+    the two edges' signed distances, whose central derivative is the mean of the two: the
+    corners (4 + c, 3 + c) and (4 + c, 12 + c) lie on sample centres, and with one segment
+    taken (before) p_min.x was 8.04 against 9.26 by differences at 1x1. On the pixel line
+    the edge is one kernel radius from the centres, where the kernel's slope is 0: gradient
+    and differences are both about 0."""
+    c = 0.5 / samples  # a sample centre's offset from the pixel corner
+    lo = torch.tensor([4.0 + c, 3.0 + c])     # through sample centres
+    hi = torch.tensor([15.0, 12.0 + c])       # x on a pixel line, y through sample centres
+    W = weights(2)
+
+    def loss(p_min, p_max):
+        shapes = [Shape(geometry=Rect(p_min=p_min, p_max=p_max), fill=Solid(torch.tensor([0.2, 0.5, 0.9, 1.0])))]
+        img = vecfit.render(Scene(width=SIZE, height=SIZE, shapes=shapes), SIZE, SIZE, samples=samples,
+                            mode="analytic", background=(1, 1, 1))
+        return (img.double() * W.double()).sum()
+
+    p_min, p_max = lo.clone().requires_grad_(True), hi.clone().requires_grad_(True)
+    loss(p_min, p_max).backward()
+    got = torch.cat([p_min.grad, p_max.grad]).double()
+    h = 1e-3
+    fd = []
+    for k in range(4):
+        e = torch.zeros(4)
+        e[k] = h
+        with torch.no_grad():
+            fd.append(float(loss(lo + e[:2], hi + e[2:]) - loss(lo - e[:2], hi - e[2:])) / (2 * h))
+    fd = torch.tensor(fd, dtype=torch.float64)
+    scale = float(fd.abs().max())
+    assert scale > 1  # the edges through sample centres move pixels
+    assert torch.allclose(got, fd, atol=0.01 * scale), (got, fd)

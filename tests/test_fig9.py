@@ -7,7 +7,7 @@ sides (vecfit/renderer/fig9.py; benchmarks/fig9.py prints the full table).
 Analytical 1x1 at a step of 0.01 px: its image curves within +-0.5 px (the kernel's support
 is one pixel wide, sampled once per pixel: the slope of L swings from -30 to 160 across
 tiger's +-0.5 px, smoothly), so a wide step measures the curve, not the derivative. At 0.01
-px: tiger 0.3% / 0.6%, mcseem2 0.6% / 0.3% (before the on-edge fix mcseem2 was 4-7% off at
+px: tiger 0.4% / 0.5%, mcseem2 0.6% / 0.3% (before the on-edge fix mcseem2 was 4-7% off at
 any small step). Tolerance 3%, the issue's: the remaining error is the kinks of the
 prefiltered image (thin strokes' centre lines, medial axes of slivers), which make L' vary
 by a few % within 0.01 px.

@@ -2,7 +2,7 @@
 
 The twin computes each pixel's coverage K(sd / r) from the same pieces as the core
 (scene/coverage.h: fill segments; per stroke segment its sweep, butt end lines, caps and
-joins, DESIGN.md "Strokes"), with the closest points found without gradients (the distance
+joins, and the bevel edges that bound the sweeps beside them, DESIGN.md "Strokes"), with the closest points found without gradients (the distance
 is stationary there) and autograd through the distance and the kernel. One scene per
 piece kind, each a single shape over white at 1 sample per pixel: the twin's image must
 equal the core's (so the twin is the same function), then every point's gradient and the
@@ -113,17 +113,31 @@ def join_polygon_sd(poly, q):
     return torch.where(inside, -outer, dists.min(dim=0).values)
 
 
-def join_sd(v, t_in, t_out, kind, hw, q, miter_limit=4.0):
-    if kind == "round":
-        return (q - v).norm(dim=-1) - hw
+def join_polygon(v, t_in, t_out, kind, hw, miter_limit=4.0):
+    """scene/stroke.h make_join's polygon: the vertex, then its outer points (a bevel
+    triangle, or the miter quadrilateral within the limit)."""
     s = 1.0 if float(cross(t_in, t_out).detach()) >= 0 else -1.0
     n_in, n_out = -s * perp(t_in), -s * perp(t_out)
     cos_half = (0.5 * (1 + (t_in * t_out).sum())).clamp(min=0).sqrt()
     if kind == "miter" and 1 / float(cos_half.detach()) <= miter_limit:
-        poly = [v, v + hw * n_in, v + (hw / cos_half) * unit(n_in + n_out), v + hw * n_out]
-    else:
-        poly = [v, v + hw * n_in, v + hw * n_out]
-    return join_polygon_sd(poly, q)
+        return [v, v + hw * n_in, v + (hw / cos_half) * unit(n_in + n_out), v + hw * n_out]
+    return [v, v + hw * n_in, v + hw * n_out]
+
+
+def join_sd(v, t_in, t_out, kind, hw, q, miter_limit=4.0):
+    if kind == "round":
+        return (q - v).norm(dim=-1) - hw
+    return join_polygon_sd(join_polygon(v, t_in, t_out, kind, hw, miter_limit), q)
+
+
+def bevel_edge_distance(v, t_in, t_out, kind, hw, q):
+    """The seam rule (scene/coverage.h bevel_edge): the distance to a bevel's outer edge
+    (also a miter's past its limit), which bounds the depth of the sweeps on both sides;
+    None for other joins."""
+    if kind == "round":
+        return None
+    poly = join_polygon(v, t_in, t_out, kind, hw)
+    return segment_distance(q, poly[1], poly[2]) if len(poly) == 3 else None
 
 
 def cap_sd(v, outward, kind, hw, q):
@@ -139,18 +153,32 @@ def cap_sd(v, outward, kind, hw, q):
     return torch.where(inside, -torch.minimum(hw - s, hw - au), outside)
 
 
-def stroke_sd(segments, hw, q, cap, join):
-    """An open stroke of the segments (control points each) with the cap and join."""
+def end_tangent(P, t):
+    return unit(bezier_deriv(P, torch.tensor(float(t), dtype=torch.float64)))
+
+
+def stroke_sd(segments, hw, q, cap, join, seams=None):
+    """An open stroke of the segments (control points each) with the cap and join.
+    seams, if a list: gets per pixel whether a bevel edge bounded a sweep there."""
     sds = []
     for k, P in enumerate(segments):
         sd = sweep_distance(P, q) - hw
-        t0, t1 = unit(bezier_deriv(P, torch.tensor(0.0, dtype=torch.float64))), \
-            unit(bezier_deriv(P, torch.tensor(1.0, dtype=torch.float64)))
+        t0, t1 = end_tangent(P, 0), end_tangent(P, 1)
         ends = [(0, P[0], t0, k == 0), (1, P[-1], t1, k == len(segments) - 1)]
-        if cap == "butt":
+        if cap == "butt" and (k == 0 or k == len(segments) - 1):
             dl = torch.stack([segment_distance(q, at - hw * perp(t), at + hw * perp(t))
                               for side, at, t, free in ends if free]).min(dim=0).values
             sd = torch.where(sd <= 0, torch.maximum(sd, -dl), torch.minimum(sd, dl))
+        # the joins at this sweep's ends: (vertex, incoming tangent, outgoing tangent)
+        joins = ([(P[0], end_tangent(segments[k - 1], 1), t0)] if k > 0 else []) + \
+            ([(P[-1], t1, end_tangent(segments[k + 1], 0))] if k + 1 < len(segments) else [])
+        for v, t_in, t_out in joins:
+            e = bevel_edge_distance(v, t_in, t_out, join, hw, q)
+            if e is not None:
+                bounded = (sd <= 0) & (-e > sd)
+                if seams is not None:
+                    seams.append(bounded.detach())
+                sd = torch.where(sd <= 0, torch.maximum(sd, -e), sd)
         for side, at, t, free in ends:
             if free and cap != "butt":
                 sd = torch.minimum(sd, cap_sd(at, -t if side == 0 else t, cap, hw, q))
@@ -246,6 +274,11 @@ STROKES = {
     "miter join": (torch.tensor([[3.2, 18.1], [11.7, 5.3], [20.4, 17.6]]), [1, 1], 3.6, "butt", "miter"),
     "join of curves": (torch.tensor([[3.2, 18.1], [4.0, 8.0], [11.7, 5.3], [17.0, 9.0], [20.4, 17.6]]), [2, 2], 3.0,
                        "round", "miter"),
+    # the seam rule: a wide bevel whose edge bounds both sweeps' depth within the kernel's
+    # reach of pixel centres, and a miter's bevel fallback (a 160-degree turn) between curves
+    "bevel seams": (torch.tensor([[4.06, 11.55], [13.5, 8.25], [9.96, 17.6]]), [1, 1], 7.4, "butt", "bevel"),
+    "miter past its limit, curves": (torch.tensor([[2.6, 9.05], [9.0, 6.75], [17.4, 9.85], [10.0, 10.55], [3.1, 13.35]]),
+                                     [2, 2], 4.2, "round", "miter"),
 }
 
 
@@ -255,5 +288,11 @@ def test_strokes(kind):
     core_img, g_points, g_width = core(points, degrees, width, cap, join)
     P = points.double().clone().requires_grad_(True)
     w = torch.tensor(width, dtype=torch.float64, requires_grad=True)
-    sd = stroke_sd(split(P, degrees), w / 2, centres(), cap, join)
+    seams = []
+    sd = stroke_sd(split(P, degrees), w / 2, centres(), cap, join, seams)
+    if "seam" in kind or "past its limit" in kind:
+        # the scene must exercise the rule: pixels whose depth a bevel edge bounds, within the
+        # kernel's reach of the edge (where the coverage depends on it)
+        used = torch.stack(seams).any(dim=0) & (sd.detach().abs() < R)
+        assert int(used.sum()) >= 2, f"{kind}: the seam rule decides no pixel"
     compare(f"stroke, {kind}", core_img, (g_points, g_width), coverage(sd), (P, w))

@@ -148,8 +148,23 @@ VF_HD void collect_hits_analytic(const SceneView& sc, const TileView& bins, Vec2
         Hit h;
         h.draw = e.draw;
         h.sd = entry_sdf(sc, bins, e, region, p, r, &h.arg);
-        if (h.arg.kind == SdfArg::SEGMENT && std::fabs(h.sd) < ON_EDGE)
-            h.arg.side = entry_inside_side(sc, bins, e, region, h.arg);
+        if (h.arg.kind == SdfArg::SEGMENT && std::fabs(h.sd) < ON_EDGE) {
+            if (h.arg.item2 < 0) h.arg.side = entry_inside_side(sc, bins, e, region, h.arg);
+            else {  // on a vertex: each segment's side, probed a little into the segment (at
+                    // the vertex itself the probes lie on the other edge's line)
+                for (int k = 0; k < 2; ++k) {
+                    SdfArg a = h.arg;
+                    a.item = k == 0 ? h.arg.item : h.arg.item2;
+                    a.t = k == 0 ? h.arg.t : h.arg.t2;
+                    const Segment& sg = sc.fill_items[a.item].seg;
+                    Vec2 tangent = seg_deriv(sg, a.t);
+                    double speed = length(tangent);
+                    a.closest = seg_eval(sg, a.t);
+                    if (speed > 0) a.closest = a.closest + ((a.t < 0.5 ? 100 : -100) * ON_EDGE / speed) * tangent;
+                    (k == 0 ? h.arg.side : h.arg.side2) = (int8_t)entry_inside_side(sc, bins, e, region, a);
+                }
+            }
+        }
         h.cov = kernel_coverage(h.sd / r);
         if (h.cov <= 0) continue;
         brush_color(sc, sc.brushes[d.brush], p, h.brush);

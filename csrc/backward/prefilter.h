@@ -20,8 +20,9 @@ namespace vf {
 // Adds g_sd * d(sd)/d(parameters) for a hit of the analytical prefilter. At a closest
 // point the first-order condition holds, so the solver's t* drops out (implicit
 // function theorem): d|B(t*) - p| / dP_i = basis_i(t*) (B(t*) - p) / |B(t*) - p|.
-// Joins, caps and butt ends: central differences of their construction in the vertex,
-// the tangents' angles and the width. entry_sdf_backward at the end dispatches to the pieces.
+// Joins, caps, butt ends and bevel edges bounding sweeps (the seam rule, scene/coverage.h
+// bevel_edge): central differences of their construction in the vertex, the tangents'
+// angles and the width. entry_sdf_backward at the end dispatches to the pieces.
 
 // v = d sd / d(pixel-space point idx); idx < 0: a point no input holds.
 VF_HD void add_point_grad(const GradView& g, int32_t idx, Vec2 v) {
@@ -47,17 +48,24 @@ VF_HD void fill_sdf_backward(const SceneView& sc, const PreparedDraw& d, const H
     if (arg.kind == SdfArg::SEGMENT) {
         // d sd / d(closest point): the inward direction, sign (closest - p) / dist off the
         // edge; on it, the unit normal on the inside's side (none where both or neither are).
-        const PreparedSegment& seg = sc.fill_items[arg.item];
-        Vec2 inward;
-        if (dist >= ON_EDGE) inward = (sign / dist) * (arg.closest - p);
-        else {
-            Vec2 tangent = seg_deriv(seg.seg, arg.t);
-            double speed = length(tangent);
-            if (arg.side == 0 || speed <= 0) return;
-            inward = (arg.side / speed) * perp(tangent);
+        // On a vertex (a second segment within ON_EDGE), half to each: the central derivative.
+        bool vertex = dist < ON_EDGE && arg.item2 >= 0;
+        for (int k = 0; k < (vertex ? 2 : 1); ++k) {
+            const PreparedSegment& seg = sc.fill_items[k == 0 ? arg.item : arg.item2];
+            double t = k == 0 ? arg.t : arg.t2;
+            int side = k == 0 ? arg.side : arg.side2;
+            Vec2 inward;
+            if (dist >= ON_EDGE) inward = (sign / dist) * (arg.closest - p);
+            else {
+                Vec2 tangent = seg_deriv(seg.seg, t);
+                double speed = length(tangent);
+                if (side == 0 || speed <= 0) continue;
+                inward = (side / speed) * perp(tangent);
+            }
+            double w = vertex ? 0.5 * g_sd : g_sd;
+            for (int i = 0; i <= seg.seg.degree; ++i)
+                add_point_grad(g, seg.point_index[i], (w * bernstein(seg.seg.degree, i, t)) * inward);
         }
-        for (int i = 0; i <= seg.seg.degree; ++i)
-            add_point_grad(g, seg.point_index[i], (g_sd * bernstein(seg.seg.degree, i, arg.t)) * inward);
         return;
     }
     if (dist <= 0) return;
@@ -168,6 +176,7 @@ struct EndPiece {
     Vec2 V;
     int side;                 // 0: the item's start, 1: its end
     bool butt, join, point;   // butt end line; join with the next item; a zero-length subpath's dot
+    bool seam;                // the join's bevel edge bounding a sweep (SdfArg::SEAM)
     double sign;              // of the hit's sd (the butt end line's distance is unsigned)
 
     VF_HD double sd(Vec2 qq, Vec2 t_in, Vec2 t_out, double w) const {
@@ -176,6 +185,11 @@ struct EndPiece {
             return sign * point_line_segment_distance(qq, V - w * n, V + w * n);
         }
         StrokeEnd e;
+        if (seam) {  // -(distance to the outer edge), inside the sweep next to the bevel
+            e = make_join(V, t_in, t_out, d.join, w, d.miter_limit);
+            const Vec2* edge = bevel_edge(e);
+            return edge ? -point_line_segment_distance(qq, edge[0], edge[1]) : 0.0;
+        }
         if (join) e = make_join(V, t_in, t_out, d.join, w, d.miter_limit);
         else if (point) {
             e = stored;
@@ -185,25 +199,28 @@ struct EndPiece {
     }
 };
 
-// BUTT / END: central differences of EndPiece::sd in q (the vertex moves the piece: d/dV =
-// -d/dq), in the half width and in the angles of the tangents, which turn with the
-// control points of their end frames.
+// BUTT / END / SEAM: central differences of EndPiece::sd in q (the vertex moves the piece:
+// d/dV = -d/dq), in the half width and in the angles of the tangents, which turn with the
+// control points of their end frames. A SEAM hit at an item's start is its prev item's
+// join: it is handled as that item's end.
 VF_HD void end_sdf_backward(const StrokeChain& c, const Hit& h) {
     const SceneView& sc = c.sc;
     const PreparedDraw& d = c.d;
     const SdfArg& arg = h.arg;
     const Vec2 q = c.q;
     const double gs = c.gs;
-    const StrokeSegment& s = sc.stroke_items[arg.item];
-    int side = arg.side;
+    bool seam = arg.kind == SdfArg::SEAM;
+    const int item = seam && arg.side == 0 ? sc.stroke_items[arg.item].prev : arg.item;
+    const StrokeSegment& s = sc.stroke_items[item];
+    int side = seam ? 1 : arg.side;
     bool point = s.seg.degree == 1 && s.seg.p[0].x == s.seg.p[1].x && s.seg.p[0].y == s.seg.p[1].y;
     EndFrame in = end_frame(whole_segment(sc, d, s), side == 1), out;
-    bool join = side == 1 && arg.kind == SdfArg::END && s.next >= 0 && s.end.kind != StrokeEnd::NONE;
+    bool join = side == 1 && (arg.kind == SdfArg::END || seam) && s.next >= 0 && s.end.kind != StrokeEnd::NONE;
     if (join) out = end_frame(whole_segment(sc, d, sc.stroke_items[s.next]), false);
     Vec2 V = side == 0 ? s.seg.p[0] : seg_end(s.seg);
     const StrokeEnd& stored = side == 0 ? s.start : s.end;
     double hw = stored.hw;  // the draw's, or the vertex's (per-point widths)
-    const EndPiece piece{d, stored, V, side, arg.kind == SdfArg::BUTT, join, point, h.sd < 0 ? -1.0 : 1.0};
+    const EndPiece piece{d, stored, V, side, arg.kind == SdfArg::BUTT, join, point, seam, h.sd < 0 ? -1.0 : 1.0};
     auto value = [&](Vec2 qq, Vec2 t_in, Vec2 t_out, double w) { return piece.sd(qq, t_in, t_out, w); };
     auto rotate = [](Vec2 v, double a) {
         return Vec2{v.x * std::cos(a) - v.y * std::sin(a), v.x * std::sin(a) + v.y * std::cos(a)};
@@ -255,7 +272,7 @@ VF_HD void entry_sdf_backward(const SceneView& sc, const Hit& h, Vec2 p, double 
     if (!d.metric_identity) metric_scale_backward(c, h.sd, g_sd);
     if (h.arg.kind == SdfArg::SWEEP && d.varying) varying_sweep_sdf_backward(c, h.arg);
     else if (h.arg.kind == SdfArg::ELLIPSE || h.arg.kind == SdfArg::SWEEP) sweep_sdf_backward(c, h.arg);
-    else end_sdf_backward(c, h);  // BUTT / END
+    else end_sdf_backward(c, h);  // BUTT / END / SEAM
 }
 
 }  // namespace vf

@@ -14,7 +14,8 @@
 // Pieces meet along internal seams (a sweep's end normal, a join polygon's sides from the
 // vertex, a cap's back edge). Signed distances treat seams as open: a point inside a piece
 // is as deep as its distance to the piece's real boundary, so the analytical prefilter
-// sees no lines inside a stroke.
+// sees no lines inside a stroke; where two pieces disagree on a seam (a sweep and a bevel
+// triangle) the image would jump there, which the seam rule prevents (bevel_edge).
 // Why this form: each piece has a simple inside test and a signed distance, and the
 // union's boundary is a set of curves with known normals (offset curves, disk arcs,
 // polygon edges, butt end lines), which is what boundary sampling needs for gradients.
@@ -52,15 +53,24 @@
 namespace vf {
 
 // Which piece a signed distance came from, for its gradient (analytical prefilter).
+// (Packed to 40 bytes: a Hit, which holds one, stays within two cache lines.)
 struct SdfArg {
-    enum Kind { NONE, SEGMENT, ELLIPSE, SWEEP, BUTT, END } kind = NONE;
-    int item = -1;     // fill or stroke item (global index)
-    int side = 0;      // BUTT / END: 0 at the item's start, 1 at its end; SEGMENT on the
+    enum Kind : int8_t { NONE, SEGMENT, ELLIPSE, SWEEP, BUTT, END, SEAM } kind = NONE;
+    int8_t side = 0;   // BUTT / END / SEAM: 0 at the item's start, 1 at its end (SEAM: the
+                       // bevel edge bounding the sweep, see bevel_edge); SEGMENT on the
                        // edge (see ON_EDGE): +1 / -1 where the inside lies along +/- the
                        // segment's left normal, 0 where it lies on both sides or neither
+    // SEGMENT on the edge: a second segment also within ON_EDGE (the sample on a vertex,
+    // e.g. a rect's corner on a pixel centre), its inside side, index (-1: none) and
+    // parameter (a float: only its Bernstein weights use it)
+    int8_t side2 = 0;
+    int item = -1;     // fill or stroke item (global index)
+    int item2 = -1;
+    float t2 = 0;
     double t = 0;      // SEGMENT / SWEEP: parameter of the closest point
     Vec2 closest;      // SEGMENT / SWEEP / ELLIPSE: the closest point
 };
+static_assert(sizeof(SdfArg) == 40, "SdfArg grew: a Hit would span a third cache line");
 
 // Signed crossings of the ray from p towards +x, up to and including x_max, with the
 // segment; each y-monotone piece counts on the half-open range [y_low, y_high) so that
@@ -103,7 +113,10 @@ VF_HD int ray_crossings(const PreparedSegment& s, Vec2 p, double x_max = 1e300) 
 // A fill's signed distance is +-|closest - p|; within ON_EDGE (pixels) of the edge the
 // direction closest - p is lost to rounding (exactly 0 where a pixel centre lies on the
 // edge, as on mcseem2's 45-degree segments through integer points), so its gradient takes
-// the segment's normal, turned towards the inside (SdfArg::side).
+// the segment's normal, turned towards the inside (SdfArg::side). That is the two-sided
+// derivative: across one edge the signed distance is linear. On a vertex, within ON_EDGE
+// of two segments, it is a kink (the max or min of the two edges' signed distances), and
+// its central derivative is the mean of the two segments' (SdfArg::item2): half each.
 constexpr double ON_EDGE = 1e-7;
 
 // Parabolic prefilter kernel: coverage of a half-plane at signed distance d (in units of
@@ -149,6 +162,19 @@ VF_HD double join_polygon_sdf(const Vec2* v, int n, Vec2 q) {
         if (i != 0 && i != n - 1) outer = vmin(outer, d);
     }
     return convex_contains(v, n, q) ? -outer : all;
+}
+
+// The outer edge of a bevel join (or of a miter join's bevel fallback), nullptr for any
+// other end piece. Seam rule: the sweeps on either side of a bevel are no deeper than
+// their distance to this edge. A sweep's depth is its distance to its offset curves, the
+// bevel triangle's its distance to this edge, and on the seam between them (the sweep's
+// end normal, at s from the vertex) the two differ: hw - s against (hw - s) cos(turn / 2),
+// so the image jumped where a point crossed it. Bounded, the sweep is as deep as the
+// triangle on the seam (the edge is the closer there), and near the vertex its depth is
+// the true one (the bevel edge is the union's boundary). Round joins, miters within their
+// limit, caps and butt ends already agree with the sweep on their seams.
+VF_HD const Vec2* bevel_edge(const StrokeEnd& e) {
+    return e.kind == StrokeEnd::POLYGON && e.n_poly == 3 ? e.poly + 1 : nullptr;
 }
 
 // Local frame of a square cap: s along the outward tangent from the end point, u across.
@@ -306,8 +332,11 @@ VF_HD bool stroke_item_contains(const StrokeSegment& s, Vec2 q) {
 }
 
 // Signed distance (stroke space) to this item's pieces. The butt end lines of free ends
-// bound the sweep; other end normals are interior seams covered by a join or cap.
-VF_HD double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double limit, SdfArg* arg = nullptr) {
+// bound the sweep; other end normals are interior seams covered by a join or cap, and a
+// bevel join's outer edge bounds the sweeps on both its sides (bevel_edge). `items`: the
+// draw's stroke items, by global index (the join at this item's start is its prev's end).
+VF_HD double stroke_item_sdf(const StrokeSegment* items, const StrokeSegment& s, Vec2 q, double limit,
+                             SdfArg* arg = nullptr) {
     // Farther than hw + limit from the hull: the sweep cannot bring the distance under limit.
     double t = 0;
     double sd = near_segment(s, q, s.hw_max + limit) ? sweep_sdf(s, q, &t) : 1e300;
@@ -327,6 +356,15 @@ VF_HD double stroke_item_sdf(const StrokeSegment& s, Vec2 q, double limit, SdfAr
         double combined = sd <= 0 ? vmax(sd, -dl) : vmin(sd, dl);
         if (combined != sd) { kind = SdfArg::BUTT; side = dl_side; }
         sd = combined;
+    }
+    // the seam rule: inside the sweep, bevel edges at either end bound the depth
+    if (sd <= 0 && (s.bevel_start || s.end.kind == StrokeEnd::POLYGON)) {
+        for (int k = 0; k < 2; ++k) {
+            const Vec2* edge = k == 0 ? (s.bevel_start ? bevel_edge(items[s.prev].end) : nullptr) : bevel_edge(s.end);
+            if (!edge) continue;
+            double e = -point_line_segment_distance(q, edge[0], edge[1]);
+            if (e > sd) { sd = e; kind = SdfArg::SEAM; side = k; }
+        }
     }
     double e0 = end_sdf(s.start, q), e1 = end_sdf(s.end, q);
     if (e0 < sd) { sd = e0; kind = SdfArg::END; side = 0; }
@@ -369,7 +407,8 @@ VF_HD double fill_distance(const SceneView& sc, const PreparedDraw& d, const Ite
     double best = limit;
     for (int i = 0; i < items.size(); ++i) {
         const PreparedSegment& s = segs[items[i]];
-        if (distance2(s.box, p) >= best * best) continue;
+        double d2 = distance2(s.box, p);  // (on an edge, with arg: look for a second one)
+        if (d2 >= best * best && !(arg && best < ON_EDGE && d2 < ON_EDGE * ON_EDGE)) continue;
         Closest c;
         if (s.seg.degree == 1) {
             Vec2 a = s.seg.p[0], e = s.seg.p[1] - a;
@@ -379,9 +418,23 @@ VF_HD double fill_distance(const SceneView& sc, const PreparedDraw& d, const Ite
         } else {
             c = seg_closest(s.seg, p);
         }
+        if (arg && c.dist < ON_EDGE && best < ON_EDGE) {  // a vertex: keep both segments
+            int keep = c.dist < best ? arg->item : d.first_item + items[i];
+            double keep_t = c.dist < best ? arg->t : c.t;  // (stored as a float)
+            if (c.dist < best) {
+                best = c.dist;
+                arg->item = d.first_item + items[i];
+                arg->t = c.t;
+                arg->closest = seg_eval(s.seg, c.t);
+            }
+            arg->item2 = keep;
+            arg->t2 = (float)keep_t;
+            continue;
+        }
         if (c.dist < best) {
             best = c.dist;
             if (arg) {
+                arg->item2 = -1;
                 arg->kind = SdfArg::SEGMENT;
                 arg->item = d.first_item + items[i];
                 arg->t = c.t;
@@ -429,7 +482,8 @@ VF_HD double stroke_sdf(const SceneView& sc, const PreparedDraw& d, const Items&
         for (int i = 0; i < items.size(); ++i) {
             Box b = grown(all[items[i]].box, limit);
             if (p.x < b.x0 || p.x > b.x1 || p.y < b.y0 || p.y > b.y1) continue;
-            double v = stroke_item_sdf(all[items[i]], q, limit / d.metric_scale, arg ? &local : nullptr);
+            double v = stroke_item_sdf(sc.stroke_items.data(), all[items[i]], q, limit / d.metric_scale,
+                                       arg ? &local : nullptr);
             if (v < sd) {
                 sd = v;
                 if (arg) {

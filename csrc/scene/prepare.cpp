@@ -203,6 +203,7 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
             } else {
                 StrokeSegment& next = segs[last ? 0 : i + 1];
                 segs[i].next = (int)out.size() + (last ? 0 : i + 1);
+                next.prev = (int)out.size() + i;
                 if (var && !last && next.source == segs[i].source) {
                     // Pieces of one curve meet smoothly: no join (a disk of the local width
                     // could stick out of a sweep whose width changes fast).
@@ -215,6 +216,7 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
                 if (var && point_hw(k2) > point_hw(k)) k = k2;
                 segs[i].end = make_join(seg_end(segs[i].seg), seg_end_tangent(segs[i].seg, true),
                                         seg_end_tangent(next.seg, false), d.join, point_hw(k), d.miter_limit);
+                next.bevel_start = segs[i].end.kind == StrokeEnd::POLYGON && segs[i].end.n_poly == 3;
                 set_width(segs[i].end, k);
             }
         }

@@ -104,6 +104,9 @@ struct StrokeSegment {
     double t0 = 0, t1 = 1; // the part of the source segment this item is (curves are split
                            // into short pieces: tighter bounds, fewer roots to find)
     bool butt_start = false, butt_end = false;  // free end with a butt cap: an edge of the stroke
+    bool bevel_start = false;  // the join at this item's start (prev's end) is a bevel: seam rule
+    int32_t prev = -1;     // the stroke item whose end joins this item's start (index into
+                           // stroke_items; here, it fills what was padding)
     StrokeEnd start, end;
     Box box;               // pixel-space bounds of everything above, widened by the half width
     // The segment's control points in the frame of its chord (origin p0, unit axis u):
