@@ -118,9 +118,10 @@ void tile_forward(const SceneView& sc, const TileView& bins, const RenderOptions
                 const LocalItem& item = items[li];
                 const PreparedSegment& seg = segs[item.item];
                 // Only the rows whose samples (within R of their row's centre line) can lie
-                // in the segment's height range can cross it.
-                int r0 = std::max(0, (int)std::ceil(seg.box.y0 - 0.5 - R) - y0);
-                int r1 = std::min(rows - 1, (int)std::floor(seg.box.y1 - 0.5 + R) - y0);
+                // in the segment's height range can cross it. (Clamped as doubles: a
+                // coordinate can be 10^28 px.)
+                int r0 = clamp_to_int(std::ceil(seg.box.y0 - 0.5 - R) - y0, 0, rows);
+                int r1 = clamp_to_int(std::floor(seg.box.y1 - 0.5 + R) - y0, -1, rows - 1);
                 if (r0 <= r1)
                     for (int a = ts.row_begin[r0]; a < ts.row_begin[r1 + 1]; ++a)
                         ts.winding[a] += ray_crossings(seg, ts.p[ts.active[a]], region.x1);
