@@ -28,9 +28,15 @@ class ParameterKind:
         self.v = torch.zeros_like(self.flat)
         self.steps = torch.zeros_like(self.flat)
 
-    def gradient(self) -> torch.Tensor:
-        return torch.cat([(t.grad if t.grad is not None else torch.zeros_like(t)).reshape(-1)
-                          for t in self.tensors])
+    def gradient(self, leaf: torch.Tensor | None = None) -> torch.Tensor:
+        """The kind's gradient: that of ``leaf`` (the flat tensor as a leaf, when the
+        renderer read the values from it) plus those of the Scene's tensors."""
+        out = leaf.grad if leaf is not None and leaf.grad is not None else None
+        if any(t.grad is not None for t in self.tensors):
+            own = torch.cat([(t.grad if t.grad is not None else torch.zeros_like(t)).reshape(-1)
+                             for t in self.tensors])
+            out = own if out is None else out + own
+        return out if out is not None else torch.zeros_like(self.flat)
 
     def zero_grad(self) -> None:
         for t in self.tensors:

@@ -21,6 +21,7 @@ import torch
 from vecfit.errors import NonFiniteScene, VecfitError
 from vecfit.io.images import downscaled, downscaled_weight
 from vecfit.renderer import device as devices
+from vecfit.renderer.persistent import PersistentPack
 from vecfit.renderer.raster import MODES, render
 from vecfit.renderer.scene import Scene
 from vecfit.renderer.stopwatch import lap, phase
@@ -33,6 +34,9 @@ from .rates import parameter_kinds
 # get no useful gradient there: the 128-px peppers trace (705 shapes) lost 1 dB coarse.
 MIN_COARSE_PIXELS_PER_SHAPE = 64
 MIN_COARSE_SIDE = 32  # and a target this small at half size is cheap enough at full size
+# Pack the scene once per size and refresh only its floats (renderer/persistent.py); off
+# packs it on every iteration (tests compare the two).
+PERSISTENT_PACK = True
 
 PARAMETER_KINDS = ("points", "colors", "stroke_widths", "opacities", "radii", "gradient_points",
                    "gradient_radii", "stop_offsets", "transforms")
@@ -138,7 +142,8 @@ class Step:
     """What an iteration hook sees after an Adam step: the image rendered for this
     iteration's loss (detached, [H, W, 4] at the optimised size), the Scene (already
     stepped), and ``reset(tensor)``, which clears Adam's memory of a tensor that the hook
-    re-initialised. Hooks change the Scene's tensors in place, under no_grad."""
+    re-initialised. Hooks change the Scene's tensors in place, under no_grad, and call
+    ``reset`` for each tensor they change (the loop then packs the Scene anew)."""
     iteration: int
     image: torch.Tensor
     scene: Scene
@@ -224,9 +229,23 @@ def optimize(scene: Scene, target: Target, settings: Settings,
     start = time.perf_counter()
 
     frame = {}
+    packs: dict = {}  # (width, height) -> PersistentPack, or None where it does not apply
+    leaves: list = []  # this iteration's kinds' flat tensors as autograd leaves
 
     def level(iteration: int) -> tuple[Target, torch.Tensor]:
         return levels[iteration >= fine_from]
+
+    def packed(w: int, h: int, grad: bool):
+        if not PERSISTENT_PACK:
+            return None
+        pack = packs.get((w, h), False)
+        if pack is False or (pack is not None and not pack.still_valid([k.flat for k in kinds])):
+            with phase("pack"):
+                pack = packs[(w, h)] = PersistentPack.build(scene, w, h, kinds)
+        if pack is None:
+            return None
+        leaves[:] = [k.flat.detach().requires_grad_(grad) for k in kinds]
+        return pack.arrays(leaves)
 
     def evaluate(iteration: int, grad: bool):
         at, goal = level(iteration)
@@ -235,7 +254,8 @@ def optimize(scene: Scene, target: Target, settings: Settings,
             image = render(scene, w, h, samples=settings.samples, mode=settings.mode,
                            seed=settings.seed + iteration, background=target.background,
                            threads=settings.threads, boundary_samples=settings.boundary_samples,
-                           interior_samples=settings.interior_samples, device=device)
+                           interior_samples=settings.interior_samples, device=device,
+                           packed=packed(w, h, grad))
             frame["image"] = image.detach()
             loss = at.loss(loss_fn, settings.loss, at.compared(image), goal)
             return loss if penalty is None else loss + penalty()
@@ -248,6 +268,7 @@ def optimize(scene: Scene, target: Target, settings: Settings,
             offset += t.numel()
 
     def reset(tensor: torch.Tensor) -> None:
+        packs.clear()  # a hook changed the Scene: whatever it changed, pack it anew
         if id(tensor) in where:
             i, offset, n = where[id(tensor)]
             for state in (kinds[i].m, kinds[i].v, kinds[i].steps):
@@ -281,11 +302,12 @@ def optimize(scene: Scene, target: Target, settings: Settings,
                             loss.backward()
                     # else nothing drawn depends on the parameters any more (e.g. every shape
                     # shrank to nothing): zero gradients, Adam's momentum still moves them
-                    grads = [k.gradient() for k in kinds]
+                    grads = [k.gradient(leaves[i] if leaves else None) for i, k in enumerate(kinds)]
                     if not all(torch.isfinite(g).all() for g in grads):
                         grads = None
                 for k in kinds:
                     k.zero_grad()
+                leaves.clear()
                 if grads is None:
                     # A non-finite loss or gradient: go back to the best parameters and try
                     # again with smaller steps rather than let NaN into the Scene.

@@ -43,7 +43,7 @@ def learning_rate_scales(scene: Scene, width: int, height: int) -> dict[int, flo
         put(shape.stroke_width, ppu)
         for paint in (shape.fill, shape.stroke):
             if isinstance(paint, (LinearGradient, RadialGradient)):
-                gppu = ppu * math.sqrt(abs(float(torch.linalg.det(paint.transform[:2, :2].double()))))
+                gppu = ppu * math.sqrt(abs(float(torch.linalg.det(paint.transform.detach()[:2, :2].double()))))
                 if paint.units == "objectBoundingBox":
                     gppu *= local_bbox_size(g) or 0.0
                 for name in ("start", "end", "center", "focal", "radius"):

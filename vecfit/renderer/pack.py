@@ -19,7 +19,7 @@ from vecfit.errors import VecfitError
 from .geometry import affine_apply, local_bbox, rect_as_path, value
 from .layout import (CAPS, COLUMNS, DRAW_FILL, DRAW_STROKE, FILL_RULES, JOINS, BRUSH_LINEAR,
                      BRUSH_RADIAL, BRUSH_SOLID, SHAPE_ELLIPSE, SHAPE_PATH)
-from .scene import Circle, LinearGradient, Path, RadialGradient, Rect, Scene, Shape, Solid
+from .scene import Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect, Scene, Shape, Solid
 
 
 
@@ -74,8 +74,13 @@ class Packed:
 
 
 class Packer:
-    def __init__(self, scene: Scene, width: int, height: int):
+    """``trace`` (optional, vecfit.renderer.persistent.Provenance): told where each scene
+    tensor's values land in the float arrays, so that a fitting loop can refresh them
+    without packing again."""
+
+    def __init__(self, scene: Scene, width: int, height: int, trace=None):
         self.scene = scene
+        self.trace = trace
         self.out = Packed()
         sx, sy = width / scene.width, height / scene.height
         self.canvas = torch.diag(torch.tensor([sx, sy, 1.0], dtype=torch.float32)) @ scene.view.float()
@@ -136,6 +141,8 @@ class Packer:
         out = self.out
         g = m
         if paint.units == "objectBoundingBox":
+            if self.trace:
+                self.trace.used_otherwise(*_geometry_tensors(geometry))
             box = local_bbox(geometry)
             if box is None:
                 return None
@@ -150,19 +157,31 @@ class Packer:
         if abs(value(torch.linalg.det(g[:2, :2]))) < 1e-30:
             return None
         to_paint = torch.linalg.inv(g)[:2].reshape(6)
+        # its row: after the solids and the gradients before it (see _finish_brushes)
+        first = (self._n_solid + getattr(self, "_n_gradients", 0)) * COLUMNS["brush_params"]
         if isinstance(paint, LinearGradient):
             params = torch.cat([to_paint, paint.start.float(), paint.end.float(), torch.zeros(1)])
             kind = BRUSH_LINEAR
+            if self.trace:
+                self.trace.copy("brush_params", first + 6, paint.start)
+                self.trace.copy("brush_params", first + 8, paint.end)
         elif isinstance(paint, RadialGradient):
             # SVG 2 semantics, as resvg and browsers draw it: a focal point outside the
             # circle makes a cone, and the area outside the cone is not painted.
             c, f, r = paint.center.float(), paint.focal.float(), paint.radius.float().reshape(1)
             params = torch.cat([to_paint, c, r, f])
             kind = BRUSH_RADIAL
+            if self.trace:
+                self.trace.copy("brush_params", first + 6, paint.center)
+                self.trace.copy("brush_params", first + 8, paint.radius)
+                self.trace.copy("brush_params", first + 9, paint.focal)
         else:
             raise VecfitError(f"unknown paint {type(paint).__name__}")
         colors = paint.colors.float()
         colors = torch.cat([colors[:, :3], colors[:, 3:4] * alpha], dim=1)
+        if self.trace:
+            self.trace.copy("stop_offsets", out.n_stops, paint.offsets)
+            self.trace.colors("stop_colors", out.n_stops * 4, paint.colors, torch.full((len(paint.offsets),), value(alpha)))
         out.brushes.append([kind, out.n_stops, len(paint.offsets)])
         out.brush_params.append(params)
         out.stop_offsets.append(paint.offsets.float())
@@ -232,7 +251,11 @@ class Packer:
             else:
                 factors.append(shape.opacity)
             geometry = shape.geometry
+            if self.trace:
+                self._trace_presence(shape, has_stroke, scale_np[i] > 0)
             if isinstance(geometry, Rect):
+                if self.trace:  # (its corners and radii become path points non-linearly)
+                    self.trace.used_otherwise(geometry.p_min, geometry.p_max, geometry.corner_radii)
                 geometry = rect_as_path(geometry)
                 if geometry is None:
                     continue
@@ -256,10 +279,21 @@ class Packer:
                 out.draws.append([index, DRAW_STROKE, 0, paint, layer,
                                   CAPS[shape.linecap], JOINS[shape.linejoin], per_point])
 
-        paths.finish(out, matrices, scale)
+        paths.finish(out, matrices, scale, self.trace)
         self._finish_brushes(solid_colors, solid_alphas, gradient_rows)
         self._finish_draw_params(stroke_rows, matrices, scale, similar)
         return out
+
+    def _trace_presence(self, shape: Shape, has_stroke: bool, scaled: bool) -> None:
+        """Tells the trace which of the shape's draws exist because of a value that the
+        loop may change (a stroke's width above 0, an ellipse's radii)."""
+        g = shape.geometry
+        if shape.stroke is not None and scaled:
+            widths = g.widths if isinstance(g, Path) and g.widths is not None else shape.stroke_width
+            self.trace.present_if_positive(widths, has_stroke)
+        if isinstance(g, (Circle, Ellipse)):
+            r = g.radius if isinstance(g, Circle) else g.radii
+            self.trace.present_if_positive(r, value(r.min()) > 0, every=True)
 
     def _add_ellipse(self, geometry, m: torch.Tensor) -> int | None:
         r = geometry.radius.reshape(1).expand(2) if isinstance(geometry, Circle) else geometry.radii
@@ -267,6 +301,9 @@ class Packer:
             return None
         c = affine_apply(m, geometry.center.reshape(1, 2).float())[0]
         axes = m[:2, :2] @ torch.diag(r.float())
+        if self.trace:
+            self.trace.ellipse(len(self.out.ellipses), geometry.center, geometry.radius if isinstance(geometry, Circle)
+                               else geometry.radii, m.detach().numpy())
         self.out.ellipses.append(torch.cat([c, axes.reshape(4)]))
         self.out.shapes.append([SHAPE_ELLIPSE, 0, 0, len(self.out.ellipses) - 1])
         return len(self.out.shapes) - 1
@@ -275,7 +312,7 @@ class Packer:
         """Paint table: the solids (stacked in one go), then the gradients; draws that
         point at a gradient are renumbered."""
         out = self.out
-        n_solid = len(solid_colors)
+        n_solid = self._n_solid = len(solid_colors)
         if n_solid:
             colors = _stack(solid_colors)
             # Multiply each paint's alpha factors: pad the lists with ones and stack once.
@@ -284,6 +321,9 @@ class Packer:
             columns = [_stack([f[k] if k < len(f) else one for f in solid_alphas]) for k in range(depth)]
             alphas = torch.stack(columns).prod(dim=0).reshape(n_solid)
             colors = torch.cat([colors[:, :3], colors[:, 3:4] * alphas[:, None]], dim=1)
+            if self.trace:
+                for row, (color, a) in enumerate(zip(solid_colors, alphas.detach())):
+                    self.trace.colors("brush_params", row * COLUMNS["brush_params"] + 6, color, a.reshape(1))
             ident = torch.eye(2, 3).reshape(1, 6).expand(n_solid, 6)
             out.brush_params.append(torch.cat([ident, colors, torch.zeros(n_solid, 1)], dim=1))
             out.brushes.extend([[BRUSH_SOLID, 0, 0]] * n_solid)
@@ -323,6 +363,12 @@ class Packer:
             stroke_params = torch.cat([(widths * s)[:, None], limits[:, None], metric], dim=1)
             params = params.index_put((rows,), stroke_params)
         keep = getattr(self, "_keep_draws", [True] * n)
+        if self.trace and stroke_rows:
+            row_after = np.cumsum(keep) - 1  # rows once the draws that paint nothing are dropped
+            for (row, i), s_i in zip(stroke_rows, s.detach().numpy()):
+                if keep[row]:
+                    self.trace.scaled("draw_params", int(row_after[row]) * COLUMNS["draw_params"],
+                                      self.scene.shapes[i].stroke_width, float(s_i))
         if not all(keep):
             mask = torch.tensor(keep)
             params = params[mask]
@@ -355,10 +401,17 @@ class _PathBatch:
         self.subpath_slot.append(subpath_slot)
         return core_shape
 
-    def finish(self, out: Packed, matrices: torch.Tensor, scale: torch.Tensor) -> None:
+    def finish(self, out: Packed, matrices: torch.Tensor, scale: torch.Tensor, trace=None) -> None:
         if not self.points:
             return
         counts = [len(p) for p in self.points]
+        if trace:
+            row, m_np, s_np = out.n_points, matrices.detach().numpy(), scale.detach().numpy()
+            for points, widths, owner, n in zip(self.points, self.widths, self.owner, counts):
+                trace.points("points", row, points, m_np[owner])
+                if widths is not None:
+                    trace.scaled("point_widths", row, widths, float(s_np[owner]))
+                row += n
         local = torch.cat(self.points).float()
         # (numpy: torch's repeat_interleave wakes its thread pool, 0.6 ms a call on 2 busy cores)
         owner = torch.from_numpy(np.repeat(np.asarray(self.owner, dtype=np.int64), counts))
@@ -398,6 +451,14 @@ class _PathBatch:
         idx = sub_first_point[sub_of_seg][:, None] + local_idx
         idx = np.where(j <= deg[:, None], idx, -1)
         out.segments.append(np.concatenate([deg[:, None], idx], axis=1))
+
+
+def _geometry_tensors(geometry) -> list:
+    if isinstance(geometry, Path):
+        return [geometry.points]
+    if isinstance(geometry, Rect):
+        return [geometry.p_min, geometry.p_max, geometry.corner_radii]
+    return [geometry.center, geometry.radius if isinstance(geometry, Circle) else geometry.radii]
 
 
 def _stroke_width_positive(shape: Shape) -> bool:

@@ -132,7 +132,8 @@ class _Render(torch.autograd.Function):
 def render(scene: Scene, width: int | None = None, height: int | None = None, *,
            samples: int = 2, mode: str = "mc", filter: str = "box", filter_radius: float = 0.5,
            seed: int = 0, background=None, threads: int | None = None, boundary_samples: float = 2.0,
-           interior_samples: int = 0, device: str = "cpu", _brute_force: bool = False, _gpu_lists: bool = False) -> torch.Tensor:
+           interior_samples: int = 0, device: str = "cpu", packed: tuple | None = None,
+           _brute_force: bool = False, _gpu_lists: bool = False) -> torch.Tensor:
     """Render ``scene`` into an [H, W, 4] float tensor of straight RGBA.
 
     samples: N means N x N stratified samples per pixel (jittered in "mc" mode, at the
@@ -152,13 +153,22 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     The scene's tensors and the result are CPU tensors either way (the scene is packed
     and prepared on the host).
 
+    packed: the scene already packed at this size, (integer tables, float arrays in
+    FLOAT_INPUTS order), as PersistentPack.arrays gives it; the image and its gradients
+    then follow those arrays, and the scene gives only its size.
+
     (_brute_force and _gpu_lists are for tests: every draw tested at every sample, and the
     CPU backward pass run first with a GPU thread's list sizes, see backward_fallbacks.)
     """
     check_options(samples, mode, filter, filter_radius)
     width, height = output_size(scene, width, height)
     background = background_rgba(background)
-    structure, floats = packed_for_core(scene, width, height)
+    if packed is None:
+        structure, floats = packed_for_core(scene, width, height)
+    else:
+        structure, floats = packed
+        if not all(torch.isfinite(f.detach()).all() for f in floats):
+            raise NonFiniteScene("the scene has non-finite values")
     settings = dict(width=width, height=height, samples=int(samples), mode=mode, filter=filter,
                     filter_radius=float(filter_radius), seed=int(seed), threads=int(threads or 0),
                     background=background, device=devices.resolve(device))

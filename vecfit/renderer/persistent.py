@@ -1,0 +1,228 @@
+"""The scene packed once for a fitting loop: each iteration refreshes only the floats.
+
+Packing a Scene (pack.py) walks its shapes in Python and builds an autograd graph through
+every shape's tensors: on a 705-shape trace that is 7 ms a call and 11 ms of autograd in
+the backward pass, an eighth of an iteration. In a fitting loop the structure (segments,
+draws, paints, layers) does not change, and while transforms and opacities stay fixed,
+every float the core reads is an affine function of the optimised values: a point is its
+shape's matrix times the point, a colour's alpha the colour's times fixed opacities, a
+width the width times its shape's scale. So the Packer is run once with a Provenance that
+records where each tensor's values land and with which coefficient, and an iteration
+computes all float arrays at once:
+
+    floats = base + scatter(coefficient * gather(x))
+
+where x is the optimiser's flat parameter tensors side by side; autograd of that is a
+gather and a scatter, so gradients reach the flat tensors by index.
+
+PersistentPack.build answers None where that does not hold (transforms or opacities
+optimised; a rect's corners, or geometry under a bounding-box gradient, optimised) and the
+loop packs on every iteration as before. The build checks itself once against the
+Packer: the same floats, and the same gradients for a random image adjoint.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from .layout import COLUMNS
+from .pack import Packer
+from .raster import FLOAT_INPUTS
+from .scene import Scene
+from .stopwatch import phase
+
+# Kinds whose values enter the packed floats non-linearly (matrix products, alpha
+# products): with either optimised, the loop packs the scene on every iteration.
+NON_AFFINE_KINDS = ("transforms", "opacities")
+
+
+@dataclass
+class _Route:
+    """out[out_index] (+)= coefficient * tensor.reshape(-1)[source_index] (+ constant)."""
+    array: str
+    out_index: np.ndarray
+    tensor: torch.Tensor
+    source_index: np.ndarray
+    coefficient: np.ndarray
+    constant: np.ndarray | None = None  # the part that does not depend on the tensor (else 0)
+
+
+class Provenance:
+    """What the Packer tells about where scene tensors' values land (see pack.Packer)."""
+
+    def __init__(self):
+        self.routes: list[_Route] = []
+        self.nonlinear: set[int] = set()   # ids of tensors used in other ways
+        self.presence: list[tuple] = []    # (tensor, draws present, reduce): see present_if_positive
+
+    def __bool__(self) -> bool:
+        return True
+
+    def copy(self, array: str, first: int, tensor: torch.Tensor) -> None:
+        n = tensor.numel()
+        self.routes.append(_Route(array, first + np.arange(n), tensor, np.arange(n), np.ones(n)))
+
+    def scaled(self, array: str, first: int, tensor: torch.Tensor, scale: float) -> None:
+        n = tensor.numel()
+        self.routes.append(_Route(array, first + np.arange(n), tensor, np.arange(n), np.full(n, scale)))
+
+    def colors(self, array: str, first: int, tensor: torch.Tensor, alpha) -> None:
+        """RGBA rows: RGB copied, A times the row's ``alpha`` (fixed opacities)."""
+        n = tensor.numel()
+        coefficient = np.ones((n // 4, 4))
+        coefficient[:, 3] = np.asarray(alpha, dtype=np.float64).reshape(-1)
+        self.routes.append(_Route(array, first + np.arange(n), tensor, np.arange(n), coefficient.reshape(-1)))
+
+    def points(self, array: str, row: int, tensor: torch.Tensor, m: np.ndarray) -> None:
+        """[n, 2] points mapped by the affine matrix m into rows row... of a 2-column array."""
+        n = len(tensor)
+        k = np.arange(n)
+        for c in range(2):  # out[.., c] = m[c, 0] x + m[c, 1] y + m[c, 2]
+            for j in range(2):
+                if m[c, j] != 0:
+                    self.routes.append(_Route(array, 2 * (row + k) + c, tensor, 2 * k + j, np.full(n, m[c, j]),
+                                              np.full(n, m[c, 2])))
+
+    def ellipse(self, row: int, center: torch.Tensor, radii: torch.Tensor, m: np.ndarray) -> None:
+        """An ellipses row: centre mapped by m, axes = m's linear part times diag(radii)."""
+        first = row * COLUMNS["ellipses"]
+        for c in range(2):
+            for j in range(2):
+                if m[c, j] != 0:
+                    self.routes.append(_Route("ellipses", np.array([first + c]), center, np.array([j]),
+                                              np.array([m[c, j]]), np.array([m[c, 2]])))
+        circle = radii.numel() == 1
+        for i in range(2):
+            for j in range(2):
+                self.routes.append(_Route("ellipses", np.array([first + 2 + 2 * i + j]), radii,
+                                          np.array([0 if circle else j]), np.array([m[i, j]])))
+
+    def used_otherwise(self, *tensors: torch.Tensor) -> None:
+        self.nonlinear.update(id(t) for t in tensors)
+
+    def present_if_positive(self, tensor: torch.Tensor, present: bool, every: bool = False) -> None:
+        """A draw exists while the tensor's largest value (``every``: its smallest) is > 0."""
+        self.presence.append((tensor, bool(present), every))
+
+
+class PersistentPack:
+    """See the module's docstring. ``arrays(leaves)`` gives the core's integer tables and
+    float arrays for this iteration; ``leaves`` are the kinds' flat tensors (requiring
+    grad), in the order of the kinds given to build."""
+
+    def __init__(self, structure, shapes, base, destination, source, coefficient, conditions):
+        self.structure = structure
+        self._shapes = shapes          # FLOAT_INPUTS' shapes, in order
+        self._base = base              # all float arrays side by side (float32)
+        self._destination = destination
+        self._source = source
+        self._coefficient = coefficient
+        self._conditions = conditions  # (x indices, group starts, expected, every) per reduce kind
+
+    @classmethod
+    def build(cls, scene: Scene, width: int, height: int, kinds) -> "PersistentPack | None":
+        if any(k.name in NON_AFFINE_KINDS for k in kinds):
+            return None
+        trace = Provenance()
+        with torch.no_grad():
+            arrays = Packer(scene, width, height, trace=trace).pack().arrays()
+        at: dict[int, int] = {}  # id(tensor) -> its first element in x (the kinds side by side)
+        offset = 0
+        for k in kinds:
+            for t in k.tensors:
+                at[id(t)] = offset
+                offset += t.numel()
+        if any(i in at for i in trace.nonlinear):
+            return None
+        floats = [arrays[name].to(torch.float32) for name in FLOAT_INPUTS]
+        starts = np.concatenate([[0], np.cumsum([f.numel() for f in floats])])
+        first_of = dict(zip(FLOAT_INPUTS, starts[:-1]))
+        base = torch.cat([f.reshape(-1) for f in floats]) if floats else torch.zeros(0)
+        dst, src, coef, constant_at, constant = [], [], [], [], []
+        for r in trace.routes:
+            where = at.get(id(r.tensor))
+            if where is None:
+                continue  # a value the loop does not change: the packed one stays
+            d = first_of[r.array] + r.out_index
+            dst.append(d)
+            src.append(where + r.source_index)
+            coef.append(r.coefficient)
+            constant_at.append(d)
+            constant.append(r.constant if r.constant is not None else np.zeros(len(d)))
+        base = base.clone()
+        if dst:
+            base[torch.from_numpy(np.concatenate(constant_at))] = torch.from_numpy(
+                np.concatenate(constant)).float()
+        as_index = lambda parts: torch.from_numpy(np.concatenate(parts).astype(np.int64)) if parts \
+            else torch.zeros(0, dtype=torch.int64)  # noqa: E731
+        pack = cls({k: v for k, v in arrays.items() if k not in FLOAT_INPUTS}, [f.shape for f in floats],
+                   base, as_index(dst), as_index(src),
+                   torch.from_numpy(np.concatenate(coef)).float() if coef else torch.zeros(0),
+                   _conditions(trace.presence, at))
+        return pack if pack._agrees(scene, width, height, kinds, floats) else None
+
+    def arrays(self, leaves: list[torch.Tensor]) -> tuple[dict, list[torch.Tensor]]:
+        """(integer tables, float arrays in FLOAT_INPUTS order), differentiable w.r.t. leaves."""
+        with phase("pack"):
+            x = torch.cat(leaves) if len(leaves) > 1 else leaves[0]
+            out = self._base.index_add(0, self._destination, x.index_select(0, self._source) * self._coefficient)
+            floats, offset = [], 0
+            for shape in self._shapes:
+                n = int(np.prod(shape))
+                floats.append(out[offset:offset + n].view(shape))
+                offset += n
+        return self.structure, floats
+
+    def still_valid(self, flats: list[torch.Tensor]) -> bool:
+        """Whether every draw that exists because of a value (a stroke's width, an
+        ellipse's radii) still exists, and no other has come to exist."""
+        if not self._conditions:
+            return True
+        x = (torch.cat(flats) if len(flats) > 1 else flats[0]).detach().numpy()
+        for index, starts, expected, every in self._conditions:
+            reduce = np.minimum if every else np.maximum
+            if not np.array_equal(reduce.reduceat(x[index], starts) > 0, expected):
+                return False
+        return True
+
+    def _agrees(self, scene, width, height, kinds, floats) -> bool:
+        """Once per build: the same floats as the Packer's, and the same gradients of the
+        kinds' values for a random adjoint of the floats (a missed or wrong route shows)."""
+        leaves = [k.flat.detach().clone().requires_grad_() for k in kinds]
+        _, mine = self.arrays(leaves)
+        for a, b in zip(mine, floats):
+            if not torch.allclose(a.detach(), b, rtol=1e-5, atol=1e-5):
+                return False
+        generator = torch.Generator().manual_seed(0)
+        adjoints = [torch.randn(f.shape, generator=generator) for f in floats]
+        fast = torch.autograd.grad(sum((a * g).sum() for a, g in zip(mine, adjoints)), leaves, allow_unused=True)
+        tensors = [t for k in kinds for t in k.tensors]
+        with torch.enable_grad():
+            packed = Packer(scene, width, height).pack().arrays()
+            total = sum((packed[name].float() * g).sum() for name, g in zip(FLOAT_INPUTS, adjoints))
+            used = [t for t in tensors if t.requires_grad]
+            slow = dict(zip(map(id, used), torch.autograd.grad(total, used, allow_unused=True))) if used else {}
+        for k, f in zip(kinds, fast):
+            reference = torch.cat([(slow.get(id(t)) if slow.get(id(t)) is not None else torch.zeros_like(t))
+                                   .reshape(-1) for t in k.tensors])
+            f = f if f is not None else torch.zeros_like(reference)
+            scale = float(reference.abs().max()) if reference.numel() else 0.0
+            if not torch.allclose(f, reference, rtol=1e-4, atol=1e-4 * max(1.0, scale)):
+                return False
+        return True
+
+
+def _conditions(presence, at: dict[int, int]) -> list:
+    """presence (tensor, present, every) rows of optimised tensors as index arrays over x,
+    one set for 'largest > 0' and one for 'smallest > 0'."""
+    out = []
+    for every in (False, True):
+        rows = [(at[id(t)], t.numel(), present) for t, present, e in presence
+                if e == every and id(t) in at and t.numel() > 0]
+        if rows:
+            index = np.concatenate([start + np.arange(n) for start, n, _ in rows])
+            starts = np.concatenate([[0], np.cumsum([n for _, n, _ in rows])[:-1]])
+            out.append((index, starts, np.array([p for _, _, p in rows]), every))
+    return out
