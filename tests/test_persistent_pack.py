@@ -82,6 +82,23 @@ def test_mixed_scene_same_image_and_gradients(tmp_path):
     _assert_same(scene, kinds, 37, 29)  # another size: other matrices
 
 
+def test_square_rect(tmp_path):
+    scene = _scene(tmp_path, MIXED.replace('<path d="M0 0 H128 V96 H0 Z" fill="#eee"/>',
+                                           '<rect x="3" y="4" width="100" height="80" fill="#eee" stroke="#f00"/>'))
+    kinds = parameter_kinds(scene, RATES, 64, 48)
+    _assert_same(scene, kinds, 64, 48)
+    pack = PersistentPack.build(scene, 64, 48, kinds)
+    flats = [k.flat for k in kinds]
+    rect = scene.shapes[0].geometry
+    with torch.no_grad():
+        rect.p_max[0] = 2.0  # narrower than nothing: no longer drawn
+        assert not pack.still_valid(flats)
+        rect.p_max[0] = 103.0
+        assert pack.still_valid(flats)
+        rect.corner_radii.fill_(2.0)  # rounded: another path
+        assert not pack.still_valid(flats)
+
+
 def test_per_point_widths(tmp_path):
     scene = _scene(tmp_path)
     path = scene.shapes[-1].geometry

@@ -253,16 +253,18 @@ class Packer:
             geometry = shape.geometry
             if self.trace:
                 self._trace_presence(shape, has_stroke, scale_np[i] > 0)
+            rect = None
             if isinstance(geometry, Rect):
-                if self.trace:  # (its corners and radii become path points non-linearly)
-                    self.trace.used_otherwise(geometry.p_min, geometry.p_max, geometry.corner_radii)
+                rect = geometry
+                if self.trace:
+                    self.trace.rect(rect)
                 geometry = rect_as_path(geometry)
                 if geometry is None:
                     continue
             if isinstance(geometry, Path):
                 if not geometry.subpaths:
                     continue
-                index = paths.add(geometry, i, len(out.shapes), len(out.subpaths), with_widths=has_stroke)
+                index = paths.add(geometry, i, len(out.shapes), len(out.subpaths), with_widths=has_stroke, rect=rect)
                 out.shapes.append([SHAPE_PATH, len(out.subpaths), len(geometry.subpaths), -1])
                 out.subpaths.extend([None] * len(geometry.subpaths))  # filled by the batch
             else:
@@ -386,14 +388,16 @@ class _PathBatch:
         self.subpaths: list[list] = []
         self.subpath_slot: list[int] = []       # first row in Packed.subpaths per path
         self.widths: list = []                  # per-point stroke widths per path, or None
+        self.rects: list = []                   # the Rect a path was made from, or None
 
     def add(self, path: Path, shape_index: int, core_shape: int, subpath_slot: int,
-            with_widths: bool = False) -> int:
+            with_widths: bool = False, rect: Rect | None = None) -> int:
         widths = path.widths if with_widths else None
         if widths is not None and widths.numel() != len(path.points):
             raise VecfitError(f"a path's widths must have one value per point "
                               f"({widths.numel()} widths for {len(path.points)} points)")
         self.widths.append(widths)
+        self.rects.append(rect)
         self.points.append(path.points)
         self.owner.append(shape_index)
         self.degrees.append(np.asarray(path.degrees, dtype=np.int64))
@@ -407,8 +411,11 @@ class _PathBatch:
         counts = [len(p) for p in self.points]
         if trace:
             row, m_np, s_np = out.n_points, matrices.detach().numpy(), scale.detach().numpy()
-            for points, widths, owner, n in zip(self.points, self.widths, self.owner, counts):
-                trace.points("points", row, points, m_np[owner])
+            for points, widths, owner, n, rect in zip(self.points, self.widths, self.owner, counts, self.rects):
+                if rect is not None:
+                    trace.rect_corners("points", row, rect, m_np[owner])
+                else:
+                    trace.points("points", row, points, m_np[owner])
                 if widths is not None:
                     trace.scaled("point_widths", row, widths, float(s_np[owner]))
                 row += n

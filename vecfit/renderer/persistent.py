@@ -16,7 +16,7 @@ where x is the optimiser's flat parameter tensors side by side; autograd of that
 gather and a scatter, so gradients reach the flat tensors by index.
 
 PersistentPack.build answers None where that does not hold (transforms or opacities
-optimised; a rect's corners, or geometry under a bounding-box gradient, optimised) and the
+optimised; a rounded rect's corners, or geometry under a bounding-box gradient, optimised) and the
 loop packs on every iteration as before. The build checks itself once against the
 Packer: the same floats, and the same gradients for a random image adjoint.
 """
@@ -56,6 +56,7 @@ class Provenance:
         self.routes: list[_Route] = []
         self.nonlinear: set[int] = set()   # ids of tensors used in other ways
         self.presence: list[tuple] = []    # (tensor, draws present, reduce): see present_if_positive
+        self.differences: list[tuple] = []  # (a, i, b, j, present): a draw exists while a[i] > b[j]
 
     def __bool__(self) -> bool:
         return True
@@ -98,6 +99,33 @@ class Provenance:
             for j in range(2):
                 self.routes.append(_Route("ellipses", np.array([first + 2 + 2 * i + j]), radii,
                                           np.array([0 if circle else j]), np.array([m[i, j]])))
+
+    def rect(self, rect) -> None:
+        """A rect becomes a path (geometry.rect_as_path): with square corners, its corners
+        are its p_min and p_max (rect_corners); rounded, the radii enter non-linearly. It
+        is drawn while its width and height are above 0 and keeps square corners while a
+        radius is 0 (conditions)."""
+        rx, ry = (float(v) for v in rect.corner_radii.detach())
+        if rx > 0 and ry > 0:
+            self.used_otherwise(rect.p_min, rect.p_max, rect.corner_radii)
+            return
+        self.present_if_positive(rect.corner_radii, False, every=True)
+        for axis in range(2):
+            size = float(rect.p_max.detach()[axis] - rect.p_min.detach()[axis])
+            self.differences.append((rect.p_max, axis, rect.p_min, axis, size > 0))
+
+    def rect_corners(self, array: str, row: int, rect, m: np.ndarray) -> None:
+        """A square-cornered rect's four corners (x0 y0, x1 y0, x1 y1, x0 y1) mapped by m."""
+        corners = np.arange(4)
+        x_of = {id(rect.p_min): corners[[0, 3]], id(rect.p_max): corners[[1, 2]]}
+        y_of = {id(rect.p_min): corners[[0, 1]], id(rect.p_max): corners[[2, 3]]}
+        for tensor in (rect.p_min, rect.p_max):
+            for j, of in ((0, x_of), (1, y_of)):
+                k = of[id(tensor)]
+                for c in range(2):
+                    if m[c, j] != 0:
+                        self.routes.append(_Route(array, 2 * (row + k) + c, tensor, np.full(len(k), j),
+                                                  np.full(len(k), m[c, j]), np.full(len(k), m[c, 2])))
 
     def used_otherwise(self, *tensors: torch.Tensor) -> None:
         self.nonlinear.update(id(t) for t in tensors)
@@ -160,7 +188,7 @@ class PersistentPack:
         pack = cls({k: v for k, v in arrays.items() if k not in FLOAT_INPUTS}, [f.shape for f in floats],
                    base, as_index(dst), as_index(src),
                    torch.from_numpy(np.concatenate(coef)).float() if coef else torch.zeros(0),
-                   _conditions(trace.presence, at))
+                   _conditions(trace.presence, trace.differences, at))
         return pack if pack._agrees(scene, width, height, kinds, floats) else None
 
     def arrays(self, leaves: list[torch.Tensor]) -> tuple[dict, list[torch.Tensor]]:
@@ -181,9 +209,12 @@ class PersistentPack:
         if not self._conditions:
             return True
         x = (torch.cat(flats) if len(flats) > 1 else flats[0]).detach().numpy()
-        for index, starts, expected, every in self._conditions:
-            reduce = np.minimum if every else np.maximum
-            if not np.array_equal(reduce.reduceat(x[index], starts) > 0, expected):
+        for kind, a, b, expected in self._conditions:
+            if kind == "difference":
+                values = x[a] - x[b]
+            else:  # a: indices, b: where each tensor's run starts
+                values = (np.minimum if kind == "every" else np.maximum).reduceat(x[a], b)
+            if not np.array_equal(values > 0, expected):
                 return False
         return True
 
@@ -214,9 +245,10 @@ class PersistentPack:
         return True
 
 
-def _conditions(presence, at: dict[int, int]) -> list:
-    """presence (tensor, present, every) rows of optimised tensors as index arrays over x,
-    one set for 'largest > 0' and one for 'smallest > 0'."""
+def _conditions(presence, differences, at: dict[int, int]) -> list:
+    """The conditions on optimised tensors as index arrays over x: (kind, a, b, expected)
+    with kind "any" (a tensor's largest value > 0), "every" (its smallest > 0) or
+    "difference" (x[a] - x[b] > 0)."""
     out = []
     for every in (False, True):
         rows = [(at[id(t)], t.numel(), present) for t, present, e in presence
@@ -224,5 +256,10 @@ def _conditions(presence, at: dict[int, int]) -> list:
         if rows:
             index = np.concatenate([start + np.arange(n) for start, n, _ in rows])
             starts = np.concatenate([[0], np.cumsum([n for _, n, _ in rows])[:-1]])
-            out.append((index, starts, np.array([p for _, _, p in rows]), every))
+            out.append(("every" if every else "any", index, starts, np.array([p for _, _, p in rows])))
+    rows = [(at[id(a)] + i, at[id(b)] + j, present) for a, i, b, j, present in differences
+            if id(a) in at and id(b) in at]
+    if rows:
+        a, b, expected = (np.array(v) for v in zip(*rows))
+        out.append(("difference", a, b, expected))
     return out
