@@ -1,8 +1,9 @@
 """Where a fitting iteration's core time goes (the core's phase clocks), for peppers and
 kitty at the fitting loop's settings (MC, 2x2 samples, 2 boundary samples per pixel,
 1 interior sample, 2 threads): medians over the iterations of render + L2 backward.
-With --hash it prints instead a hash of the image and of every gradient per scene, mode
-and thread count, to check that a change of the core leaves them bit for bit.
+With --hash it prints instead hashes of the image and the gradients per scene, mode and
+thread count (peppers, kitty, tiger), to check that a change of the core leaves them bit
+for bit.
 
 Usage: python benchmarks/plan.py [--iterations N] [--threads T] [--core PATH] [--hash]
 --core loads another build of vecfit._core (a copy of the .so), to compare builds
@@ -74,15 +75,42 @@ def timings(args) -> None:
 
 
 def hashes(args) -> None:
+    """Hashes of the core's image and gradient arrays (what the core returns), and of the
+    Scene tensors' gradients (after torch's packing backward, which is not always
+    bit-reproducible on its own: an occasional run differs there with the core's output
+    the same)."""
+    import vecfit.renderer.raster as raster
+    core = raster._core
+    got = []
+
+    class Recording:  # the core as raster calls it, hashing what it returns
+        def __getattr__(self, name):
+            return getattr(core, name)
+
+        def render_keeping(self, *a, **k):
+            image, kept = core.render_keeping(*a, **k)
+            got.append(hashlib.sha256(image.tobytes()).hexdigest()[:16])
+            return image, kept
+
+        def render_grad(self, *a):
+            grads = core.render_grad(*a)
+            h = hashlib.sha256()
+            for name in sorted(grads):
+                h.update(grads[name].tobytes())
+            got.append(h.hexdigest()[:16])
+            return grads
+
+    raster._core = Recording()
     for name in ("peppers", "kitty", "tiger"):
         scene, params = load(name)
         for mode in ("mc", "analytic"):
             for threads in (1, 2):
-                image = iteration(scene, params, 3, threads, mode)
-                h = hashlib.sha256(image.detach().numpy().tobytes())
+                got.clear()
+                iteration(scene, params, 3, threads, mode)
+                h = hashlib.sha256()
                 for t in params:
                     h.update(b"-" if t.grad is None else t.grad.numpy().tobytes())
-                print(name, mode, threads, h.hexdigest()[:16])
+                print(name, mode, threads, "image", got[0], "core grads", got[1], "scene grads", h.hexdigest()[:16])
 
 
 def main() -> None:

@@ -11,6 +11,7 @@
 #include "common/cancel.h"
 #include "common/phase_clock.h"
 #include "common/thread_pool.h"
+#include "scene/draw_runs.h"
 
 namespace vf {
 namespace {
@@ -90,19 +91,18 @@ void pixel_adjoints(const RenderOptions& o, const float* image, const float* d_i
 // the canvas at most a few times: 4 (W + H) pixels of length): a segment 1e9 pixels long
 // would otherwise ask for billions of samples, nearly all off the canvas. The cap keeps the
 // estimate unbiased (each sample is weighted by length / count), only noisier there.
-std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_, int width, int height) {
-    std::vector<Piece> out;
+std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_, int width, int height, int threads) {
     const double cap = std::ceil(density_ * 4.0 * ((double)width + height));
     auto count = [&](double len) { return clamp_to_int(std::ceil(std::min(density_ * len, cap)), 1, 1 << 30); };
-    for (int di = 0; di < (int)sc_.draws.size(); ++di) {
+    auto draw_pieces = [&](int di, std::vector<Piece>& out) {
         const PreparedDraw& d = sc_.draws[di];
-        if (!valid(d.box)) continue;
+        if (!valid(d.box)) return;
         if (d.is_ellipse) {
             double r = std::max(d.ellipse.r0, d.ellipse.r1) + (d.kind == DRAW_STROKE ? d.half_width : 0);
             double len = 2 * M_PI * r * (d.kind == DRAW_STROKE ? d.metric_scale : 1.0);
             if (d.kind == DRAW_FILL) out.push_back({Piece::ELLIPSE, di, 0, 0, count(len)});
             else for (int s = -1; s <= 1; s += 2) out.push_back({Piece::ELLIPSE, di, 0, s, count(len)});
-            continue;
+            return;
         }
         for (int k = 0; k < d.n_items; ++k) {
             if (d.kind == DRAW_FILL) {
@@ -126,7 +126,22 @@ std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_, int wi
                     out.push_back({Piece::END, di, k, 1, count(end_len(s.end.hw))});
             }
         }
-    }
+    };
+    // Runs of draws on the threads, joined in draw order: the serial list exactly.
+    const int n_draws = (int)sc_.draws.size();
+    if (threads <= 0) threads = ThreadPool::hardware_threads();
+    const std::vector<int> bounds = draw_runs(sc_.draws.data(), n_draws, std::min(threads, std::max(1, n_draws)));
+    const int n_runs = (int)bounds.size() - 1;
+    std::vector<std::vector<Piece>> runs(n_runs);
+    ThreadPool::instance().parallel_for(n_runs, threads, [&](int r, int) {
+        for (int di = bounds[r]; di < bounds[r + 1]; ++di) draw_pieces(di, runs[r]);
+    });
+    if (n_runs == 1) return std::move(runs[0]);
+    std::vector<Piece> out;
+    size_t n = 0;
+    for (const auto& run : runs) n += run.size();
+    out.reserve(n);
+    for (const auto& run : runs) out.insert(out.end(), run.begin(), run.end());
     return out;
 }
 
@@ -144,7 +159,7 @@ BackwardPlan plan_backward(const PreparedScene& prepared, const RenderOptions& o
                           o.threads);
     pixel_adjoints(o, image, d_image, plan.gpix);
     const SceneView sc = prepared.view();
-    if (o.mode == MODE_MC) plan.pieces = boundary_pieces(sc, boundary_density, o.width, o.height);
+    if (o.mode == MODE_MC) plan.pieces = boundary_pieces(sc, boundary_density, o.width, o.height, o.threads);
     BoundaryContext& bc = plan.boundary;
     bc.width = o.width;
     bc.height = o.height;

@@ -5,6 +5,7 @@
 
 #include "common/thread_pool.h"
 #include "scene/coverage.h"
+#include "scene/draw_runs.h"
 
 namespace vf {
 namespace {
@@ -195,54 +196,54 @@ TileBins bin_draws(const PreparedScene& sc, int width, int height, double margin
     bins.ny = (height + TILE - 1) / TILE;
     bins.margin = margin;
     TileRange all{0, 0, bins.nx - 1, bins.ny - 1};
-    // Draws are binned independently, in runs of consecutive draws shared out between
-    // threads, and the runs joined in draw order: the bins are the serial ones exactly.
-    // About a dozen runs per thread, cut by item count, even out draws of unequal size.
+    // Draws are binned independently, in runs shared out between threads (see draw_runs).
     const int n_draws = (int)sc.draws.size();
     if (threads <= 0) threads = ThreadPool::hardware_threads();
     threads = std::max(1, std::min(threads, n_draws));
-    const int n_runs = threads == 1 ? 1 : std::min(n_draws, 12 * threads);
+    const std::vector<int> bounds = draw_runs(sc.draws.data(), n_draws, threads);
+    const int n_runs = (int)bounds.size() - 1;
     std::vector<DrawRun> runs(n_runs);
-    {
-        size_t total = 0;
-        for (const PreparedDraw& d : sc.draws) total += 1 + d.n_items;
-        size_t done = 0;
-        int r = 0;
-        for (int i = 0; i < n_draws; ++i) {
-            // (a run closes once the items so far reach its share of the whole)
-            done += 1 + sc.draws[i].n_items;
-            if (r + 1 < n_runs && done * n_runs >= total * (r + 1)) {
-                runs[r].end = i + 1;
-                runs[++r].begin = i + 1;
-            }
-        }
-        runs[r].end = n_draws;
-        for (++r; r < n_runs; ++r) runs[r].begin = runs[r].end = n_draws;
+    for (int r = 0; r < n_runs; ++r) {
+        runs[r].begin = bounds[r];
+        runs[r].end = bounds[r + 1];
     }
     std::vector<DrawScratch> scratch(threads);
     ThreadPool::instance().parallel_for(n_runs, threads, [&](int r, int worker) {
         bin_run(sc, bins, all, every_tile, runs[r], scratch[worker]);
     });
 
-    // The runs' items joined; a stable counting sort by tile keeps each tile's entries
-    // in paint order.
+    // The runs joined: their items in order, and a stable counting sort of their entries
+    // by tile (which keeps each tile's entries in paint order), the two side by side.
     std::vector<size_t> item_offset(n_runs + 1, 0);
     for (int r = 0; r < n_runs; ++r) item_offset[r + 1] = item_offset[r] + runs[r].items.size();
     bins.items.resize(item_offset[n_runs]);
-    for (int r = 0; r < n_runs; ++r) std::copy(runs[r].items.begin(), runs[r].items.end(), bins.items.begin() + item_offset[r]);
-    int n_tiles = bins.nx * bins.ny;
-    bins.start.assign(n_tiles + 1, 0);
-    for (const DrawRun& run : runs)
-        for (const Pending& p : run.pending) ++bins.start[p.tile + 1];
-    for (int t = 0; t < n_tiles; ++t) bins.start[t + 1] += bins.start[t];
-    bins.entries.resize(bins.start[n_tiles]);
-    std::vector<int> cursor(bins.start.begin(), bins.start.end() - 1);
-    for (int r = 0; r < n_runs; ++r)
-        for (const Pending& p : runs[r].pending) {
-            TileEntry& e = bins.entries[cursor[p.tile]++];
-            e = p.entry;
-            e.first += (int)item_offset[r];
-        }
+    const int n_tiles = bins.nx * bins.ny;
+    auto join_items = [&] {
+        for (int r = 0; r < n_runs; ++r)
+            std::copy(runs[r].items.begin(), runs[r].items.end(), bins.items.begin() + item_offset[r]);
+    };
+    auto sort_entries = [&] {
+        bins.start.assign(n_tiles + 1, 0);
+        for (const DrawRun& run : runs)
+            for (const Pending& p : run.pending) ++bins.start[p.tile + 1];
+        for (int t = 0; t < n_tiles; ++t) bins.start[t + 1] += bins.start[t];
+        bins.entries.resize(bins.start[n_tiles]);
+        std::vector<int> cursor(bins.start.begin(), bins.start.end() - 1);
+        for (int r = 0; r < n_runs; ++r)
+            for (const Pending& p : runs[r].pending) {
+                TileEntry& e = bins.entries[cursor[p.tile]++];
+                e = p.entry;
+                e.first += (int)item_offset[r];
+            }
+    };
+    bool done[2] = {false, false};
+    ThreadPool::instance().parallel_for(2, threads, [&](int task, int) {
+        task == 0 ? join_items() : sort_entries();
+        done[task] = true;
+    });
+    // (tasks skipped by a cancel: the bins stay whole, for whatever still reads them)
+    if (!done[0]) join_items();
+    if (!done[1]) sort_entries();
     return bins;
 }
 
