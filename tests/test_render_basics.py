@@ -101,3 +101,19 @@ def test_tiles_match_brute_force(mode, samples, filter):
     fast = vecfit.render(scene, 248, 255, samples=samples, mode=mode, filter=filter)
     brute = vecfit.render(scene, 248, 255, samples=samples, mode=mode, filter=filter, _brute_force=True)
     assert torch.equal(fast, brute)
+
+
+@pytest.mark.parametrize("mode", ["mc", "analytic"])
+def test_tiles_independent_of_thread_count(mode):
+    """The tiles are binned by runs of draws on as many threads as the render has and
+    joined in draw order: the image (whose compositing order and windings come from the
+    tiles) is the one-thread image bit for bit, whatever the count (odd ones too)."""
+    import warnings
+    from pathlib import Path as FilePath
+    tiger = FilePath(__file__).resolve().parents[1] / "examples" / "tiger.svg"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        scene = vecfit.load_svg(tiger)
+    one = vecfit.render(scene, 248, 255, samples=2, mode=mode, threads=1)
+    for threads in (2, 3, 7):
+        assert torch.equal(vecfit.render(scene, 248, 255, samples=2, mode=mode, threads=threads), one)

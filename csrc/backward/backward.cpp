@@ -4,49 +4,82 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <optional>
 #include <vector>
 
 #include "common/cancel.h"
 #include "common/phase_clock.h"
 #include "common/thread_pool.h"
+#include "scene/draw_runs.h"
 
 namespace vf {
 namespace {
 
+// Buffers for the pixel adjoints kept from pass to pass: a fresh 8 MB buffer (512 x 512)
+// was faulted in page by page, which took longer than filling it (6 of the 9 ms of
+// pixel_adjoints on kitty, 864 x 576). A few are kept, one per concurrent pass (batches).
+std::mutex spare_mutex;
+std::vector<std::vector<double>> spare_buffers;
+
+std::vector<double> adjoint_buffer(size_t n) {
+    std::vector<double> v;
+    {
+        std::lock_guard<std::mutex> lock(spare_mutex);
+        if (!spare_buffers.empty()) {
+            v = std::move(spare_buffers.back());
+            spare_buffers.pop_back();
+        }
+    }
+    if (v.capacity() < n) v = std::vector<double>();  // (not copied over into a bigger one)
+    v.resize(n);  // every element is written by pixel_adjoints
+    return v;
+}
+
+void keep_adjoint_buffer(std::vector<double>&& v) {
+    if (v.capacity() > (size_t(64) << 20) / sizeof(double)) return;  // (a big image's is given back)
+    std::lock_guard<std::mutex> lock(spare_mutex);
+    if ((int)spare_buffers.size() < ThreadPool::hardware_threads()) spare_buffers.push_back(std::move(v));
+}
+
 // dL/d(premultiplied scene colour, background under it excluded) of each pixel, from
-// dL/d(straight output) and the output itself.
+// dL/d(straight output) and the output itself. Parallel over rows: pixels are independent.
 void pixel_adjoints(const RenderOptions& o, const float* image, const float* d_image, std::vector<double>& g) {
-    int n = o.width * o.height;
-    g.assign(4 * (size_t)n, 0);
+    const int W = o.width, H = o.height;
+    g = adjoint_buffer(4 * (size_t)W * H);
     double bg[4];
     premultiplied_background(o, bg);
-    for (int p = 0; p < n; ++p) {
-        const float* s = image + 4 * p;
-        const float* ds = d_image + 4 * p;
-        double a = s[3];
-        if (a <= 0) {
-            // An empty pixel: its straight colour jumps from 0 to the colour of whatever
-            // comes to cover it (no derivative), but its alpha is the premultiplied alpha
-            // (background empty too), so a boundary moving into it still has a gradient
-            // through alpha. (Skipping such pixels gave a shape's edge lying exactly on a
-            // pixel line no gradient towards the empty side: the boundary sample there
-            // lands in the empty pixel.)
-            g[4 * (size_t)p + 3] = ds[3];
-            continue;
+    constexpr int ROWS = 16;  // rows per task
+    ThreadPool::instance().parallel_for((H + ROWS - 1) / ROWS, o.threads, [&](int task, int) {
+        for (size_t p = (size_t)task * ROWS * W, end = std::min((size_t)(task + 1) * ROWS, (size_t)H) * W; p < end; ++p) {
+            const float* s = image + 4 * p;
+            const float* ds = d_image + 4 * p;
+            double* gp = g.data() + 4 * p;
+            double a = s[3];
+            if (a <= 0) {
+                // An empty pixel: its straight colour jumps from 0 to the colour of whatever
+                // comes to cover it (no derivative), but its alpha is the premultiplied alpha
+                // (background empty too), so a boundary moving into it still has a gradient
+                // through alpha. (Skipping such pixels gave a shape's edge lying exactly on a
+                // pixel line no gradient towards the empty side: the boundary sample there
+                // lands in the empty pixel.)
+                gp[0] = gp[1] = gp[2] = 0;
+                gp[3] = ds[3];
+                continue;
+            }
+            double gc[4];
+            double sum = 0;
+            for (int i = 0; i < 3; ++i) {
+                gc[i] = ds[i] / a;  // straight = premultiplied / alpha
+                sum += ds[i] * s[i];
+            }
+            gc[3] = ds[3] - sum / a;
+            // total = scene + (1 - scene.a) * background
+            double gb = gc[0] * bg[0] + gc[1] * bg[1] + gc[2] * bg[2] + gc[3] * bg[3];
+            for (int i = 0; i < 4; ++i) gp[i] = gc[i];
+            gp[3] -= gb;
         }
-        double gc[4];
-        double sum = 0;
-        for (int i = 0; i < 3; ++i) {
-            gc[i] = ds[i] / a;  // straight = premultiplied / alpha
-            sum += ds[i] * s[i];
-        }
-        gc[3] = ds[3] - sum / a;
-        // total = scene + (1 - scene.a) * background
-        double gb = gc[0] * bg[0] + gc[1] * bg[1] + gc[2] * bg[2] + gc[3] * bg[3];
-        for (int i = 0; i < 4; ++i) g[4 * (size_t)p + i] = gc[i];
-        g[4 * (size_t)p + 3] -= gb;
-    }
+    });
 }
 
 // The boundary pieces of every draw, each with its number of samples (density per pixel
@@ -58,19 +91,18 @@ void pixel_adjoints(const RenderOptions& o, const float* image, const float* d_i
 // the canvas at most a few times: 4 (W + H) pixels of length): a segment 1e9 pixels long
 // would otherwise ask for billions of samples, nearly all off the canvas. The cap keeps the
 // estimate unbiased (each sample is weighted by length / count), only noisier there.
-std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_, int width, int height) {
-    std::vector<Piece> out;
+std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_, int width, int height, int threads) {
     const double cap = std::ceil(density_ * 4.0 * ((double)width + height));
     auto count = [&](double len) { return clamp_to_int(std::ceil(std::min(density_ * len, cap)), 1, 1 << 30); };
-    for (int di = 0; di < (int)sc_.draws.size(); ++di) {
+    auto draw_pieces = [&](int di, std::vector<Piece>& out) {
         const PreparedDraw& d = sc_.draws[di];
-        if (!valid(d.box)) continue;
+        if (!valid(d.box)) return;
         if (d.is_ellipse) {
             double r = std::max(d.ellipse.r0, d.ellipse.r1) + (d.kind == DRAW_STROKE ? d.half_width : 0);
             double len = 2 * M_PI * r * (d.kind == DRAW_STROKE ? d.metric_scale : 1.0);
             if (d.kind == DRAW_FILL) out.push_back({Piece::ELLIPSE, di, 0, 0, count(len)});
             else for (int s = -1; s <= 1; s += 2) out.push_back({Piece::ELLIPSE, di, 0, s, count(len)});
-            continue;
+            return;
         }
         for (int k = 0; k < d.n_items; ++k) {
             if (d.kind == DRAW_FILL) {
@@ -94,7 +126,22 @@ std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_, int wi
                     out.push_back({Piece::END, di, k, 1, count(end_len(s.end.hw))});
             }
         }
-    }
+    };
+    // Runs of draws on the threads, joined in draw order: the serial list exactly.
+    const int n_draws = (int)sc_.draws.size();
+    if (threads <= 0) threads = ThreadPool::hardware_threads();
+    const std::vector<int> bounds = draw_runs(sc_.draws.data(), n_draws, std::min(threads, std::max(1, n_draws)));
+    const int n_runs = (int)bounds.size() - 1;
+    std::vector<std::vector<Piece>> runs(n_runs);
+    ThreadPool::instance().parallel_for(n_runs, threads, [&](int r, int) {
+        for (int di = bounds[r]; di < bounds[r + 1]; ++di) draw_pieces(di, runs[r]);
+    });
+    if (n_runs == 1) return std::move(runs[0]);
+    std::vector<Piece> out;
+    size_t n = 0;
+    for (const auto& run : runs) n += run.size();
+    out.reserve(n);
+    for (const auto& run : runs) out.insert(out.end(), run.begin(), run.end());
     return out;
 }
 
@@ -108,10 +155,11 @@ BackwardPlan plan_backward(const PreparedScene& prepared, const RenderOptions& o
     plan.options = settled(o);
     const double R = plan.options.filter_radius;
     // Boundary samples reach pixels within R of them, so tiles must see that far out.
-    plan.bins = bin_draws(prepared, o.width, o.height, (o.mode == MODE_ANALYTIC ? 2 * R : R) + 4 * EPS_NORMAL, false);
+    plan.bins = bin_draws(prepared, o.width, o.height, (o.mode == MODE_ANALYTIC ? 2 * R : R) + 4 * EPS_NORMAL, false,
+                          o.threads);
     pixel_adjoints(o, image, d_image, plan.gpix);
     const SceneView sc = prepared.view();
-    if (o.mode == MODE_MC) plan.pieces = boundary_pieces(sc, boundary_density, o.width, o.height);
+    if (o.mode == MODE_MC) plan.pieces = boundary_pieces(sc, boundary_density, o.width, o.height, o.threads);
     BoundaryContext& bc = plan.boundary;
     bc.width = o.width;
     bc.height = o.height;
@@ -190,6 +238,7 @@ bool render_backward(const PreparedScene& prepared, const SceneArrays& a, const 
     }
 
     timer.reset();
+    keep_adjoint_buffer(std::move(plan.gpix));
     for (char f : overflowed)
         if (f) return false;
     out = grads[0];

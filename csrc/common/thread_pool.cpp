@@ -3,6 +3,18 @@
 #include "common/cancel.h"
 
 namespace vf {
+namespace {
+// Whether this thread is running a parallel_for's task: a parallel_for called from one
+// runs its tasks on the spot (the pool runs one parallel_for at a time; waiting for it
+// there would wait for ever).
+thread_local bool in_task = false;
+
+struct InTask {
+    bool was = in_task;
+    InTask() { in_task = true; }
+    ~InTask() { in_task = was; }
+};
+}  // namespace
 
 ThreadPool& ThreadPool::instance() {
     static ThreadPool pool;
@@ -42,8 +54,11 @@ void ThreadPool::worker_loop(int id) {
         const auto* job = job_;
         int n = n_tasks_;
         lock.unlock();
-        for (int t; (t = next_.fetch_add(1)) < n;)
-            if (!cancelled()) (*job)(t, id);
+        {
+            InTask task;
+            for (int t; (t = next_.fetch_add(1)) < n;)
+                if (!cancelled()) (*job)(t, id);
+        }
         lock.lock();
         if (--running_ == 0) done_.notify_all();
     }
@@ -53,7 +68,7 @@ void ThreadPool::parallel_for(int n, int threads, const std::function<void(int, 
     if (n <= 0) return;
     if (threads <= 0) threads = hardware_threads();
     threads = std::min(threads, n);
-    if (threads == 1) {
+    if (threads == 1 || in_task) {
         for (int t = 0; t < n && !cancelled(); ++t) fn(t, 0);
         return;
     }
@@ -69,8 +84,11 @@ void ThreadPool::parallel_for(int n, int threads, const std::function<void(int, 
         ++generation_;
     }
     wake_.notify_all();
-    for (int t; (t = next_.fetch_add(1)) < n;)
-        if (!cancelled()) fn(t, 0);
+    {
+        InTask task;
+        for (int t; (t = next_.fetch_add(1)) < n;)
+            if (!cancelled()) fn(t, 0);
+    }
     std::unique_lock<std::mutex> lock(mutex_);
     done_.wait(lock, [&] { return running_ == 0 && next_ >= n; });
     job_ = nullptr;

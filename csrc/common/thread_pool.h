@@ -16,7 +16,8 @@ public:
     static ThreadPool& instance();
     // Runs fn(task, worker) for task in [0, n) on up to `threads` workers (0: all cores)
     // and returns when all are done. worker is in [0, threads). Once cancel_requested()
-    // (common/cancel.h) is set, the tasks not yet started are skipped.
+    // (common/cancel.h) is set, the tasks not yet started are skipped. Called from inside
+    // a task, it runs its tasks there, one after another (as worker 0).
     void parallel_for(int n, int threads, const std::function<void(int, int)>& fn);
     static int hardware_threads();
     ~ThreadPool();

@@ -33,7 +33,7 @@ ForwardPlan plan_forward(const PreparedScene& sc, const RenderOptions& o) {
     const double R = plan.options.filter_radius;
     double margin = std::max(0.0, R - 0.5) + (o.mode == MODE_ANALYTIC ? R : 0.0);
     PhaseTimer timer(PHASE_PLAN);
-    plan.bins = bin_draws(sc, o.width, o.height, margin + 1e-6, o.brute_force);
+    plan.bins = bin_draws(sc, o.width, o.height, margin + 1e-6, o.brute_force, o.threads);
     premultiplied_background(o, plan.background);
     return plan;
 }

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/thread_pool.h"
 #include "scene/coverage.h"
+#include "scene/draw_runs.h"
 
 namespace vf {
 namespace {
@@ -63,28 +65,40 @@ struct Pending {
     TileEntry entry;
 };
 
+// A worker's buffers for bin_path_draw, reused from draw to draw.
+struct DrawScratch {
+    std::vector<int> counts, start, local, cursor;
+    std::vector<TileRange> item_tiles;
+    std::vector<std::vector<std::pair<double, int>>> row_crossings;
+};
+
 // Bins the items of one path draw into its tiles (counting sort within its tile range)
 // and emits an entry per tile that the draw can affect.
 void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_index, const TileRange& range,
                    const TileBins& bins, bool every_tile, std::vector<Pending>& pending,
-                   std::vector<LocalItem>& items) {
+                   std::vector<LocalItem>& items, DrawScratch& scratch) {
     const bool fill = d.kind == DRAW_FILL;
     const int w = range.width(), h = range.y1 - range.y0 + 1;
     auto item_box = [&](int k) -> const Box& {
         return fill ? sc.fill_items[d.first_item + k].box : sc.stroke_items[d.first_item + k].box;
     };
-    std::vector<int> counts(w * h + 1, 0);
-    std::vector<TileRange> item_tiles(d.n_items);
+    std::vector<int>& counts = scratch.counts;
+    counts.assign(w * h + 1, 0);
+    std::vector<TileRange>& item_tiles = scratch.item_tiles;
+    item_tiles.resize(d.n_items);
     for (int k = 0; k < d.n_items; ++k) {
         item_tiles[k] = tiles_of(item_box(k), bins.margin, range);
         const TileRange& r = item_tiles[k];
         for (int ty = r.y0; ty <= r.y1; ++ty)
             for (int tx = r.x0; tx <= r.x1; ++tx) ++counts[(ty - range.y0) * w + (tx - range.x0)];
     }
-    std::vector<int> start(w * h + 1, 0);
+    std::vector<int>& start = scratch.start;
+    start.assign(w * h + 1, 0);
     for (int i = 0; i < w * h; ++i) start[i + 1] = start[i] + counts[i];
-    std::vector<int> local(start[w * h]);
-    std::vector<int> cursor(start.begin(), start.end() - 1);
+    std::vector<int>& local = scratch.local;
+    local.resize(start[w * h]);
+    std::vector<int>& cursor = scratch.cursor;
+    cursor.assign(start.begin(), start.end() - 1);
     for (int k = 0; k < d.n_items; ++k) {
         const TileRange& r = item_tiles[k];
         for (int ty = r.y0; ty <= r.y1; ++ty)
@@ -92,9 +106,10 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
     }
 
     // Fills: crossings of each tile row's top line, to count the corner rays.
-    std::vector<std::vector<std::pair<double, int>>> row_crossings;
+    std::vector<std::vector<std::pair<double, int>>>& row_crossings = scratch.row_crossings;
     if (fill) {
-        row_crossings.resize(h);
+        if ((int)row_crossings.size() < h) row_crossings.resize(h);
+        for (int r = 0; r < h; ++r) row_crossings[r].clear();
         for (int k = 0; k < d.n_items; ++k) {
             const PreparedSegment& s = sc.fill_items[d.first_item + k];
             int r0 = clamp_to_int(std::ceil((s.box.y0 + bins.margin) / TILE), range.y0, range.y1 + 1);
@@ -150,34 +165,85 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
     }
 }
 
+// The entries and items of a run of consecutive draws, their `first` counted from the
+// run's own items.
+struct DrawRun {
+    int begin = 0, end = 0;
+    std::vector<Pending> pending;
+    std::vector<LocalItem> items;
+};
+
+void bin_run(const PreparedScene& sc, const TileBins& bins, const TileRange& all, bool every_tile, DrawRun& run,
+             DrawScratch& scratch) {
+    for (int i = run.begin; i < run.end; ++i) {
+        const PreparedDraw& d = sc.draws[i];
+        TileRange range = tiles_of(d.box, bins.margin, all);
+        if (range.empty()) continue;
+        if (d.is_ellipse) {
+            for (int ty = range.y0; ty <= range.y1; ++ty)
+                for (int tx = range.x0; tx <= range.x1; ++tx) run.pending.push_back({ty * bins.nx + tx, TileEntry{i, 0, 0, 0}});
+        } else {
+            bin_path_draw(sc, d, i, range, bins, every_tile, run.pending, run.items, scratch);
+        }
+    }
+}
+
 }  // namespace
 
-TileBins bin_draws(const PreparedScene& sc, int width, int height, double margin, bool every_tile) {
+TileBins bin_draws(const PreparedScene& sc, int width, int height, double margin, bool every_tile, int threads) {
     TileBins bins;
     bins.nx = (width + TILE - 1) / TILE;
     bins.ny = (height + TILE - 1) / TILE;
     bins.margin = margin;
     TileRange all{0, 0, bins.nx - 1, bins.ny - 1};
-    std::vector<Pending> pending;
-    for (size_t i = 0; i < sc.draws.size(); ++i) {
-        const PreparedDraw& d = sc.draws[i];
-        TileRange range = tiles_of(d.box, margin, all);
-        if (range.empty()) continue;
-        if (d.is_ellipse) {
-            for (int ty = range.y0; ty <= range.y1; ++ty)
-                for (int tx = range.x0; tx <= range.x1; ++tx) pending.push_back({ty * bins.nx + tx, TileEntry{(int)i, 0, 0, 0}});
-        } else {
-            bin_path_draw(sc, d, (int)i, range, bins, every_tile, pending, bins.items);
-        }
+    // Draws are binned independently, in runs shared out between threads (see draw_runs).
+    const int n_draws = (int)sc.draws.size();
+    if (threads <= 0) threads = ThreadPool::hardware_threads();
+    threads = std::max(1, std::min(threads, n_draws));
+    const std::vector<int> bounds = draw_runs(sc.draws.data(), n_draws, threads);
+    const int n_runs = (int)bounds.size() - 1;
+    std::vector<DrawRun> runs(n_runs);
+    for (int r = 0; r < n_runs; ++r) {
+        runs[r].begin = bounds[r];
+        runs[r].end = bounds[r + 1];
     }
-    // Stable counting sort by tile keeps each tile's entries in paint order.
-    int n_tiles = bins.nx * bins.ny;
-    bins.start.assign(n_tiles + 1, 0);
-    for (const Pending& p : pending) ++bins.start[p.tile + 1];
-    for (int t = 0; t < n_tiles; ++t) bins.start[t + 1] += bins.start[t];
-    bins.entries.resize(pending.size());
-    std::vector<int> cursor(bins.start.begin(), bins.start.end() - 1);
-    for (const Pending& p : pending) bins.entries[cursor[p.tile]++] = p.entry;
+    std::vector<DrawScratch> scratch(threads);
+    ThreadPool::instance().parallel_for(n_runs, threads, [&](int r, int worker) {
+        bin_run(sc, bins, all, every_tile, runs[r], scratch[worker]);
+    });
+
+    // The runs joined: their items in order, and a stable counting sort of their entries
+    // by tile (which keeps each tile's entries in paint order), the two side by side.
+    std::vector<size_t> item_offset(n_runs + 1, 0);
+    for (int r = 0; r < n_runs; ++r) item_offset[r + 1] = item_offset[r] + runs[r].items.size();
+    bins.items.resize(item_offset[n_runs]);
+    const int n_tiles = bins.nx * bins.ny;
+    auto join_items = [&] {
+        for (int r = 0; r < n_runs; ++r)
+            std::copy(runs[r].items.begin(), runs[r].items.end(), bins.items.begin() + item_offset[r]);
+    };
+    auto sort_entries = [&] {
+        bins.start.assign(n_tiles + 1, 0);
+        for (const DrawRun& run : runs)
+            for (const Pending& p : run.pending) ++bins.start[p.tile + 1];
+        for (int t = 0; t < n_tiles; ++t) bins.start[t + 1] += bins.start[t];
+        bins.entries.resize(bins.start[n_tiles]);
+        std::vector<int> cursor(bins.start.begin(), bins.start.end() - 1);
+        for (int r = 0; r < n_runs; ++r)
+            for (const Pending& p : runs[r].pending) {
+                TileEntry& e = bins.entries[cursor[p.tile]++];
+                e = p.entry;
+                e.first += (int)item_offset[r];
+            }
+    };
+    bool done[2] = {false, false};
+    ThreadPool::instance().parallel_for(2, threads, [&](int task, int) {
+        task == 0 ? join_items() : sort_entries();
+        done[task] = true;
+    });
+    // (tasks skipped by a cancel: the bins stay whole, for whatever still reads them)
+    if (!done[0]) join_items();
+    if (!done[1]) sort_entries();
     return bins;
 }
 

@@ -67,8 +67,10 @@ struct TileBins {
 
 // margin: how far (pixels) outside a tile its samples and their prefilter reach.
 // With every_tile, a draw gets an entry in every tile its bounds reach (no culling of
-// tiles it cannot cover): the brute-force check of the tiles uses that.
-TileBins bin_draws(const PreparedScene& scene, int width, int height, double margin, bool every_tile = false);
+// tiles it cannot cover): the brute-force check of the tiles uses that. threads: how
+// many threads bin the draws (0: all cores); the bins do not depend on it.
+TileBins bin_draws(const PreparedScene& scene, int width, int height, double margin, bool every_tile = false,
+                   int threads = 1);
 
 // Winding number of a fill draw at p in the tile, from its entry (see above).
 VF_HD int tile_winding(const SceneView& sc, const TileView& bins, const TileEntry& e, const Box& region, Vec2 p) {
