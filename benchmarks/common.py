@@ -84,6 +84,9 @@ def parse_sets(items) -> dict:
         d = out
         for p in path:
             d = d.setdefault(p, {})
+        if value in ("true", "false"):
+            d[last] = value == "true"
+            continue
         try:
             d[last] = int(value)
         except ValueError:

@@ -9,7 +9,8 @@ PSNR of the trace rendered by vecfit (MC 2x2, box filter, over white) against th
 per budget. --overlap-check also traces at the default budget with shapes not reaching
 under their neighbours (overlap 0), which shows the seams that overlap closes. --refine B
 runs the whole `vecfit trace` job (trace, then refine with the defaults) at budget B and
-scores the written SVG as resvg renders it, next to vecfit's own figures, with wall times.
+scores the written SVG as resvg renders it, next to vecfit's own figures, with wall times,
+and where each run's iterations spend their time at its start and its end.
 """
 from __future__ import annotations
 
@@ -126,11 +127,15 @@ def refine_table(budgets, images, iterations, threads, sets=()):
     from vecfit.jobs.fit import Outputs
     from vecfit.jobs.trace import run as trace
     from common import parse_sets, resvg_rgb  # (benchmarks/ is on sys.path: the script's own folder)
+    from refine import print_breakdown
+
+    from vecfit.renderer.stopwatch import Stopwatch
 
     print("| image | budget | paths | PSNR trace | PSNR refined (vecfit) | PSNR refined (resvg) "
           "| trace s | refine s | s/iter | total s |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     means = {b: [] for b in budgets}
+    breakdowns = []
     with tempfile.TemporaryDirectory() as tmp:
         for name in images:
             image = load(name)
@@ -144,7 +149,9 @@ def refine_table(budgets, images, iterations, threads, sets=()):
                     overrides["optimize"]["iterations"] = iterations
                 config = resolve("trace", overrides=overrides)
                 out = Outputs.beside(target, Path(tmp) / f"{name}_{b}.svg")
-                rep = trace(target, config, out)
+                with Stopwatch() as watch:
+                    rep = trace(target, config, out)
+                breakdowns.append((f"{name} at {b} paths", watch.laps, rep.get("coarse_iterations", 0)))
                 bg = parse_background(rep["background"])
                 theirs = resvg_rgb(out.svg, image.shape[1], bg)
                 resvg_psnr = compare(theirs, image[..., :3].astype(np.float64))["psnr"]
@@ -156,6 +163,8 @@ def refine_table(budgets, images, iterations, threads, sets=()):
                       f"| {rep['seconds']['total']:.1f} |", flush=True)
     for b in budgets:
         print(f"mean PSNR (resvg) at {b} paths: {np.mean(means[b]):.2f} dB")
+    for label, laps, coarse in breakdowns:
+        print_breakdown(label, laps, coarse)
 
 
 if __name__ == "__main__":

@@ -28,6 +28,7 @@ from vecfit.renderer.stopwatch import lap, phase
 
 from . import losses
 from .adam import Adam
+from .outline import OutlineCost
 from .rates import parameter_kinds
 
 # The coarse level must leave each shape some pixels (8 x 8 on average), or its small shapes
@@ -64,6 +65,7 @@ class Settings:
     lr_warmup: int = 20
     fixed_alpha: bool = False
     coarse: float = 0.6  # fraction of the iterations run at half the size (coarse to fine)
+    outline: float = 0.0  # weight of the cost on outlines growing (outline.py), per px of growth per px
     lr: dict = field(default_factory=_default_rates)
 
     @classmethod
@@ -90,6 +92,8 @@ class Settings:
             raise VecfitError("lr_warmup must be 0 or more")
         if not 0 <= self.coarse < 1:  # the last iterations must be at full size
             raise VecfitError(f"coarse must be at least 0 and below 1, not {self.coarse}")
+        if not (math.isfinite(self.outline) and self.outline >= 0):
+            raise VecfitError(f"outline must be a number >= 0, not {self.outline}")
         devices.resolve(self.device)
         for kind, value in self.lr.items():
             if kind not in PARAMETER_KINDS:
@@ -228,6 +232,11 @@ def optimize(scene: Scene, target: Target, settings: Settings,
     interrupted = False
     start = time.perf_counter()
 
+    points = next((i for i, k in enumerate(kinds) if k.name == "points"), None)
+    outline = None
+    if settings.outline > 0 and points is not None:
+        outline = OutlineCost(scene, kinds[points], width, height, settings.outline) or None
+
     frame = {}
     packs: dict = {}  # (width, height) -> PersistentPack, or None where it does not apply
     leaves: list = []  # this iteration's kinds' flat tensors as autograd leaves
@@ -235,30 +244,33 @@ def optimize(scene: Scene, target: Target, settings: Settings,
     def level(iteration: int) -> tuple[Target, torch.Tensor]:
         return levels[iteration >= fine_from]
 
-    def packed(w: int, h: int, grad: bool):
+    def packed(w: int, h: int):
         if not PERSISTENT_PACK:
             return None
         pack = packs.get((w, h), False)
         if pack is False or (pack is not None and not pack.still_valid([k.flat for k in kinds])):
             with phase("pack"):
                 pack = packs[(w, h)] = PersistentPack.build(scene, w, h, kinds)
-        if pack is None:
-            return None
-        leaves[:] = [k.flat.detach().requires_grad_(grad) for k in kinds]
-        return pack.arrays(leaves)
+        return pack.arrays(leaves) if pack is not None else None
 
     def evaluate(iteration: int, grad: bool):
         at, goal = level(iteration)
         h, w = at.image.shape[:2]
+        leaves[:] = [k.flat.detach().requires_grad_(grad) for k in kinds]
         with torch.set_grad_enabled(grad):
             image = render(scene, w, h, samples=settings.samples, mode=settings.mode,
                            seed=settings.seed + iteration, background=target.background,
                            threads=settings.threads, boundary_samples=settings.boundary_samples,
                            interior_samples=settings.interior_samples, device=device,
-                           packed=packed(w, h, grad))
+                           packed=packed(w, h))
             frame["image"] = image.detach()
             loss = at.loss(loss_fn, settings.loss, at.compared(image), goal)
             return loss if penalty is None else loss + penalty()
+
+    def regularised(loss: torch.Tensor) -> torch.Tensor:
+        """What the step minimises: the loss and the outline cost (the loss curve and the
+        best-so-far follow the loss alone: the best image)."""
+        return loss + outline(leaves[points]) if outline is not None else loss
 
     where = {}
     for i, k in enumerate(kinds):
@@ -299,10 +311,10 @@ def optimize(scene: Scene, target: Target, settings: Settings,
                             b.copy_(k.flat)
                     if loss.requires_grad:
                         with phase("backward"):
-                            loss.backward()
+                            regularised(loss).backward()
                     # else nothing drawn depends on the parameters any more (e.g. every shape
                     # shrank to nothing): zero gradients, Adam's momentum still moves them
-                    grads = [k.gradient(leaves[i] if leaves else None) for i, k in enumerate(kinds)]
+                    grads = [k.gradient(leaf) for k, leaf in zip(kinds, leaves)]
                     if not all(torch.isfinite(g).all() for g in grads):
                         grads = None
                 for k in kinds:
