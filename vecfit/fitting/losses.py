@@ -10,7 +10,7 @@ LOSSES = ("l2", "l1", "ssim", "pyramid")
 
 
 def l2(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
-    return torch.mean((a - b) ** 2)
+    return F.mse_loss(a, b)  # (one fused pass each way, where (a - b) ** 2 and its mean took four)
 
 
 def l1(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
