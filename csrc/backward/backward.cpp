@@ -129,8 +129,8 @@ std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_, int wi
     };
     // Runs of draws on the threads, joined in draw order: the serial list exactly.
     const int n_draws = (int)sc_.draws.size();
-    if (threads <= 0) threads = ThreadPool::hardware_threads();
-    const std::vector<int> bounds = draw_runs(sc_.draws.data(), n_draws, std::min(threads, std::max(1, n_draws)));
+    threads = draw_threads(threads, n_draws);
+    const std::vector<int> bounds = draw_runs(sc_.draws.data(), n_draws, threads);
     const int n_runs = (int)bounds.size() - 1;
     std::vector<std::vector<Piece>> runs(n_runs);
     ThreadPool::instance().parallel_for(n_runs, threads, [&](int r, int) {

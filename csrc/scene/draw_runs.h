@@ -7,9 +7,17 @@
 #include <algorithm>
 #include <vector>
 
+#include "common/thread_pool.h"
 #include "scene/scene.h"
 
 namespace vf {
+
+// The threads to share n_draws out to: `threads` (0: all cores), at least 1, at most one
+// per draw.
+inline int draw_threads(int threads, int n_draws) {
+    if (threads <= 0) threads = ThreadPool::hardware_threads();
+    return std::max(1, std::min(threads, n_draws));
+}
 
 // Bounds of the runs (draws [b[r], b[r + 1]) form run r) for `threads` threads: one run
 // for one thread.

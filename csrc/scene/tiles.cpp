@@ -198,8 +198,7 @@ TileBins bin_draws(const PreparedScene& sc, int width, int height, double margin
     TileRange all{0, 0, bins.nx - 1, bins.ny - 1};
     // Draws are binned independently, in runs shared out between threads (see draw_runs).
     const int n_draws = (int)sc.draws.size();
-    if (threads <= 0) threads = ThreadPool::hardware_threads();
-    threads = std::max(1, std::min(threads, n_draws));
+    threads = draw_threads(threads, n_draws);
     const std::vector<int> bounds = draw_runs(sc.draws.data(), n_draws, threads);
     const int n_runs = (int)bounds.size() - 1;
     std::vector<DrawRun> runs(n_runs);

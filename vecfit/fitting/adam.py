@@ -17,9 +17,11 @@ class ParameterKind:
         self.flat = torch.cat([t.detach().reshape(-1).float() for t in tensors]).contiguous()
         self.scale = torch.cat([torch.full((t.numel(),), s, dtype=torch.float32)
                                 for t, s in zip(tensors, scales)])
+        self.offsets: dict[int, int] = {}  # id(tensor) -> its first element in flat
         offset = 0
         for t in tensors:
             n = t.numel()
+            self.offsets[id(t)] = offset
             t.data = self.flat[offset:offset + n].view(t.shape)  # alias: steps update the Scene
             t.requires_grad_(True)
             t.grad = None

@@ -283,12 +283,7 @@ def optimize(scene: Scene, target: Target, settings: Settings,
         best-so-far follow the loss alone: the best image)."""
         return loss + outline(leaves[points]) if outline is not None else loss
 
-    where = {}
-    for i, k in enumerate(kinds):
-        offset = 0
-        for t in k.tensors:
-            where[id(t)] = (i, offset, t.numel())
-            offset += t.numel()
+    where = {id(t): (i, k.offsets[id(t)], t.numel()) for i, k in enumerate(kinds) for t in k.tensors}
 
     def reset(tensor: torch.Tensor) -> None:
         packs.clear()  # a hook changed the Scene: whatever it changed, pack it anew

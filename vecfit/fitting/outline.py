@@ -31,10 +31,7 @@ from .rates import shape_pixel_scales
 class OutlineCost:
     def __init__(self, scene: Scene, points_kind, width: int, height: int, weight: float):
         self.weight = weight / (width * height)
-        at, offset = {}, 0  # id(tensor) -> its first point in the kind's flat tensor
-        for t in points_kind.tensors:
-            at[id(t)] = offset // 2
-            offset += t.numel()
+        at = {i: o // 2 for i, o in points_kind.offsets.items()}  # id(tensor) -> its first point
         scales = shape_pixel_scales(scene, width, height)
         edge_a, edge_b, edge_scale, edge_segment = [], [], [], []
         segments = 0

@@ -58,9 +58,6 @@ class Provenance:
         self.presence: list[tuple] = []    # (tensor, draws present, reduce): see present_if_positive
         self.differences: list[tuple] = []  # (a, i, b, j, present): a draw exists while a[i] > b[j]
 
-    def __bool__(self) -> bool:
-        return True
-
     def copy(self, array: str, first: int, tensor: torch.Tensor) -> None:
         n = tensor.numel()
         self.routes.append(_Route(array, first + np.arange(n), tensor, np.arange(n), np.ones(n)))
@@ -147,24 +144,24 @@ class PersistentPack:
         self._destination = destination
         self._source = source
         self._coefficient = coefficient
-        self._conditions = conditions  # (x indices, group starts, expected, every) per reduce kind
+        self._conditions = conditions  # (kind, a, b, expected): see _conditions
 
     @classmethod
     def build(cls, scene: Scene, width: int, height: int, kinds) -> "PersistentPack | None":
         if any(k.name in NON_AFFINE_KINDS for k in kinds):
             return None
         trace = Provenance()
-        with torch.no_grad():
+        with torch.enable_grad():  # (the graph serves the check in _agrees)
             arrays = Packer(scene, width, height, trace=trace).pack().arrays()
         at: dict[int, int] = {}  # id(tensor) -> its first element in x (the kinds side by side)
         offset = 0
         for k in kinds:
-            for t in k.tensors:
-                at[id(t)] = offset
-                offset += t.numel()
+            at.update((i, offset + o) for i, o in k.offsets.items())
+            offset += k.flat.numel()
         if any(i in at for i in trace.nonlinear):
             return None
-        floats = [arrays[name].to(torch.float32) for name in FLOAT_INPUTS]
+        packed = [arrays[name].to(torch.float32) for name in FLOAT_INPUTS]
+        floats = [f.detach() for f in packed]
         starts = np.concatenate([[0], np.cumsum([f.numel() for f in floats])])
         first_of = dict(zip(FLOAT_INPUTS, starts[:-1]))
         base = torch.cat([f.reshape(-1) for f in floats]) if floats else torch.zeros(0)
@@ -189,7 +186,7 @@ class PersistentPack:
                    base, as_index(dst), as_index(src),
                    torch.from_numpy(np.concatenate(coef)).float() if coef else torch.zeros(0),
                    _conditions(trace.presence, trace.differences, at))
-        return pack if pack._agrees(scene, width, height, kinds, floats) else None
+        return pack if pack._agrees(kinds, packed) else None
 
     def arrays(self, leaves: list[torch.Tensor]) -> tuple[dict, list[torch.Tensor]]:
         """(integer tables, float arrays in FLOAT_INPUTS order), differentiable w.r.t. leaves."""
@@ -218,23 +215,23 @@ class PersistentPack:
                 return False
         return True
 
-    def _agrees(self, scene, width, height, kinds, floats) -> bool:
-        """Once per build: the same floats as the Packer's, and the same gradients of the
-        kinds' values for a random adjoint of the floats (a missed or wrong route shows)."""
+    def _agrees(self, kinds, packed: list[torch.Tensor]) -> bool:
+        """Once per build: the same floats as the Packer's (``packed``, with its autograd
+        graph to the Scene's tensors), and the same gradients of the kinds' values for a
+        random adjoint of the floats (a missed or wrong route shows)."""
         leaves = [k.flat.detach().clone().requires_grad_() for k in kinds]
         _, mine = self.arrays(leaves)
-        for a, b in zip(mine, floats):
-            if not torch.allclose(a.detach(), b, rtol=1e-5, atol=1e-5):
+        for a, b in zip(mine, packed):
+            if not torch.allclose(a.detach(), b.detach(), rtol=1e-5, atol=1e-5):
                 return False
         generator = torch.Generator().manual_seed(0)
-        adjoints = [torch.randn(f.shape, generator=generator) for f in floats]
+        adjoints = [torch.randn(f.shape, generator=generator) for f in packed]
         fast = torch.autograd.grad(sum((a * g).sum() for a, g in zip(mine, adjoints)), leaves, allow_unused=True)
-        tensors = [t for k in kinds for t in k.tensors]
-        with torch.enable_grad():
-            packed = Packer(scene, width, height).pack().arrays()
-            total = sum((packed[name].float() * g).sum() for name, g in zip(FLOAT_INPUTS, adjoints))
-            used = [t for t in tensors if t.requires_grad]
-            slow = dict(zip(map(id, used), torch.autograd.grad(total, used, allow_unused=True))) if used else {}
+        used = [t for k in kinds for t in k.tensors if t.requires_grad]
+        slow = {}
+        if used and any(f.requires_grad for f in packed):
+            total = sum((f * g).sum() for f, g in zip(packed, adjoints) if f.requires_grad)
+            slow = dict(zip(map(id, used), torch.autograd.grad(total, used, allow_unused=True)))
         for k, f in zip(kinds, fast):
             reference = torch.cat([(slow.get(id(t)) if slow.get(id(t)) is not None else torch.zeros_like(t))
                                    .reshape(-1) for t in k.tensors])

@@ -92,10 +92,15 @@ def packed_for_core(scene: Scene, width: int, height: int) -> tuple[dict, list]:
     with phase("pack"):
         arrays = pack_scene(scene, width, height).arrays()
     floats = [arrays[name].to(torch.float32) for name in FLOAT_INPUTS]
+    check_finite(floats)
+    return {k: v for k, v in arrays.items() if k not in FLOAT_INPUTS}, floats
+
+
+def check_finite(floats) -> None:
+    """NonFiniteScene unless every float array (FLOAT_INPUTS order) is finite."""
     for name, value in zip(FLOAT_INPUTS, floats):
         if not torch.isfinite(value.detach()).all():
             raise NonFiniteScene(f"the scene has non-finite values ({name})")
-    return {k: v for k, v in arrays.items() if k not in FLOAT_INPUTS}, floats
 
 
 class _Render(torch.autograd.Function):
@@ -167,8 +172,7 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
         structure, floats = packed_for_core(scene, width, height)
     else:
         structure, floats = packed
-        if not all(torch.isfinite(f.detach()).all() for f in floats):
-            raise NonFiniteScene("the scene has non-finite values")
+        check_finite(floats)
     settings = dict(width=width, height=height, samples=int(samples), mode=mode, filter=filter,
                     filter_radius=float(filter_radius), seed=int(seed), threads=int(threads or 0),
                     background=background, device=devices.resolve(device))
