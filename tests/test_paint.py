@@ -13,7 +13,7 @@ import vecfit
 from helpers import photo_png, quiet_load, run
 from vecfit.fitting.metrics import compare
 from vecfit.fitting.loop import Step, Target
-from vecfit.initial.strokes import PaintSettings, Reseeder, initial_svg
+from vecfit.initial.strokes import PaintSettings, Reseeder, initial_document
 from vecfit.renderer.scene import Path as PathGeometry, Scene, Shape, Solid
 
 
@@ -65,9 +65,9 @@ def test_paint_shapes_and_resvg_agrees(astronaut, tmp_path):
 
 def test_initial_svg_is_random_but_reproducible():
     target = np.ones((40, 60, 4), np.float32)
-    a = initial_svg(target, PaintSettings(paths=10, seed=1))
-    assert a == initial_svg(target, PaintSettings(paths=10, seed=1))
-    assert a != initial_svg(target, PaintSettings(paths=10, seed=2))
+    a = initial_document(target, PaintSettings(paths=10, seed=1)).text()
+    assert a == initial_document(target, PaintSettings(paths=10, seed=1)).text()
+    assert a != initial_document(target, PaintSettings(paths=10, seed=2)).text()
     assert a.count("<path") == 10 and 'viewBox="0 0 60 40"' in a
 
 

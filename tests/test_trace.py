@@ -223,7 +223,7 @@ def test_result_counts_match_the_svg():
     assert result.segments == result.svg.count("C") + 4 * result.svg.count("<rect")
     assert result.colors == len(set(re.findall(r'fill="(#[0-9a-f]{6})"', result.svg)))
     assert result.seconds > 0
-    assert re.match(r'<svg xmlns="http://www.w3.org/2000/svg" width="96" height="80" '
+    assert re.search(r'<svg xmlns="http://www.w3.org/2000/svg" width="96" height="80" '
                     r'viewBox="0 0 96 80">', result.svg)
     # compact numbers: at most two decimals
     assert not re.search(r"\d\.\d{3}", result.svg)
@@ -244,7 +244,7 @@ def test_rgb_input_and_single_colour():
 
 def test_fully_transparent_image_gives_an_empty_svg():
     result = trace_image(np.zeros((8, 8, 4), np.float32))
-    assert result.paths == 0 and count_shapes(result.svg) == 0 and result.svg.startswith("<svg")
+    assert result.paths == 0 and count_shapes(result.svg) == 0 and re.search(r"^<svg\b", result.svg, re.M)
 
 
 @pytest.mark.parametrize("image", [

@@ -21,6 +21,8 @@ import torch
 
 from vecfit.errors import VecfitError
 from vecfit.renderer.scene import Path as PathGeometry
+from vecfit.svg.document import SvgDocument
+from vecfit.svg.pathdata import format_path_data
 
 PRIMITIVE_KINDS = ("strokes", "shapes")
 
@@ -77,37 +79,39 @@ def _shape_points(rng, center, segments, spread) -> np.ndarray:
 
 
 def _path_data(points: np.ndarray, closed: bool) -> str:
-    f = lambda v: f"{v:.2f}"  # noqa: E731
-    parts = [f"M {f(points[0, 0])} {f(points[0, 1])}"]
-    body = np.vstack([points[1:], points[:1]]) if closed else points[1:]
-    for i in range(0, len(body), 3):
-        c = body[i:i + 3]
-        parts.append("C " + " ".join(f"{f(x)} {f(y)}" for x, y in c))
-    return " ".join(parts) + (" Z" if closed else "")
+    """Cubics through ``points`` (3 per segment after the start); closed: the last cubic
+    returns to the start, then Z (a closing line of zero length, as the reader makes)."""
+    cubics = (len(points) if closed else len(points) - 1) // 3
+    if closed:
+        points = np.vstack([points, points[:1]])
+        spans, degrees = [(0, cubics + 1, True)], [3] * cubics + [1]
+    else:
+        spans, degrees = [(0, cubics, False)], [3] * cubics
+    return format_path_data(points, degrees, spans, decimals=2)
 
 
-def initial_svg(target: np.ndarray, settings: PaintSettings) -> str:
+def initial_document(target: np.ndarray, settings: PaintSettings) -> SvgDocument:
     """Random primitives over the canvas of ``target`` ([H, W, 4]); colours are random,
     as in the paper (the optimisation finds the right ones)."""
     settings.check()
     h, w = target.shape[:2]
     rng = np.random.default_rng(settings.seed)
     spread = settings.radius * max(w, h)
-    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}">']
+    document = SvgDocument.new(w, h)
     for i in range(settings.paths):
         center = rng.uniform([0, 0], [w, h])
         rgb, alpha = rng.uniform(0, 1, 3), rng.uniform(0.3, 1.0)
         if settings.kind == "strokes":
             pts = _stroke_points(rng, center, int(rng.integers(1, settings.stroke_segments + 1)), spread)
             width = rng.uniform(settings.min_width, settings.max_width)
-            out.append(f'<path id="s{i}" d="{_path_data(pts, False)}" fill="none" stroke="{_color(rgb, alpha)}" '
-                       f'stroke-width="{width:.2f}" stroke-linecap="round" stroke-linejoin="round"/>')
+            document.add("path", {"id": f"s{i}", "d": _path_data(pts, False), "fill": "none",
+                                  "stroke": _color(rgb, alpha), "stroke-width": f"{width:.2f}",
+                                  "stroke-linecap": "round", "stroke-linejoin": "round"})
         else:
             segs = int(rng.integers(settings.shape_segments_min, settings.shape_segments_max + 1))
             pts = _shape_points(rng, center, segs, spread)
-            out.append(f'<path id="s{i}" d="{_path_data(pts, True)}" fill="{_color(rgb, alpha)}"/>')
-    out.append("</svg>")
-    return "\n".join(out) + "\n"
+            document.add("path", {"id": f"s{i}", "d": _path_data(pts, True), "fill": _color(rgb, alpha)})
+    return document
 
 
 # --------------------------------------------------------------------- re-seeding

@@ -93,7 +93,7 @@ def run(edited_path, svg_path, config: dict, outputs: Outputs, progress=None, ma
     outputs.check_against(edited_path, svg_path, mask)
     outputs.report.unlink(missing_ok=True)  # a report marks a finished run
     target = load_target(edited_path)
-    scene = load_scene_to_fit(svg_path)
+    scene, document = load_scene_to_fit(svg_path)
     fit_canvas(scene, target, svg_path, edited_path)
     edit = settings_of(EditSettings, config["edit"])
     edit.check()
@@ -148,7 +148,7 @@ def run(edited_path, svg_path, config: dict, outputs: Outputs, progress=None, ma
 
     # The SVG keeps its elements: no background rect is added (an uncovered canvas stays
     # transparent, which over the background looks as optimised).
-    write_svg(scene, svg_path, outputs.svg)
+    write_svg(scene, document, outputs.svg)
     save_panels(outputs.comparison, panels_image(
         [original_rgb, target_rgb, final_rgb, error_map(final_rgb, target_rgb)]))
     seconds = time.perf_counter() - started

@@ -3,9 +3,7 @@ SVG, report and comparison picture written next to each other. `vecfit refine` s
 from the user's SVG, `vecfit trace` and `vecfit paint` from SVGs of their own making."""
 from __future__ import annotations
 
-import contextlib
 import math
-import tempfile
 import time
 import warnings
 from dataclasses import dataclass
@@ -25,7 +23,8 @@ from vecfit.renderer import device as devices
 from vecfit.renderer.raster import render
 from vecfit.renderer.scene import Scene
 from vecfit.svg.numbers import hex_color
-from vecfit.svg.read import load_svg
+from vecfit.svg.document import SvgDocument
+from vecfit.svg.read import read_svg, scene_of
 from vecfit.svg.write import write_svg
 
 OPAQUE = 0.999  # a target whose every alpha is at least this is treated as opaque
@@ -96,15 +95,16 @@ def background_for(image: np.ndarray, setting: str) -> tuple | None:
     return fitting_background(setting)
 
 
-def load_scene_to_fit(svg_path) -> Scene:
-    """The user's SVG as a Scene (its warnings shown every time), refused when it has no
-    shapes: what refine, edit and retarget start from."""
+def load_scene_to_fit(svg_path) -> tuple[Scene, SvgDocument]:
+    """The user's SVG as a Scene (its warnings shown every time) and its document (to write
+    the result into), refused when it has no shapes: what refine, edit and retarget start
+    from."""
     with warnings.catch_warnings():
         warnings.simplefilter("always")
-        scene = load_svg(svg_path)
+        scene, document = read_svg(svg_path)
     if not scene.shapes:
         raise VecfitError(f"{svg_path}: the SVG has no shapes to optimise")
-    return scene
+    return scene, document
 
 
 def check_sizes(scene: Scene, target: np.ndarray, svg_path, target_path) -> None:
@@ -117,18 +117,12 @@ def check_sizes(scene: Scene, target: np.ndarray, svg_path, target_path) -> None
                           f"{w}x{h}: their aspect ratios differ")
 
 
-@contextlib.contextmanager
-def generated_source(svg_text: str, name: str):
-    """A generated SVG (a trace, random strokes) as a temporary file and its Scene, for
-    fit (which writes its result into the source's structure, so the file must exist
-    while it runs). Yields (scene, path)."""
-    with tempfile.TemporaryDirectory(prefix="vecfit-") as tmp:
-        source = Path(tmp) / name
-        source.write_text(svg_text, encoding="utf-8")
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            scene = load_svg(source)
-        yield scene, source
+def generated_scene(document: SvgDocument) -> Scene:
+    """The Scene of an SVG that vecfit made (a trace, random strokes): nothing in it
+    deserves a warning."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return scene_of(document)
 
 
 # --------------------------------------------------------------------------- run
@@ -140,9 +134,9 @@ def _render_full(scene, w, h, config) -> torch.Tensor:
                       threads=config["threads"], device=config["device"])
 
 
-def fit_and_write(scene: Scene, source_svg, target: np.ndarray, config: dict, outputs: Outputs,
+def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, config: dict, outputs: Outputs,
                   progress=None, inputs: dict | None = None, hooks=(), keep_alpha=()) -> dict:
-    """Optimise ``scene`` (read from ``source_svg``) against ``target`` with the
+    """Optimise ``scene`` (read from ``document``) against ``target`` with the
     ``[optimize]`` settings of ``config``; writes the SVG, the comparison picture and the
     report (last, so a report means a finished run). Returns the report. ``inputs`` are
     extra report entries (a callable value is called when the report is made); ``hooks``
@@ -179,7 +173,7 @@ def fit_and_write(scene: Scene, source_svg, target: np.ndarray, config: dict, ou
     # uncovered, the background is written in as a first rect.
     covered = float(final_image[..., 3].min()) >= OPAQUE
     svg_background = background if background is not None and not covered else None
-    write_svg(scene, source_svg, outputs.svg, background=svg_background)
+    write_svg(scene, document, outputs.svg, background=svg_background)
     save_comparison(outputs.comparison, target_rgb, initial_rgb, final_rgb)
     seconds = time.perf_counter() - started
     report = {

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from vecfit.initial.strokes import PaintSettings, Reseeder, initial_svg
+from vecfit.initial.strokes import PaintSettings, Reseeder, initial_document
 from vecfit.io.frames import FrameSaver
 
 from .config import settings_of
-from .fit import Outputs, fit_and_write, generated_source, load_target
+from .fit import Outputs, fit_and_write, generated_scene, load_target
 
 
 def run(target_path, config: dict, outputs: Outputs, progress=None, frames=None) -> dict:
@@ -23,17 +23,18 @@ def run(target_path, config: dict, outputs: Outputs, progress=None, frames=None)
     if frames is not None:
         saver = FrameSaver(frames, settings.frames_every)
         hooks.append(saver)
-    with generated_source(initial_svg(target, settings), target_path.stem + ".paint.svg") as (scene, source):
+    document = initial_document(target, settings)
+    scene = generated_scene(document)
 
-        def frames_entry():  # called when the report is made, after the last frame
-            if saver is None:
-                return None
-            gif = saver.finish()
-            return {"folder": str(frames), "count": len(saver.files), "gif": str(gif) if gif else None}
+    def frames_entry():  # called when the report is made, after the last frame
+        if saver is None:
+            return None
+        gif = saver.finish()
+        return {"folder": str(frames), "count": len(saver.files), "gif": str(gif) if gif else None}
 
-        return fit_and_write(scene, source, target, config, outputs, progress, hooks=hooks,
-                   inputs={"command": "paint", "target": str(target_path),
-                           "paint": lambda: {"kind": settings.kind, "paths": settings.paths,
-                                             "reseeded": reseeder.reseeded,
-                                             "reseed_history": reseeder.history},
-                           "frames": frames_entry})
+    return fit_and_write(scene, document, target, config, outputs, progress, hooks=hooks,
+                         inputs={"command": "paint", "target": str(target_path),
+                                 "paint": lambda: {"kind": settings.kind, "paths": settings.paths,
+                                                   "reseeded": reseeder.reseeded,
+                                                   "reseed_history": reseeder.history},
+                                 "frames": frames_entry})

@@ -12,7 +12,7 @@ def run(target_path, svg_path, config: dict, outputs: Outputs, progress=None) ->
     target_path, svg_path = Path(target_path), Path(svg_path)
     outputs.check_against(target_path, svg_path)
     target = load_target(target_path)
-    scene = load_scene_to_fit(svg_path)
+    scene, document = load_scene_to_fit(svg_path)
     check_sizes(scene, target, svg_path, target_path)
-    return fit_and_write(scene, svg_path, target, config, outputs, progress,
+    return fit_and_write(scene, document, target, config, outputs, progress,
                inputs={"command": "refine", "target": str(target_path), "init": str(svg_path)})

@@ -69,7 +69,7 @@ def run(svg_path, config: dict, outputs: Outputs, progress=None, width=None, hei
     height = height if height is not None else (str(retarget.height).strip() or None)
     if width is None and height is None:
         raise VecfitError("no new size: give --width (or --height), or retarget.width in the config")
-    scene = load_scene_to_fit(svg_path)
+    scene, document = load_scene_to_fit(svg_path)
     w0, h0 = scene.width, scene.height
     if not (w0 > 0 and h0 > 0):
         raise VecfitError(f"{svg_path}: the SVG has no size")
@@ -152,7 +152,7 @@ def run(svg_path, config: dict, outputs: Outputs, progress=None, width=None, hei
     fit = compare(final_rgb, goal_rgb)
     if not all(math.isfinite(fit[k]) or (k == "psnr" and fit["mse"] == 0) for k in fit):
         raise VecfitError(f"the retargeted image has non-finite values ({fit}); nothing written")
-    write_svg(scene, svg_path, outputs.svg, canvas=(out_w, out_h))
+    write_svg(scene, document, outputs.svg, canvas=(out_w, out_h))
     original_rgb = to_rgb(original, background)
     scaled_rgb = cv2.resize(original_rgb.astype(np.float32), (cur_w, cur_h), interpolation=cv2.INTER_AREA)
     save_panels(outputs.comparison, side_by_side([original_rgb, scaled_rgb, final_rgb]))

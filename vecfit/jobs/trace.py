@@ -9,7 +9,7 @@ from vecfit.initial.trace import TraceSettings, trace_image
 from vecfit.renderer.scene import Rect, Solid
 
 from .config import settings_of
-from .fit import Outputs, fit_and_write, generated_source, load_target
+from .fit import Outputs, fit_and_write, generated_scene, load_target
 
 
 def run(target_path, config: dict, outputs: Outputs, progress=None, refine: bool = True,
@@ -28,15 +28,15 @@ def run(target_path, config: dict, outputs: Outputs, progress=None, refine: bool
                f"in {traced.seconds:.1f} s")
     if not refine:
         config = {**config, "optimize": {**config["optimize"], "iterations": 0}}
-    with generated_source(traced.svg, target_path.stem + ".trace.svg") as (scene, source):
-        if not scene.shapes:
-            raise VecfitError(f"{target_path}: nothing to trace (the image is fully transparent)")
-        # The tracer's backdrop (an opaque rect past the canvas's edges) stays opaque, so
-        # the canvas stays covered; the regions above may turn translucent (blending
-        # neighbours is worth ~2 dB on photos).
-        backdrop = [s.fill.color for s in scene.shapes[:1]
-                    if isinstance(s.geometry, Rect) and isinstance(s.fill, Solid)]
-        return fit_and_write(scene, source, target, config, outputs, progress, keep_alpha=backdrop,
-                   inputs={"command": "trace", "target": str(target_path),
-                           "trace": {"paths": traced.paths, "segments": traced.segments,
-                                     "colors": traced.colors, "seconds": traced.seconds}})
+    scene = generated_scene(traced.document)
+    if not scene.shapes:
+        raise VecfitError(f"{target_path}: nothing to trace (the image is fully transparent)")
+    # The tracer's backdrop (an opaque rect past the canvas's edges) stays opaque, so the
+    # canvas stays covered; the regions above may turn translucent (blending neighbours is
+    # worth ~2 dB on photos).
+    backdrop = [s.fill.color for s in scene.shapes[:1]
+                if isinstance(s.geometry, Rect) and isinstance(s.fill, Solid)]
+    return fit_and_write(scene, traced.document, target, config, outputs, progress, keep_alpha=backdrop,
+                         inputs={"command": "trace", "target": str(target_path),
+                                 "trace": {"paths": traced.paths, "segments": traced.segments,
+                                           "colors": traced.colors, "seconds": traced.seconds}})

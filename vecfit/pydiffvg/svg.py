@@ -24,6 +24,7 @@ from vecfit.io.images import atomic_write_text
 from vecfit.renderer import scene as vs
 from vecfit.renderer.geometry import local_bbox, rect_path
 from vecfit.svg.numbers import finite, fmt
+from vecfit.svg.pathdata import format_path_data
 from vecfit.svg.read import load_svg
 
 from .shapes import Circle, Ellipse, LinearGradient, Path, Polygon, RadialGradient, Rect, ShapeGroup
@@ -161,8 +162,11 @@ def svg_to_scene(filename):
 
 # ------------------------------------------------------------------------------ writing
 
+DECIMALS = 6
+
+
 def _num(v) -> str:
-    return fmt(v, 6)
+    return fmt(v, DECIMALS)
 
 
 def _color(c, use_gamma: bool) -> tuple[str, float]:
@@ -192,20 +196,13 @@ def _path_d(shape) -> str:
     if isinstance(shape, Rect):
         (x0, y0), (x1, y1) = finite(shape.p_min), finite(shape.p_max)
         return f"M{_num(x0)} {_num(y0)} H{_num(x1)} V{_num(y1)} H{_num(x0)} Z"
-    if isinstance(shape, Polygon):
-        pts = finite(shape.points)
-        d = "M" + " L".join(f"{_num(x)} {_num(y)}" for x, y in pts)
-        return d + (" Z" if shape.is_closed else "")
     pts = finite(shape.points)
-    ncp = [int(k) for k in np.asarray(finite(shape.num_control_points))]
-    out, k = [f"M{_num(pts[0, 0])} {_num(pts[0, 1])}"], 1
-    for i, c in enumerate(ncp):
-        seg = [pts[(k + j) % len(pts)] for j in range(c + 1)]
-        k += c + 1
-        out.append("LQC"[c] + " ".join(f"{_num(x)} {_num(y)}" for x, y in seg))
-    if shape.is_closed:
-        out.append("Z")
-    return " ".join(out)
+    closed = bool(shape.is_closed)
+    if isinstance(shape, Polygon):
+        degrees = [1] * (len(pts) if closed else len(pts) - 1)
+    else:  # diffvg's closed path: its last segment ends at the first point, as a Scene's
+        degrees = [int(k) + 1 for k in np.asarray(finite(shape.num_control_points))]
+    return format_path_data(pts, degrees, [(0, len(degrees), closed)], decimals=DECIMALS)
 
 
 def _element(shapes_in_group) -> tuple[str, dict]:

@@ -14,6 +14,7 @@ Colours are straight (not premultiplied) RGBA in [0, 1].
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any, Optional, Union
 
@@ -165,6 +166,11 @@ class Scene:
     view: torch.Tensor = field(default_factory=identity)  # root user space -> pixels
     skipped: dict[str, list[str]] = field(default_factory=dict)  # kind -> element names
 
+    def detached_copy(self) -> "Scene":
+        """A copy whose tensors are detached clones (shared tensors stay shared): the
+        Scene's values at this moment, kept apart from later changes."""
+        return _copied(self, {})
+
     def parameters(self) -> dict[str, list[torch.Tensor]]:
         """Every optimisable tensor, grouped by parameter kind."""
         kinds: dict[str, list[torch.Tensor]] = {
@@ -222,3 +228,23 @@ class Scene:
             add("opacities", group.opacity)
             add("transforms", group.transform)
         return kinds
+
+
+def _copied(value, memo: dict):
+    """``value`` with every tensor and array cloned once (by identity, through ``memo``)."""
+    if isinstance(value, torch.Tensor):
+        if id(value) not in memo:
+            memo[id(value)] = value.detach().clone()
+        return memo[id(value)]
+    if isinstance(value, np.ndarray):
+        return value.copy()
+    if isinstance(value, list):
+        return [_copied(v, memo) for v in value]
+    if isinstance(value, dict):
+        return {k: _copied(v, memo) for k, v in value.items()}
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        if id(value) not in memo:  # a paint shared by shapes stays shared
+            memo[id(value)] = dataclasses.replace(value, **{
+                f.name: _copied(getattr(value, f.name), memo) for f in dataclasses.fields(value)})
+        return memo[id(value)]
+    return value  # numbers, strings, tuples of them, None

@@ -1,4 +1,5 @@
-"""SVG path data (the ``d`` attribute) to subpaths of line, quadratic and cubic segments.
+"""SVG path data (the ``d`` attribute): read into subpaths of line, quadratic and cubic
+segments, and written from them (``format_path_data``, vecfit's one path-data writer).
 
 Written here rather than taken from svgelements because the Scene needs choices that
 svgelements does not make for us: arcs as cubics of at most 90 degrees, ``Z`` as an
@@ -13,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .numbers import fmt
 from .units import NUMBER
 
 _TOKEN = re.compile(rf"[MmZzLlHhVvCcSsQqTtAa]|{NUMBER}|[^\s,]")
@@ -275,3 +277,34 @@ def to_arrays(subpaths: list[Subpath]):
         degrees.extend(s.degrees)
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
     return pts, np.asarray(degrees, dtype=np.int64), table
+
+
+_LETTERS = {1: "L", 2: "Q", 3: "C"}
+
+
+def format_path_data(points, degrees, subpaths, decimals: int = 4, compact: bool = False) -> str:
+    """Absolute M/L/Q/C/Z path data of subpaths stored as a Scene's ``Path`` stores them:
+    ``points`` [P, 2] (finite numbers), per subpath its start, then each segment's
+    control points and end, a closed subpath's last end (its start) not stored again;
+    ``degrees`` per segment; ``subpaths`` (first segment, segment count, closed).
+
+    A closed subpath's last segment is written as ``Z`` when it is a line, else in full
+    and followed by ``Z``. Numbers have at most ``decimals`` decimals; ``compact`` leaves
+    out the spaces before command letters.
+    """
+    out, p = [], 0
+    for first, count, closed in subpaths:
+        start = p
+        out.append(f"M{fmt(points[p][0], decimals)} {fmt(points[p][1], decimals)}")
+        p += 1
+        for k in range(first, first + count):
+            d = int(degrees[k])
+            last = closed and k == first + count - 1
+            if last and d == 1:
+                break
+            ends = [points[p + j] for j in range(d - 1 if last else d)] + ([points[start]] if last else [])
+            out.append(_LETTERS[d] + " ".join(f"{fmt(x, decimals)} {fmt(y, decimals)}" for x, y in ends))
+            p += d - 1 if last else d
+        if closed:
+            out.append("Z")
+    return ("" if compact else " ").join(out)

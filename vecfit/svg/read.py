@@ -15,7 +15,6 @@ position "/i/j/k" in the document when it has no unique id.
 from __future__ import annotations
 
 import math
-from collections import Counter
 
 import numpy as np
 import torch
@@ -26,14 +25,14 @@ from vecfit.renderer.scene import Group, Scene, Shape
 
 from .brushes import BLACK, Paints, parse_opacity, parse_paint
 from .color import parse_color
-from .dom import href_id, is_svg, local_name, read_root
+from .document import SvgDocument
+from .dom import href_id, is_svg, local_name
 from .shapes import Limiter, ShapeReader
 from .skips import Skips, VecfitWarning
-from .style import Cascade, StyleSheet
 from .units import (parse_length, parse_number, parse_transform, parse_viewbox, translate,
                     view_transform)
 
-__all__ = ["load_svg", "VecfitWarning"]
+__all__ = ["load_svg", "read_svg", "scene_of", "VecfitWarning"]
 
 SHAPES = frozenset({"rect", "circle", "ellipse", "line", "polyline", "polygon", "path"})
 CONTAINERS = frozenset({"g", "a"})
@@ -63,13 +62,27 @@ def load_svg(path) -> Scene:
     out (or drawn approximately) with one VecfitWarning per kind, and listed in
     ``scene.skipped``. An SVG without drawable shapes gives an empty Scene.
     """
-    root = read_root(path)
-    reader = Reader(path, root)
+    return read_svg(path)[0]
+
+
+def read_svg(path) -> tuple[Scene, SvgDocument]:
+    """The SVG file at ``path`` as a Scene and the document it was read from (to write the
+    Scene back into with ``write_svg``); see ``load_svg``."""
+    document = SvgDocument.read(path)
+    return scene_of(document), document
+
+
+def scene_of(document: SvgDocument) -> Scene:
+    """The Scene that ``document`` draws. Records on the document what the writer needs
+    (the Scene as read, the viewport)."""
+    reader = Reader(document)
     try:
         scene = reader.read()
     except RecursionError:
-        raise SvgError(path, f"elements nested too deeply (at most {MAX_NESTING} levels)") from None
-    reader.skips.warn(path)
+        raise SvgError(document.name, f"elements nested too deeply (at most {MAX_NESTING} levels)") from None
+    reader.skips.warn(document.name)
+    document.original = scene.detached_copy()
+    document.viewport = reader.viewport
     return scene
 
 
@@ -78,60 +91,31 @@ def _name(element) -> str:
     return element.get("id") or local_name(element.tag)
 
 
-def _handles(root) -> dict[int, str]:
-    """A handle per element for ``source`` (write-back): its id when that is unique in the
-    document, else its position "/i/j/k" (indices among element children, from the root;
-    "/" is the root itself)."""
-    counts = Counter(e.get("id") for e in root.iter() if e.get("id") is not None)
-    handles, todo = {}, [(root, "")]
-    while todo:
-        element, position = todo.pop()
-        i = element.get("id")
-        handles[id(element)] = i if i is not None and counts[i] == 1 else (position or "/")
-        todo += [(child, f"{position}/{k}") for k, child in enumerate(element)]
-    return handles
-
-
 def _singular(m: np.ndarray | None) -> bool:
     return m is not None and abs(m[0, 0] * m[1, 1] - m[0, 1] * m[1, 0]) == 0
 
 
 class Reader:
-    def __init__(self, path, root):
-        self.path = path
-        self.root = root
+    def __init__(self, document: SvgDocument):
+        self.document = document
+        self.path = document.name
+        self.root = document.root
         self.skips = Skips()
-        self.ids: dict[str, object] = {}
-        self.parents: dict[int, object] = {}
+        self.ids = document.ids
         self._elements = 0  # elements walked so far, <use> instances included
         self._segments = 0
-        for n, element in enumerate(root.iter()):
-            if n >= MAX_ELEMENTS:  # entity expansion can make millions from a small file
-                self._too_many_elements()
-            i = element.get("id")
-            if i is not None:
-                self.ids.setdefault(i, element)  # the first of duplicated ids wins
-            for child in element:
-                self.parents[id(child)] = element
-        self.handles = _handles(root)
-        self.cascade = Cascade(self._style_sheet())
+        elements = sum(1 for e in self.root.iter() if isinstance(e.tag, str))
+        if elements > MAX_ELEMENTS:  # entity expansion can make millions from a small file
+            self._too_many_elements()
+        for selector in document.sheet.unsupported:
+            self.skips.add("css-selector", selector)
+        self.cascade = document.cascade
         self.width, self.height, self.view, self.viewport = self._root_size()
-        self.paints = Paints(self.ids, self._style_at, self.viewport, self.skips.add)
+        self.paints = Paints(self.ids, document.computed, self.viewport, self.skips.add)
         self.shapes: list[Shape] = []
         self.groups: list[Group] = []
-        self._styles: dict[int, dict] = {}
 
     # --------------------------------------------------------------- document
-
-    def _style_sheet(self) -> StyleSheet:
-        sheet = StyleSheet()
-        for element in self.root.iter():
-            if local_name(element.tag) == "style" and is_svg(element):
-                if (element.get("type") or "text/css").strip().lower() in ("text/css", ""):
-                    sheet.add("".join(element.itertext()))
-        for selector in sheet.unsupported:
-            self.skips.add("css-selector", selector)
-        return sheet
 
     def _root_size(self):
         """(width, height) in px, the view matrix, and the viewport size that user-space
@@ -236,7 +220,7 @@ class Reader:
         if lim.clamped:
             self.skips.add("out-of-range numbers", _name(element))
         self.groups.append(Group(transform=m, opacity=torch.tensor(float(opacity)),
-                                 parent=parent, source=self.handles[id(element)]))
+                                 parent=parent, source=self.document.handle_of(element)))
         return len(self.groups) - 1
 
     # ------------------------------------------------------------- references
@@ -287,15 +271,6 @@ class Reader:
         g = self._group(m, parse_opacity(style.get("opacity")), group, element)
         self._children(element, style, g, stack, depth)
 
-    def _style_at(self, element) -> dict:
-        """Computed properties of any element, from its ancestors (for gradient stops)."""
-        key = id(element)
-        if key not in self._styles:
-            parent = self.parents.get(key)
-            self._styles[key] = self.cascade.computed(
-                element, self._style_at(parent) if parent is not None else None)
-        return self._styles[key]
-
     # ----------------------------------------------------------------- shapes
 
     def _shape(self, tag, element, style, transform, group):
@@ -331,7 +306,7 @@ class Reader:
             fill_opacity=torch.tensor(parse_opacity(style.get("fill-opacity"))),
             stroke_opacity=torch.tensor(parse_opacity(style.get("stroke-opacity"))),
             transform=torch.eye(3) if transform is None else lim.tensor(transform),
-            group=group, source=self.handles[id(element)])
+            group=group, source=self.document.handle_of(element))
         if lim.clamped:
             self.skips.add("out-of-range numbers", name)
         self.shapes.append(shape)

@@ -1,12 +1,12 @@
-"""Scene -> SVG: write a Scene's current values back into a copy of its source SVG.
+"""Scene -> SVG: write a Scene's current values back into a copy of its SvgDocument.
 
-The source file is parsed again (comments and processing instructions kept), each
-Shape's and Group's element is found by its ``source`` handle (see ``read._handles``),
-and what the Scene models is written into that element; everything else (ids, classes,
-unknown attributes, unsupported content) stays as it was.
+Each Shape's and Group's element is found by its ``source`` handle (the document's
+handle map, the one the reader named them by), and what the Scene models is written
+into that element; everything else (ids, classes, unknown attributes, unsupported
+content, comments) stays as it was.
 
-By default only values that differ from what the source file itself gives are written,
-so an unchanged Scene reproduces the file's content (re-serialised by ElementTree);
+By default only values that differ from the Scene as it was read are written, so an
+unchanged Scene reproduces the document's content (re-serialised by ElementTree);
 ``full=True`` writes every modelled value (useful to check the writer).
 
 Style precedence: a property that the element's ``style`` attribute or a matching CSS
@@ -16,12 +16,8 @@ else as a presentation attribute.
 from __future__ import annotations
 
 import gzip
-import io
-import re
 import warnings
 import xml.etree.ElementTree as ET
-from collections import Counter
-from pathlib import Path as FsPath
 
 import numpy as np
 import torch
@@ -32,8 +28,10 @@ from vecfit.renderer.scene import (Circle, Ellipse, LinearGradient, Path, Radial
                                    Scene, Solid)
 
 from .brushes import GRADIENTS
-from .dom import local_name, read_root
+from .document import SvgDocument
+from .dom import local_name
 from .numbers import finite, fmt, hex_color, matrix
+from .pathdata import format_path_data
 from .skips import VecfitWarning
 from .style import INHERITED
 from .units import parse_length, parse_viewbox, translate
@@ -47,24 +45,8 @@ INITIAL = {"opacity": "1", "fill-opacity": "1", "stroke-opacity": "1", "stop-opa
 
 
 def path_data(path: Path) -> str:
-    """Absolute M/L/Q/C/Z path data; a closed subpath's closing line is Z."""
-    pts = finite(path.points)
-    out, p = [], 0
-    letters = {1: "L", 2: "Q", 3: "C"}
-    for first, count, closed in path.subpaths:
-        degrees = [int(d) for d in path.degrees[first:first + count]]
-        out.append(f"M{fmt(pts[p, 0])} {fmt(pts[p, 1])}")
-        p += 1
-        body = degrees[:-1] if closed and degrees else degrees
-        for d in body:
-            coords = " ".join(f"{fmt(x)} {fmt(y)}" for x, y in pts[p:p + d])
-            out.append(letters[d] + coords)
-            p += d
-        if closed and degrees:
-            if degrees[-1] != 1:  # the reader always closes with a line
-                raise VecfitError("a closed subpath must end with a line segment")
-            out.append("Z")
-    return " ".join(out)
+    """A Scene path's ``d``: absolute M/L/Q/C/Z (see ``pathdata.format_path_data``)."""
+    return format_path_data(finite(path.points), path.degrees, path.subpaths)
 
 
 # ---------------------------------------------------------------------- comparison
@@ -111,59 +93,7 @@ def _same_gradient(a, b) -> bool:
             and _same(a.focal, b.focal))
 
 
-# ------------------------------------------------------------------------ document
-
-def _parse(data: bytes):
-    """Element tree with comments and processing instructions; namespace prefixes."""
-    prefixes = []
-    for _, (prefix, uri) in ET.iterparse(io.BytesIO(data), events=("start-ns",)):
-        prefixes.append((prefix, uri))
-    parser = ET.XMLParser(target=ET.TreeBuilder(insert_comments=True, insert_pis=True))
-    parser.feed(data)
-    return parser.close(), prefixes
-
-
-_PROLOG_ITEM = re.compile(
-    rb"\s+|<\?.*?\?>|<!--.*?-->|<!DOCTYPE(?:[^\[>]|\[.*?\])*>", re.DOTALL | re.IGNORECASE)
-
-
-def _prolog(data: bytes) -> str:
-    """What comes before the root element (comments, DOCTYPE), without the XML declaration,
-    which ElementTree does not keep."""
-    i, parts = 0, []
-    if data.startswith(b"\xef\xbb\xbf"):
-        i = 3
-    while True:
-        m = _PROLOG_ITEM.match(data, i)
-        if not m:
-            break
-        item = m.group(0)
-        if not item.startswith(b"<?xml ") and not item.startswith(b"<?xml?"):
-            parts.append(item)
-        i = m.end()
-    try:
-        text = b"".join(parts).decode("utf-8").strip()
-    except UnicodeDecodeError:
-        return ""
-    return text + "\n" if text else ""
-
-
-def _elements(element):
-    return [c for c in element if isinstance(c.tag, str)]
-
-
-def _handles(root) -> dict[str, ET.Element]:
-    """handle -> element, computed exactly as the reader does (element children only)."""
-    every = [e for e in root.iter() if isinstance(e.tag, str)]
-    counts = Counter(e.get("id") for e in every if e.get("id") is not None)
-    out, todo = {}, [(root, "")]
-    while todo:
-        element, position = todo.pop()
-        i = element.get("id")
-        out[i if i is not None and counts[i] == 1 else (position or "/")] = element
-        todo += [(c, f"{position}/{k}") for k, c in enumerate(_elements(element))]
-    return out
-
+# ------------------------------------------------------------------------ styles
 
 def _split_style(text: str | None) -> list[list[str]]:
     """style attribute -> [[name, value]] (raw, in order)."""
@@ -175,23 +105,14 @@ def _split_style(text: str | None) -> list[list[str]]:
     return out
 
 
-class _Document:
-    def __init__(self, root, cascade):
-        self.root = root
-        self.cascade = cascade
-        self.parents = {}
-        for e in root.iter():
-            for c in e:
-                self.parents[id(c)] = e
-        self._computed = {}
+class _Styles:
+    """Properties written so that they compute to the wanted value in ``doc``."""
 
-    def computed(self, element) -> dict:
-        key = id(element)
-        if key not in self._computed:
-            parent = self.parents.get(key)
-            self._computed[key] = self.cascade.computed(
-                element, self.computed(parent) if parent is not None else None)
-        return self._computed[key]
+    def __init__(self, doc: SvgDocument):
+        self.doc = doc
+        self.cascade = doc.cascade
+        self.parents = doc.parents
+        self.computed = doc.computed
 
     def set_property(self, element, name: str, value: str | None):
         """Make ``name`` compute to ``value`` on ``element``; None: its initial value, by
@@ -237,10 +158,10 @@ class _Document:
 
 # -------------------------------------------------------------------------- writer
 
-def write_svg(scene: Scene, source_path, out_path, *, full: bool = False, background=None,
+def write_svg(scene: Scene, document, out_path, *, full: bool = False, background=None,
               canvas: tuple[float, float] | None = None) -> None:
-    """Write ``scene``'s values into a copy of the SVG at ``source_path`` (which the scene
-    was read from) and save it atomically at ``out_path``.
+    """Write ``scene``'s values into a copy of ``document`` (the SvgDocument the scene was
+    read from, or the path of its file) and save it atomically at ``out_path``.
 
     background: an RGB(A) colour to put behind everything as a first ``<rect>`` covering
     the viewBox (for scenes optimised over a background they do not cover themselves).
@@ -249,34 +170,40 @@ def write_svg(scene: Scene, source_path, out_path, *, full: bool = False, backgr
     viewBox is resized with it, so a user unit keeps its size in pixels.
 
     Raises VecfitError for non-finite values (nothing is written then) or a scene that
-    does not match the source file.
+    does not match the document.
     """
-    from .read import Reader  # the reader's own cascade, viewport and original scene
+    payload = svg_bytes(scene, document, full=full, background=background, canvas=canvas)
+    if str(out_path).endswith(".svgz"):
+        payload = gzip.compress(payload)
+
+    def write(tmp):
+        with open(tmp, "wb") as f:
+            f.write(payload)
+
+    atomic_write(out_path, write)
+
+
+def svg_bytes(scene: Scene, document, *, full: bool = False, background=None,
+              canvas: tuple[float, float] | None = None) -> bytes:
+    """What ``write_svg`` writes, as UTF-8 bytes."""
+    from .read import read_svg, scene_of  # the reader records the Scene as read
 
     for tensors in scene.parameters().values():
         for t in tensors:
             finite(t)
-    plain = read_root(source_path)
-    reader = Reader(source_path, plain)
-    original = reader.read()
+    if not isinstance(document, SvgDocument):
+        document = read_svg(document)[1]
+    elif document.original is None:
+        scene_of(document)
+    original = document.original
     if (len(original.shapes) != len(scene.shapes) or len(original.groups) != len(scene.groups)
             or any(a.source != b.source for a, b in zip(original.shapes, scene.shapes))
             or any(a.source != b.source for a, b in zip(original.groups, scene.groups))):
-        raise VecfitError(f"{source_path}: the scene was not read from this file "
+        raise VecfitError(f"{document.name}: the scene was not read from this file "
                           f"(its shapes and groups do not match)")
 
-    data = FsPath(source_path).read_bytes()
-    if data[:2] == b"\x1f\x8b":
-        data = gzip.decompress(data)
-    root, prefixes = _parse(data)
-    for prefix, uri in prefixes:
-        try:
-            ET.register_namespace(prefix, uri)
-        except ValueError:
-            pass  # ns0-style prefixes: ElementTree makes its own
-    handles = _handles(root)
-    doc = _Document(root, reader.cascade)
-    writer = _Writer(doc, handles, reader.viewport, full)
+    doc = document.copy()
+    writer = _Writer(doc, document.viewport, full)
 
     done: set = set()
     for shape, orig in zip(scene.shapes, original.shapes):
@@ -287,7 +214,7 @@ def write_svg(scene: Scene, source_path, out_path, *, full: bool = False, backgr
     if writer.averaged:
         names = ", ".join(str(a) for a in writer.averaged[:5]) + (", ..." if len(writer.averaged) > 5 else "")
         warnings.warn(f"SVG has no per-point stroke widths: {len(writer.averaged)} path(s) ({names}) "
-                      f"written with the mean of their widths as stroke-width", VecfitWarning, stacklevel=2)
+                      f"written with the mean of their widths as stroke-width", VecfitWarning, stacklevel=3)
     done = set()
     for group, orig in zip(scene.groups, original.groups):
         if group.source in done:
@@ -309,19 +236,10 @@ def write_svg(scene: Scene, source_path, out_path, *, full: bool = False, backgr
                 written.add(p.source)
 
     if canvas is not None:
-        _set_canvas(root, canvas, (original.width, original.height))
+        _set_canvas(doc.root, canvas, (original.width, original.height))
     if background is not None:
-        _add_background(root, background)
-    text = ET.tostring(root, encoding="unicode")
-    payload = ('<?xml version="1.0" encoding="UTF-8"?>\n' + _prolog(data) + text + "\n").encode("utf-8")
-    if str(out_path).endswith(".svgz"):
-        payload = gzip.compress(payload)
-
-    def write(tmp):
-        with open(tmp, "wb") as f:
-            f.write(payload)
-
-    atomic_write(out_path, write)
+        _add_background(doc.root, background)
+    return doc.serialize()
 
 
 def _set_canvas(root, size, before) -> None:
@@ -362,9 +280,11 @@ def _add_background(root, color) -> None:
 
 
 class _Writer:
-    def __init__(self, doc: _Document, handles, viewport, full: bool):
-        self.doc = doc
-        self.handles = handles
+    def __init__(self, doc: SvgDocument, viewport, full: bool):
+        self.doc = _Styles(doc)
+        self.handles = doc.handles
+        self.root = doc.root
+        self.by_id = doc.element_by_id
         self.viewport = viewport
         self.full = full
         self.averaged = []  # sources of paths whose per-point widths were averaged
@@ -495,7 +415,7 @@ class _Writer:
                 x = parse_length(e.get("x"), self.viewport[0]) or 0.0
                 y = parse_length(e.get("y"), self.viewport[1]) or 0.0
                 m = m @ translate(-x, -y)
-            elif tag in ("svg", "symbol") and e is not self.doc.root:
+            elif tag in ("svg", "symbol") and e is not self.root:
                 # The group's transform includes the viewBox mapping: not writable as is.
                 if not _same(group.transform, orig.transform):
                     warnings.warn(f"the transform of <{tag}> {group.source} is not written back",
@@ -512,11 +432,11 @@ class _Writer:
         chain, seen = [], set()
         e = self.handles.get(paint.source)
         if e is None:
-            e = _by_id(self.doc.root, paint.source)
+            e = self.by_id(paint.source)
         while e is not None and local_name(e.tag) in GRADIENTS and id(e) not in seen:
             seen.add(id(e))
             chain.append(e)
-            e = _by_id(self.doc.root, href_id(e))
+            e = self.by_id(href_id(e))
         if not chain:
             raise VecfitError(f"no gradient element #{paint.source} in the source SVG")
         g = chain[0]
@@ -552,12 +472,3 @@ class _Writer:
                 a = float(c[3])
                 self.doc.set_property(s, "stop-opacity",
                                       None if a >= 1 else fmt(min(max(a, 0.0), 1.0), 6))
-
-
-def _by_id(root, i):
-    if i is None:
-        return None
-    for e in root.iter():
-        if isinstance(e.tag, str) and e.get("id") == i:
-            return e
-    return None

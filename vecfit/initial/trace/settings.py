@@ -46,11 +46,16 @@ class TraceSettings:
 
 @dataclass
 class TraceResult:
-    svg: str          # complete SVG document text
+    document: "SvgDocument"  # the traced SVG (vecfit.svg.document)
     paths: int        # number of shapes written
     colors: int       # number of distinct fill colours
     segments: int     # total segments (cubics; the background rect counts its 4 sides)
     seconds: float
+
+    @property
+    def svg(self) -> str:
+        """The traced SVG as text."""
+        return self.document.text()
 
 
 def check_settings(s: TraceSettings) -> None:

@@ -1,31 +1,32 @@
-"""SVG text of the traced shapes."""
+"""The traced shapes as elements of a new SvgDocument."""
 from __future__ import annotations
 
-from vecfit.svg.numbers import fmt
+import numpy as np
 
+from vecfit.svg.document import NewDocument, SvgDocument
+from vecfit.svg.pathdata import format_path_data
 
-def number(v: float) -> str:
-    """Compact decimal with at most 2 decimals: 12.5, 3, -0.25 (never -0)."""
-    return fmt(v, 2)
+DECIMALS = 2  # a trace is placed to a hundredth of a pixel, its refinement finer
 
 
 def path_data(subpaths) -> str:
-    """'M x y C ... Z' for each closed subpath of cubic segments [S, 4, 2]."""
-    parts = []
+    """'M x y C ... Z' for each closed subpath of cubic segments [S, 4, 2] (each closed by
+    a Z after its last cubic, as the reader closes it: a line of zero length)."""
+    points, degrees, spans = [], [], []
     for segs in subpaths:
         if len(segs) == 0:
             continue
-        parts.append(f"M{number(segs[0, 0, 0])} {number(segs[0, 0, 1])}")
-        for seg in segs:
-            parts.append("C" + " ".join(f"{number(x)} {number(y)}" for x, y in seg[1:]))
-        parts.append("Z")
-    return "".join(parts)
+        spans.append((len(degrees), len(segs) + 1, True))
+        points.append(np.asarray(segs[:1, 0]))
+        points.append(np.asarray(segs[:, 1:]).reshape(-1, 2))
+        degrees += [3] * len(segs) + [1]
+    if not spans:
+        return ""
+    return format_path_data(np.concatenate(points), degrees, spans, decimals=DECIMALS, compact=True)
 
 
-def svg_document(width: int, height: int, elements: list[str]) -> str:
-    head = (f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" '
-            f'viewBox="0 0 {width} {height}">')
-    return "\n".join([head, *elements, "</svg>"]) + "\n"
+def new_document(width: int, height: int) -> NewDocument:
+    return SvgDocument.new(width, height)
 
 
 # The background rect reaches this far past the canvas: its edges then touch no pixel,
@@ -33,12 +34,14 @@ def svg_document(width: int, height: int, elements: list[str]) -> str:
 BACKGROUND_MARGIN = 4
 
 
-def rect_element(ident: str, width: int, height: int, fill: str) -> str:
+def add_rect(document: NewDocument, ident: str, width: int, height: int, fill: str) -> None:
     m = BACKGROUND_MARGIN
-    return (f'<rect id="{ident}" x="-{m}" y="-{m}" width="{width + 2 * m}" height="{height + 2 * m}" '
-            f'fill="{fill}"/>')
+    document.add("rect", {"id": ident, "x": f"-{m}", "y": f"-{m}", "width": f"{width + 2 * m}",
+                          "height": f"{height + 2 * m}", "fill": fill})
 
 
-def path_element(ident: str, d: str, fill: str, evenodd: bool = False) -> str:
-    rule = ' fill-rule="evenodd"' if evenodd else ""
-    return f'<path id="{ident}" d="{d}" fill="{fill}"{rule}/>'
+def add_path(document: NewDocument, ident: str, d: str, fill: str, evenodd: bool = False) -> None:
+    attributes = {"id": ident, "d": d, "fill": fill}
+    if evenodd:
+        attributes["fill-rule"] = "evenodd"
+    document.add("path", attributes)

@@ -1,4 +1,4 @@
-"""trace_image: a raster image to an initial vector graphic (SVG text).
+"""trace_image: a raster image to an initial vector graphic (an SvgDocument).
 
 Pipeline: colour quantisation (k-means in CIELAB) -> connected regions of each colour ->
 speckles and slivers merged into neighbours, then merges until the path budget holds ->
@@ -21,7 +21,7 @@ from .quantize import OPAQUE, prefilter, quantize_colors
 from .regions import build_regions, palette_colors
 from .settings import TraceResult, TraceSettings, check_settings
 from .subpixel import refine_outlines
-from .svgtext import path_data, path_element, rect_element, svg_document
+from .svgtext import add_path, add_rect, new_document, path_data
 
 
 def check_image(image) -> np.ndarray:
@@ -48,7 +48,7 @@ def check_image(image) -> np.ndarray:
 
 def trace_image(image: np.ndarray, settings: TraceSettings = TraceSettings(),
                 progress=None) -> TraceResult:
-    """Trace an image into SVG text.
+    """Trace an image into an SVG document (vecfit.svg.document).
 
     image: float32 RGBA [H, W, 4], straight alpha in [0, 1] (what vecfit.io.images.load_rgba
     returns). Pixels with alpha >= 0.5 are traced as opaque shapes; the others get no shape,
@@ -105,10 +105,10 @@ def trace_image(image: np.ndarray, settings: TraceSettings = TraceSettings(),
     fitted = fit_outlines(outlines, s.tolerance, s.corner_angle, s.smoothing)
 
     paint = palette_colors(regions, classes, rgb) if s.palette else regions.color
-    elements, segments, fills = [], 0, set()
+    document, segments, fills = new_document(w, h), 0, set()
     if background is not None:
         fills.add(hex_color(paint[background]))
-        elements.append(rect_element("p0", w, h, hex_color(paint[background])))
+        add_rect(document, "p0", w, h, hex_color(paint[background]))
         segments += 4
     for i, sl in shapes:
         subpaths = [sp for sp in fitted[sl] if len(sp)]
@@ -117,8 +117,8 @@ def trace_image(image: np.ndarray, settings: TraceSettings = TraceSettings(),
         fill = hex_color(paint[i])
         fills.add(fill)
         cut = any(holes[sl])
-        elements.append(path_element(f"p{len(elements)}", path_data(subpaths), fill, evenodd=cut))
+        add_path(document, f"p{len(document.root)}", path_data(subpaths), fill, evenodd=cut)
         segments += sum(len(sp) for sp in subpaths)
     report("fit", 1.0)
-    return TraceResult(svg=svg_document(w, h, elements), paths=len(elements), colors=len(fills),
+    return TraceResult(document=document, paths=len(document.root), colors=len(fills),
                        segments=segments, seconds=time.perf_counter() - start)
