@@ -18,7 +18,7 @@ import numpy as np
 import torch
 
 import vecfit
-from vecfit.renderer.scene import Path, Scene, Shape, Solid
+from vecfit.scene import Path, Scene, Shape, Solid
 
 
 def strokes_scene(n, size, seed=0):

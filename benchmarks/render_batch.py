@@ -16,7 +16,7 @@ import numpy as np
 import torch
 
 import vecfit
-from vecfit.renderer.scene import Path, Scene, Shape, Solid
+from vecfit.scene import Path, Scene, Shape, Solid
 from vecfit.renderer.stopwatch import Stopwatch, lap
 
 

@@ -68,7 +68,7 @@ def main() -> None:
     if args.squeeze_init:
         import vecfit.jobs.retarget as job
         from vecfit.editing.points import point_tensors
-        from vecfit.renderer.pack import Packer
+        from vecfit.scene.placement import shape_matrices
 
         def squeeze(scene, seams, width, height, axis=0):
             """Plain scaling of the points about the canvas origin, in pixels."""
@@ -76,7 +76,7 @@ def main() -> None:
             factor = (width if axis == 0 else height) - len(seams)
             factor /= width if axis == 0 else height
             with torch.no_grad():
-                for shape, m in zip(scene.shapes, Packer(scene, width, height).shape_matrices().double()):
+                for shape, m in zip(scene.shapes, shape_matrices(scene, width, height).double()):
                     inverse = torch.linalg.inv(m)
                     for t in point_tensors(shape):
                         p = t.detach().double().reshape(-1, 2)

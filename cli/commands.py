@@ -165,7 +165,7 @@ def info(svg, build):
     --build, what the compiled core has."""
     import vecfit
     from vecfit.errors import VecfitError
-    from vecfit.io.scene_summary import summarize
+    from vecfit.scene.summary import summarize
 
     if build:
         from vecfit.renderer.device import build_summary

@@ -36,8 +36,8 @@ import torch
 from torch import nn
 
 from vecfit.io.images import atomic_write_text, save_png
-from vecfit.renderer.scene import Path as CurvePath
-from vecfit.renderer.scene import Scene, Shape, Solid
+from vecfit.scene import Path as CurvePath
+from vecfit.scene import Scene, Shape, Solid
 
 SIZE = 32         # pixels
 STROKES = 4       # cubic strokes per digit

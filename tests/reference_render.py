@@ -1,7 +1,7 @@
 """An independent NumPy reference renderer for vecfit Scenes (a test helper).
 
 It shares no code with ``vecfit._core`` or ``vecfit.renderer``: it reads the Scene dataclasses
-(``vecfit/renderer/scene.py``) and point-samples them on a supersampled grid, box-filtered.
+(``vecfit/scene/model.py``) and point-samples them on a supersampled grid, box-filtered.
 
     render_reference(scene, width, height, samples=8, background=None) -> [H, W, 4] float64
 
@@ -494,7 +494,7 @@ def stop_colors(offsets, colors, t) -> np.ndarray:
 def paint_straight(paint, q, bbox) -> np.ndarray:
     """Straight RGBA [M, 4] of a paint at local points q [M, 2]; ``bbox`` = (min, max) of the
     shape's local fill geometry, used by objectBoundingBox units."""
-    from vecfit.renderer.scene import LinearGradient, RadialGradient, Solid
+    from vecfit.scene import LinearGradient, RadialGradient, Solid
     M = len(q)
     if isinstance(paint, Solid):
         return np.broadcast_to(_np(paint.color).reshape(4), (M, 4)).copy()
@@ -569,7 +569,7 @@ def _group_chain(scene, shape) -> list[int]:
 
 def _prepare_geometry(geometry, tol):
     """(kind, fill data, outline for the stroke or None, local fill bbox) or None if not drawn."""
-    from vecfit.renderer.scene import Circle, Ellipse, Path, Rect
+    from vecfit.scene import Circle, Ellipse, Path, Rect
     if isinstance(geometry, Path):
         outline = _path_outline(geometry, tol)
         if not outline:

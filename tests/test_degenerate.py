@@ -7,7 +7,7 @@ import torch
 
 import vecfit
 from vecfit.errors import VecfitError
-from vecfit.renderer.scene import Circle, Ellipse, Path, Rect, Scene, Shape, Solid
+from vecfit.scene import Circle, Ellipse, Path, Rect, Scene, Shape, Solid
 
 RED = lambda: Solid(torch.tensor([1.0, 0.0, 0.0, 1.0]))  # noqa: E731
 

@@ -21,7 +21,7 @@ import pytest
 import torch
 
 import vecfit
-from vecfit.renderer.scene import Path, Rect, Scene, Shape, Solid
+from vecfit.scene import Path, Rect, Scene, Shape, Solid
 
 SIZE = 20
 

@@ -19,7 +19,7 @@ from vecfit.fitting.loop import Settings, Target, optimize
 from vecfit.fitting.metrics import compare, to_rgb
 from vecfit.jobs.config import resolve
 from vecfit.renderer.raster import render
-from vecfit.renderer.scene import Circle, Path, Scene, Shape, Solid
+from vecfit.scene import Circle, Path, Scene, Shape, Solid
 
 resvg_py = pytest.importorskip("resvg_py")
 

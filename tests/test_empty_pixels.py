@@ -10,7 +10,7 @@ import pytest
 import torch
 
 import vecfit
-from vecfit.renderer.scene import Path, Scene, Shape, Solid
+from vecfit.scene import Path, Scene, Shape, Solid
 
 
 @pytest.mark.parametrize("right", [26.0, 26.25])

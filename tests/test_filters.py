@@ -16,7 +16,7 @@ import torch
 
 import vecfit
 from test_gradients import BOUNDARY, SAMPLES, SIZE, W, background
-from vecfit.renderer.scene import Circle, Rect, Scene, Shape, Solid
+from vecfit.scene import Circle, Rect, Scene, Shape, Solid
 
 PROFILES = {  # the filter along one axis, u = offset / radius in [-1, 1]
     "tent": lambda u: 1 - np.abs(u),

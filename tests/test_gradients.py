@@ -20,7 +20,7 @@ import pytest
 import torch
 
 import vecfit
-from vecfit.renderer.scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient,
+from vecfit.scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient,
                                    Rect, Scene, Shape, Solid)
 
 SIZE = 40

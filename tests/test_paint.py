@@ -14,7 +14,7 @@ from helpers import photo_png, quiet_load, run
 from vecfit.fitting.metrics import compare
 from vecfit.fitting.loop import Step, Target
 from vecfit.initial.strokes import PaintSettings, Reseeder, initial_document
-from vecfit.renderer.scene import Path as PathGeometry, Scene, Shape, Solid
+from vecfit.scene import Path as PathGeometry, Scene, Shape, Solid
 
 
 @pytest.fixture(scope="module")

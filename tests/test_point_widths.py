@@ -18,7 +18,7 @@ import torch
 import vecfit
 from test_gradients import OFF_GRID, W, background, check, solid
 from vecfit.errors import VecfitError
-from vecfit.renderer.scene import Path, Scene, Shape
+from vecfit.scene import Path, Scene, Shape
 
 CURVE = torch.tensor([[7.0, 30.0], [12.0, 5.0], [26.0, 36.0], [33.0, 10.0]])
 CURVE_WIDTHS = torch.tensor([2.0, 6.0, 3.0, 5.0])

@@ -19,7 +19,7 @@ import pytest
 import torch
 
 import vecfit
-from vecfit.renderer.scene import Path, Scene, Shape, Solid
+from vecfit.scene import Path, Scene, Shape, Solid
 
 SIZE = 24
 R = 0.5  # the box filter's kernel radius at 1 sample per pixel

@@ -17,7 +17,7 @@ import torch
 import diffvg
 import pydiffvg
 import vecfit
-from vecfit.renderer import scene as vs
+from vecfit import scene as vs
 
 S = 40  # canvas and image size
 

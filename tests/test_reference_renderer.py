@@ -22,7 +22,7 @@ import torch
 
 from reference_render import (bezier_eval, paint_straight, premultiply, render_reference,
                               stop_colors, winding_numbers)
-from vecfit.renderer.scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient,
+from vecfit.scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient,
                                    Rect, Scene, Shape, Solid)
 
 S = 16  # samples per pixel side in the area tests

@@ -20,7 +20,7 @@ from vecfit.errors import VecfitError
 from vecfit.fitting.metrics import compare
 from vecfit.fitting.loop import Settings, Target, optimize
 from vecfit.jobs.fit import load_target
-from vecfit.renderer.scene import Circle, LinearGradient, Scene, Shape, Solid
+from vecfit.scene import Circle, LinearGradient, Scene, Shape, Solid
 
 from shared_data import SHARED
 PEPPERS = SHARED / "data" / "photos" / "peppers.png"

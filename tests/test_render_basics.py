@@ -7,7 +7,7 @@ import torch
 
 import vecfit
 from vecfit.renderer.raster import output_size
-from vecfit.renderer.scene import Circle, LinearGradient, Path, Rect, Scene, Shape, Solid
+from vecfit.scene import Circle, LinearGradient, Path, Rect, Scene, Shape, Solid
 
 
 def square(x0, y0, x1, y1, color, **kw):
@@ -58,7 +58,7 @@ def test_linear_gradient_user_space():
 def test_group_opacity_is_a_layer():
     """Two overlapping opaque squares in a group of opacity 0.5: the overlap shows only the
     top square at half alpha (a layer), not the two blended."""
-    from vecfit.renderer.scene import Group
+    from vecfit.scene import Group
     shapes = [square(0, 0, 6, 8, [1, 0, 0, 1], group=0), square(2, 0, 8, 8, [0, 0, 1, 1], group=0)]
     img = vecfit.render(Scene(width=8, height=8, shapes=shapes,
                               groups=[Group(opacity=torch.tensor(0.5))]))

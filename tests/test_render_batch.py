@@ -7,7 +7,7 @@ import pytest
 import torch
 
 import vecfit
-from vecfit.renderer.scene import LinearGradient, Path, Scene, Shape, Solid
+from vecfit.scene import LinearGradient, Path, Scene, Shape, Solid
 
 
 def digit_like(seed: int, size: int = 32) -> Scene:

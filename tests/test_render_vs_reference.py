@@ -38,7 +38,7 @@ import pytest
 import torch
 
 from reference_render import premultiply, render_reference
-from vecfit.renderer.scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient,
+from vecfit.scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient,
                                    Rect, Scene, Shape, Solid)
 
 pytest.importorskip(

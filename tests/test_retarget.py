@@ -16,7 +16,7 @@ from helpers import quiet_load, run
 from vecfit.editing.points import carve_points
 from vecfit.editing.seams import carve, energy, foreground, remove_seam, shift, vertical_seam
 from vecfit.jobs.retarget import parse_size
-from vecfit.renderer.scene import Path, Scene, Shape, Solid
+from vecfit.scene import Path, Scene, Shape, Solid
 
 resvg_py = pytest.importorskip("resvg_py")
 

@@ -18,7 +18,7 @@ import pytest
 import torch
 
 import vecfit
-from vecfit.renderer.scene import Path, Scene, Shape, Solid
+from vecfit.scene import Path, Scene, Shape, Solid
 
 SIZE = 24
 HW = 3.3  # the pixel centre (12.5, 9.5) lies 3 px above the vertex (12.5, 12.5): 0.3 px inside

@@ -13,9 +13,9 @@ import pytest
 import torch
 
 from helpers import need
-from vecfit.io.scene_summary import summarize
+from vecfit.scene.summary import summarize
 from vecfit.errors import SvgError
-from vecfit.renderer.scene import (Circle, Ellipse, LinearGradient, Path as PathGeometry,
+from vecfit.scene import (Circle, Ellipse, LinearGradient, Path as PathGeometry,
                                    RadialGradient, Rect, Scene, Solid)
 from vecfit.svg import VecfitWarning, load_svg
 from vecfit.svg.color import parse_color

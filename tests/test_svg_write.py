@@ -14,7 +14,7 @@ import torch
 
 import vecfit
 from vecfit.errors import SvgError, VecfitError
-from vecfit.renderer.scene import Circle, Ellipse, LinearGradient, Path as PathGeometry, Solid
+from vecfit.scene import Circle, Ellipse, LinearGradient, Path as PathGeometry, Solid
 from vecfit.svg import VecfitWarning
 from vecfit.svg.numbers import fmt
 from vecfit.svg.write import path_data, write_svg

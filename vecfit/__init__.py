@@ -25,7 +25,7 @@ __all__ = ["Circle", "Ellipse", "Group", "LinearGradient", "Path", "RadialGradie
 
 _LAZY = {"render": ".renderer.raster", "render_batch": ".renderer.batch",
          "cuda_device_count": ".renderer.device", "has_cuda": ".renderer.device",
-         **{name: ".renderer.scene" for name in ("Circle", "Ellipse", "Group", "LinearGradient", "Path",
+         **{name: ".scene" for name in ("Circle", "Ellipse", "Group", "LinearGradient", "Path",
                                                  "RadialGradient", "Rect", "Scene", "Shape", "Solid")}}
 
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import torch
 
-from vecfit.renderer.pack import Packer
-from vecfit.renderer.scene import Circle, Ellipse, Path, Rect, Scene
+from vecfit.scene.placement import shape_matrices
+from vecfit.scene import Circle, Ellipse, Path, Rect, Scene
 
 from .seams import shift
 
@@ -28,7 +28,7 @@ def carve_points(scene: Scene, seams: list, width: int, height: int, axis: int =
     ones (axis 1; seams of the transposed image) move y. Each point is mapped in pixels
     through its shape's transforms and back."""
     with torch.no_grad():
-        matrices = Packer(scene, width, height).shape_matrices().double()
+        matrices = shape_matrices(scene, width, height).double()
         for shape, m in zip(scene.shapes, matrices):
             if abs(float(torch.linalg.det(m[:2, :2]))) < 1e-12:
                 continue  # a shape flattened by its transform draws nothing

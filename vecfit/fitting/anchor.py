@@ -14,7 +14,7 @@ import numpy as np
 import torch
 
 from vecfit.renderer.raster import render
-from vecfit.renderer.scene import Path, Scene
+from vecfit.scene import Path, Scene
 
 from .rates import LENGTH_KINDS, learning_rate_scales
 

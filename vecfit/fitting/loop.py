@@ -23,7 +23,7 @@ from vecfit.io.images import downscaled, downscaled_weight
 from vecfit.renderer import device as devices
 from vecfit.renderer.persistent import PersistentPack
 from vecfit.renderer.raster import MODES, render
-from vecfit.renderer.scene import Scene
+from vecfit.scene import Scene
 from vecfit.renderer.stopwatch import lap, phase
 
 from . import losses

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from vecfit.renderer.scene import Path, Scene
+from vecfit.scene import Path, Scene
 
 from .rates import shape_pixel_scales
 

@@ -8,9 +8,9 @@ import math
 import numpy as np
 import torch
 
-from vecfit.renderer.geometry import local_bbox_size
-from vecfit.renderer.pack import Packer
-from vecfit.renderer.scene import LinearGradient, RadialGradient, Scene
+from vecfit.scene.geometry import local_bbox_size
+from vecfit.scene.placement import shape_matrices
+from vecfit.scene import LinearGradient, RadialGradient, Scene
 
 from .adam import ParameterKind
 
@@ -22,7 +22,7 @@ LENGTH_KINDS = ("points", "stroke_widths", "radii", "gradient_points", "gradient
 def shape_pixel_scales(scene: Scene, width: int, height: int) -> np.ndarray:
     """Pixels per unit of each shape's own space (sqrt |det| of its map to the canvas)."""
     with torch.no_grad():
-        lin = Packer(scene, width, height).shape_matrices()[:, :2, :2]
+        lin = shape_matrices(scene, width, height)[:, :2, :2]
         det = lin[:, 0, 0] * lin[:, 1, 1] - lin[:, 0, 1] * lin[:, 1, 0]
     return torch.sqrt(torch.abs(det)).numpy().astype(np.float64)
 

@@ -20,7 +20,7 @@ import numpy as np
 import torch
 
 from vecfit.errors import VecfitError
-from vecfit.renderer.scene import Path as PathGeometry
+from vecfit.scene import Path as PathGeometry
 from vecfit.svg.document import SvgDocument
 from vecfit.svg.pathdata import format_path_data
 

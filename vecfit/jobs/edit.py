@@ -22,7 +22,7 @@ from vecfit.fitting.rates import learning_rate_scales
 from vecfit.io.images import downscaled, downscaled_weight
 from vecfit.io.report import error_map, panels_image, save_panels, save_report
 from vecfit.renderer import device as devices
-from vecfit.renderer.scene import Scene
+from vecfit.scene import Scene
 from vecfit.svg.numbers import hex_color
 from vecfit.svg.write import write_svg
 

@@ -21,7 +21,7 @@ from vecfit.io.images import downscaled, load_rgba
 from vecfit.io.report import save_comparison, save_report
 from vecfit.renderer import device as devices
 from vecfit.renderer.raster import render
-from vecfit.renderer.scene import Scene
+from vecfit.scene import Scene
 from vecfit.svg.numbers import hex_color
 from vecfit.svg.document import SvgDocument
 from vecfit.svg.read import read_svg, scene_of

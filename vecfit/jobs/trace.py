@@ -6,7 +6,7 @@ from pathlib import Path
 
 from vecfit.errors import VecfitError
 from vecfit.initial.trace import TraceSettings, trace_image
-from vecfit.renderer.scene import Rect, Solid
+from vecfit.scene import Rect, Solid
 
 from .config import settings_of
 from .fit import Outputs, fit_and_write, generated_scene, load_target

@@ -21,7 +21,7 @@ import numpy as np
 import torch
 
 from vecfit.errors import VecfitError
-from vecfit.renderer import scene as vs
+from vecfit import scene as vs
 
 from .enums import ColorType, ShapeType
 

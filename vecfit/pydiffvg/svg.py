@@ -21,8 +21,8 @@ import numpy as np
 import torch
 
 from vecfit.io.images import atomic_write_text
-from vecfit.renderer import scene as vs
-from vecfit.renderer.geometry import local_bbox, rect_path
+from vecfit import scene as vs
+from vecfit.scene.geometry import local_bbox, rect_path
 from vecfit.svg.numbers import finite, fmt
 from vecfit.svg.pathdata import format_path_data
 from vecfit.svg.read import load_svg

@@ -20,7 +20,7 @@ from vecfit.limits import MAX_PIXELS
 
 from . import device as devices
 from .raster import FLOAT_INPUTS, background_rgba, check_options, packed_for_core, render
-from .scene import Scene
+from vecfit.scene import Scene
 from .stopwatch import add_core_phases, phase
 
 

@@ -11,7 +11,7 @@ import copy
 import torch
 
 from vecfit.renderer.raster import render
-from vecfit.renderer.scene import Circle, Ellipse, Path, Rect, Scene
+from vecfit.scene import Circle, Ellipse, Path, Rect, Scene
 
 
 def weighting(seed: int, height: int, width: int, border: float = 4.0) -> torch.Tensor:

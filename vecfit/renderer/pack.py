@@ -15,12 +15,12 @@ import numpy as np
 import torch
 
 from vecfit.errors import VecfitError
+from vecfit.scene import Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect, Scene, Shape, Solid
+from vecfit.scene.geometry import affine_apply, local_bbox, rect_as_path, value
+from vecfit.scene.placement import canvas_matrix, group_matrices, stacked_shape_matrices
 
-from .geometry import affine_apply, local_bbox, rect_as_path, value
 from .layout import (CAPS, COLUMNS, DRAW_FILL, DRAW_STROKE, FILL_RULES, JOINS, BRUSH_LINEAR,
                      BRUSH_RADIAL, BRUSH_SOLID, SHAPE_ELLIPSE, SHAPE_PATH)
-from .scene import Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect, Scene, Shape, Solid
-
 
 
 @dataclass
@@ -82,8 +82,7 @@ class Packer:
         self.scene = scene
         self.trace = trace
         self.out = Packed()
-        sx, sy = width / scene.width, height / scene.height
-        self.canvas = torch.diag(torch.tensor([sx, sy, 1.0], dtype=torch.float32)) @ scene.view.float()
+        self.canvas = canvas_matrix(scene, width, height)
         self.group_matrix: list[torch.Tensor] = []
         self.group_layer: list[int] = []
         self._group_draw_counts = self._count_group_draws()
@@ -113,12 +112,9 @@ class Packer:
     def _prepare_groups(self) -> None:
         """Matrices to pixels and layers: a group with opacity < 1 over several draws is a
         layer; over one draw its opacity folds into that draw's alpha."""
+        self.group_matrix = group_matrices(self.scene, self.canvas)
         for i, group in enumerate(self.scene.groups):
-            if group.parent >= i:
-                raise VecfitError("scene groups must come after their parents")
-            parent_m = self.canvas if group.parent < 0 else self.group_matrix[group.parent]
             parent_layer = 0 if group.parent < 0 else self.group_layer[group.parent]
-            self.group_matrix.append(parent_m @ group.transform.float())
             if value(group.opacity) < 1 and self._group_draw_counts[i] > 1:
                 self.group_layer.append(self._new_layer(parent_layer, group.opacity))
             else:
@@ -192,26 +188,11 @@ class Packer:
 
     # ------------------------------------------------------------------- draws
 
-    def shape_matrices(self) -> torch.Tensor:
-        """[n_shapes, 3, 3]: each shape's map from its own space to pixels."""
-        self._prepare_groups()
-        return self._shape_matrices()
-
-    def _shape_matrices(self) -> torch.Tensor:
-        """Each shape's local -> pixel matrix, [S, 3, 3], in one batched product."""
-        shapes = self.scene.shapes
-        if not shapes:
-            return torch.zeros((0, 3, 3))
-        parents = torch.stack([self.canvas] + self.group_matrix)
-        index = torch.tensor([s.group + 1 for s in shapes])
-        own = torch.stack([s.transform.float() for s in shapes])
-        return parents[index] @ own
-
     def pack(self) -> Packed:
         self._prepare_groups()
         out = self.out
         shapes = self.scene.shapes
-        matrices = self._shape_matrices()
+        matrices = stacked_shape_matrices(self.scene, self.canvas, self.group_matrix)
         # Similarity (no metric needed for strokes) and uniform scale of every shape.
         lin = matrices[:, :2, :2]
         scale = torch.sqrt(torch.abs(lin[:, 0, 0] * lin[:, 1, 1] - lin[:, 0, 1] * lin[:, 1, 0]))

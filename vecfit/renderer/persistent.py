@@ -30,7 +30,7 @@ import torch
 from .layout import COLUMNS
 from .pack import Packer
 from .raster import FLOAT_INPUTS
-from .scene import Scene
+from vecfit.scene import Scene
 from .stopwatch import phase
 
 # Kinds whose values enter the packed floats non-linearly (matrix products, alpha

@@ -15,7 +15,7 @@ from vecfit.limits import MAX_PIXELS
 
 from . import device as devices
 from .pack import pack_scene
-from .scene import Scene
+from vecfit.scene import Scene
 from .stopwatch import add_core_phases, phase
 
 MODES = ("mc", "analytic")

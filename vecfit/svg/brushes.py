@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vecfit.renderer.scene import LinearGradient, RadialGradient, Solid, as_tensor
+from vecfit.scene import LinearGradient, RadialGradient, Solid, as_tensor
 
 from .color import RGBA, parse_color
 from .dom import href_id, local_name

@@ -21,7 +21,7 @@ import torch
 
 from vecfit import limits
 from vecfit.errors import SvgError
-from vecfit.renderer.scene import Group, Scene, Shape
+from vecfit.scene import Group, Scene, Shape
 
 from .brushes import BLACK, Paints, parse_opacity, parse_paint
 from .color import parse_color

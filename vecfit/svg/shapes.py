@@ -12,7 +12,7 @@ import re
 
 import torch
 
-from vecfit.renderer.scene import Circle, Ellipse, Path, Rect
+from vecfit.scene import Circle, Ellipse, Path, Rect
 
 from .pathdata import PathDataError, Subpath, parse_path_data, to_arrays
 from .units import clamp_array, parse_length, parse_number

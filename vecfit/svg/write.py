@@ -24,7 +24,7 @@ import torch
 
 from vecfit.errors import VecfitError
 from vecfit.io.images import atomic_write
-from vecfit.renderer.scene import (Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect,
+from vecfit.scene import (Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect,
                                    Scene, Solid)
 
 from .brushes import GRADIENTS

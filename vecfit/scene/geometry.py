@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from .scene import Circle, Ellipse, Path, Rect
+from .model import Circle, Ellipse, Path, Rect
 
 KAPPA = 0.5522847498307936  # cubic approximation of a quarter ellipse
 

@@ -6,7 +6,7 @@ from collections import Counter
 import numpy as np
 import torch
 
-from vecfit.renderer.scene import (CUBIC, LINE, QUADRATIC, Circle, Ellipse, LinearGradient, Path,
+from .model import (CUBIC, LINE, QUADRATIC, Circle, Ellipse, LinearGradient, Path,
                                    RadialGradient, Rect, Scene, Solid)
 
 _GEOMETRY = ((Path, "path"), (Rect, "rect"), (Circle, "circle"), (Ellipse, "ellipse"))

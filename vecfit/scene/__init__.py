@@ -1,0 +1,9 @@
+"""The Scene and its geometry: plain data of torch tensors, below the renderer and the SVG
+reader and writer, which both speak it. ``model`` holds the types, ``geometry`` a shape's
+own-space geometry, ``placement`` where shapes land on a canvas, ``summary`` what
+`vecfit info` lists."""
+from .model import (CUBIC, LINE, QUADRATIC, Circle, Ellipse, Geometry, Group, LinearGradient, Paint, Path,
+                    RadialGradient, Rect, Scene, Shape, Solid, as_tensor, identity)
+
+__all__ = ["CUBIC", "LINE", "QUADRATIC", "Circle", "Ellipse", "Geometry", "Group", "LinearGradient", "Paint",
+           "Path", "RadialGradient", "Rect", "Scene", "Shape", "Solid", "as_tensor", "identity"]
