@@ -19,12 +19,13 @@ from typing import Callable, Optional
 import torch
 
 from vecfit.errors import NonFiniteScene, VecfitError
+from vecfit.io.compositing import composite_torch
 from vecfit.io.images import downscaled, downscaled_weight
 from vecfit.renderer import device as devices
 from vecfit.renderer.persistent import PersistentPack
 from vecfit.renderer.raster import MODES, render
-from vecfit.scene import Scene
 from vecfit.renderer.stopwatch import lap, phase
+from vecfit.scene import Scene
 
 from . import losses
 from .adam import Adam
@@ -125,11 +126,7 @@ class Target:
         """The channels the loss sees: RGB over the opaque background (a render is already
         over it; a target with transparent parts is put over it here), else premultiplied
         RGBA."""
-        alpha = rgba[..., 3:]
-        if self.opaque:
-            bg = torch.tensor(self.background[:3], dtype=rgba.dtype)
-            return rgba[..., :3] * alpha + bg * (1 - alpha)
-        return torch.cat([rgba[..., :3] * alpha, alpha], dim=-1)
+        return composite_torch(rgba, self.background if self.opaque else None)
 
     def rendered(self, image: torch.Tensor) -> torch.Tensor:
         """compared() of a render made over this target's background: the core has

@@ -6,6 +6,8 @@ import math
 import numpy as np
 from skimage.metrics import structural_similarity
 
+from vecfit.io.compositing import composite
+
 
 def to_rgb(image: np.ndarray, background=(1.0, 1.0, 1.0)) -> np.ndarray:
     """[H, W, 4] straight RGBA (or [H, W, 3]) -> [H, W, 3] RGB composited over background
@@ -13,10 +15,7 @@ def to_rgb(image: np.ndarray, background=(1.0, 1.0, 1.0)) -> np.ndarray:
     image = np.asarray(image, dtype=np.float64)
     if image.shape[2] == 3:
         return image
-    if background is None:
-        background = (1.0, 1.0, 1.0)
-    a = image[..., 3:4]
-    return image[..., :3] * a + np.asarray(background[:3], dtype=np.float64) * (1 - a)
+    return composite(image, (1.0, 1.0, 1.0) if background is None else background)
 
 
 def compare(result: np.ndarray, target: np.ndarray) -> dict:
@@ -32,7 +31,4 @@ def compare(result: np.ndarray, target: np.ndarray) -> dict:
 def seen(rgba: np.ndarray, background) -> np.ndarray:
     """The channels the loss compares (loop.Target.compared): RGB over an opaque background,
     else premultiplied RGBA."""
-    a = rgba[..., 3:]
-    if background is not None:
-        return rgba[..., :3] * a + np.asarray(background[:3], np.float32) * (1 - a)
-    return np.concatenate([rgba[..., :3] * a, a], axis=2)
+    return composite(rgba, background)

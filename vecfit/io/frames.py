@@ -3,10 +3,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 from PIL import Image
 
-from vecfit.fitting.metrics import to_rgb
-
+from .compositing import composite
 from .images import atomic_write, to_uint8
 
 
@@ -23,7 +23,9 @@ class FrameSaver:
     def __call__(self, step) -> None:
         if step.iteration % self.every:
             return
-        rgb = to_uint8(to_rgb(step.image.numpy(), step.target.background))
+        background = step.target.background
+        rgb = to_uint8(composite(step.image.numpy().astype(np.float64),
+                                 (1.0, 1.0, 1.0) if background is None else background))
         path = self.folder / f"frame_{step.iteration:05d}.png"
         atomic_write(path, lambda tmp: Image.fromarray(rgb, "RGB").save(tmp, format="PNG"))
         self.files.append(path)

@@ -23,19 +23,30 @@ Packer: the same floats, and the same gradients for a random image adjoint.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 import torch
 
+from vecfit.scene import Scene
+
 from .layout import COLUMNS
 from .pack import Packer
 from .raster import FLOAT_INPUTS
-from vecfit.scene import Scene
 from .stopwatch import phase
 
-# Kinds whose values enter the packed floats non-linearly (matrix products, alpha
-# products): with either optimised, the loop packs the scene on every iteration.
+# Parameter kinds (Scene.parameters) whose values enter the packed floats non-linearly
+# (matrix products, alpha products): with either optimised, the loop packs the scene on
+# every iteration.
 NON_AFFINE_KINDS = ("transforms", "opacities")
+
+
+class FlatTensors(Protocol):
+    """Scene tensors laid side by side in one flat tensor (an optimiser's parameter
+    group): what the persistent pack reads the optimised values from."""
+    tensors: list[torch.Tensor]
+    flat: torch.Tensor
+    offsets: dict[int, int]  # id(tensor) -> its first element in flat
 
 
 @dataclass
@@ -147,8 +158,13 @@ class PersistentPack:
         self._conditions = conditions  # (kind, a, b, expected): see _conditions
 
     @classmethod
-    def build(cls, scene: Scene, width: int, height: int, kinds) -> "PersistentPack | None":
-        if any(k.name in NON_AFFINE_KINDS for k in kinds):
+    def build(cls, scene: Scene, width: int, height: int, kinds: list[FlatTensors]) -> "PersistentPack | None":
+        """The pack of ``scene`` at width x height whose floats follow the values in
+        ``kinds`` (side by side, in order), or None where they are not affine in them."""
+        kinds = list(kinds)
+        optimised = {id(t) for k in kinds for t in k.tensors}
+        parameters = scene.parameters()
+        if any(id(t) in optimised for kind in NON_AFFINE_KINDS for t in parameters[kind]):
             return None
         trace = Provenance()
         with torch.enable_grad():  # (the graph serves the check in _agrees)
