@@ -25,7 +25,7 @@ from PIL import Image
 from vecfit.fitting.metrics import compare
 from vecfit.jobs.config import resolve
 from vecfit.jobs.edit import run as edit
-from vecfit.jobs.fit import Outputs
+from vecfit.jobs.protocol import Inputs, Outputs
 
 sys.path.insert(0, str(ROOT / "tests"))
 from editing_cases import edited_svg, structure  # noqa: E402  (shared with the tests)
@@ -70,7 +70,7 @@ def main() -> None:
             start = time.perf_counter()
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                report = edit(png, src, config, outputs)
+                report = edit(Inputs(image=png, svg=src), config, outputs)
             seconds = time.perf_counter() - start
             before = compare(resvg_rgb(src, width), goal)["psnr"]
             after = compare(resvg_rgb(outputs.svg, width), goal)["psnr"]

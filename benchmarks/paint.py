@@ -16,7 +16,7 @@ from PIL import Image
 
 from vecfit.jobs.config import resolve
 from vecfit.jobs.paint import run as paint
-from vecfit.jobs.fit import Outputs
+from vecfit.jobs.protocol import Inputs, Outputs
 
 CHECKPOINTS = (0, 50, 100, 200, 300, 400, 500)
 
@@ -52,7 +52,7 @@ def main() -> None:
                         "optimize": {"iterations": args.iterations, "threads": args.threads},
                         "paint": {"reseed_every": reseed}})
                     out = Outputs.beside(target, tmp / f"{name}_{size}_{reseed}.svg")
-                    report = paint(target, config, out)
+                    report = paint(Inputs(image=target), config, out)
                     rows.append((name, size, reseed, report))
                     print(f"{name} {size} reseed={reseed}: PSNR {report['optimized']['psnr']:.2f} dB, "
                           f"{report['seconds']['per_iteration']:.3f} s/iter, "

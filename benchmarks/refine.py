@@ -20,7 +20,8 @@ from common import SHARED, parse_sets, resvg_rgb
 from vecfit.io.colors import parse_background
 from vecfit.jobs.config import resolve
 from vecfit.fitting.metrics import compare, to_rgb
-from vecfit.jobs.fit import Outputs, load_target
+from vecfit.jobs.fit import load_target
+from vecfit.jobs.protocol import Inputs, Outputs
 from vecfit.jobs.refine import run as refine
 from vecfit.renderer.stopwatch import Stopwatch
 
@@ -50,7 +51,7 @@ def main() -> None:
             outputs = Outputs.beside(Path(tmp) / TARGETS[name])
             with warnings.catch_warnings(), Stopwatch() as watch:
                 warnings.simplefilter("ignore")
-                report = refine(target_path, svg_path, config, outputs)
+                report = refine(Inputs(image=target_path, svg=svg_path), config, outputs)
             target = load_target(target_path)
             bg = parse_background(report["background"])
             goal = to_rgb(target, bg)

@@ -30,7 +30,7 @@ import numpy as np
 from PIL import Image
 
 from vecfit.jobs.config import resolve
-from vecfit.jobs.fit import Outputs
+from vecfit.jobs.protocol import Inputs, Outputs
 from vecfit.jobs.retarget import run as retarget
 
 SALIENT = {"cat": (0xF9, 0xF4, 0xEA), "ice_cream": (0x1C, 0xA8, 0xE0)}
@@ -94,7 +94,8 @@ def main() -> None:
             start = time.perf_counter()
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                report = retarget(src, config, outputs, width=args.width)
+                report = retarget(Inputs(svg=src), {**config, "retarget": {**config["retarget"], "width": args.width}},
+                                  outputs)
             seconds = time.perf_counter() - start
             before, after = resvg_rgba(src), resvg_rgba(outputs.svg)
             h, w = before.shape[:2]

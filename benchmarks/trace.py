@@ -124,7 +124,7 @@ def refine_table(budgets, images, iterations, threads, sets=()):
     from vecfit.io.colors import parse_background
     from vecfit.jobs.config import resolve
     from vecfit.fitting.metrics import compare
-    from vecfit.jobs.fit import Outputs
+    from vecfit.jobs.protocol import Inputs, Outputs
     from vecfit.jobs.trace import run as trace
     from common import parse_sets, resvg_rgb  # (benchmarks/ is on sys.path: the script's own folder)
     from refine import print_breakdown
@@ -150,7 +150,7 @@ def refine_table(budgets, images, iterations, threads, sets=()):
                 config = resolve("trace", overrides=overrides)
                 out = Outputs.beside(target, Path(tmp) / f"{name}_{b}.svg")
                 with Stopwatch() as watch:
-                    rep = trace(target, config, out)
+                    rep = trace(Inputs(image=target), config, out)
                 breakdowns.append((f"{name} at {b} paths", watch.laps, rep.get("coarse_iterations", 0)))
                 bg = parse_background(rep["background"])
                 theirs = resvg_rgb(out.svg, image.shape[1], bg)

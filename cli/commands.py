@@ -250,14 +250,14 @@ def _resolve_config(command, preset, config_file, options, extra=None):
 
 
 class _ProgressBar:
-    """An Adam progress bar on stderr, with the loss; silent when quiet. It appears with
-    the first iteration, so an error in the inputs is not preceded by a bar (or, in a log,
-    by the bar's label alone)."""
+    """A job's listener (vecfit.jobs.protocol.Progress): an Adam progress bar on stderr,
+    with the loss, whose length the job gives; its status lines; silent when quiet. The
+    bar appears with the first iteration, so an error in the inputs is not preceded by a
+    bar (or, in a log, by the bar's label alone)."""
 
-    def __init__(self, label: str, iterations: int, quiet: bool):
-        self.make = None if quiet or iterations == 0 else lambda: click.progressbar(
-            length=iterations, label=label, file=sys.stderr, show_pos=True, show_eta=True,
-            item_show_func=lambda p: None if p is None else f"loss {p.loss:.5g}")
+    def __init__(self, label: str, quiet: bool):
+        self.label, self.quiet = label, quiet
+        self.make = None
         self.bar = None
 
     def __enter__(self):
@@ -266,6 +266,17 @@ class _ProgressBar:
     def __exit__(self, *exc):
         if self.bar is not None:
             self.bar.__exit__(*exc)
+
+    def start(self, iterations: int) -> None:
+        if self.quiet or iterations == 0 or self.bar is not None:
+            return
+        self.make = lambda: click.progressbar(
+            length=iterations, label=self.label, file=sys.stderr, show_pos=True, show_eta=True,
+            item_show_func=lambda p: None if p is None else f"loss {p.loss:.5g}")
+
+    def status(self, message: str) -> None:
+        if not self.quiet:
+            _echo_err(message)
 
     def __call__(self, progress) -> None:
         if self.make is None:
@@ -276,13 +287,19 @@ class _ProgressBar:
         self.bar.update(1, current_item=progress)
 
 
-def _run_job(label, iterations, quiet, job):
-    """Runs an optimising job with a progress bar; user errors and Ctrl-C end it cleanly."""
+# The progress bar's label of each job.
+_LABELS = {"refine": "refine", "trace": "refine", "paint": "paint", "edit": "edit", "retarget": "retarget"}
+
+
+def _run_job(name, inputs, config, outputs, quiet):
+    """Runs the job ``name`` (vecfit.jobs.protocol) with a progress bar; user errors and
+    Ctrl-C end it cleanly."""
     from vecfit.errors import VecfitError
+    from vecfit.jobs.protocol import job_function
 
     try:
-        with _ProgressBar(label, iterations, quiet) as bar:
-            report = job(bar)
+        with _ProgressBar(_LABELS[name], quiet) as bar:
+            report = job_function(name)(inputs, config, outputs, progress=bar)
     except VecfitError as e:
         _echo_err(f"error: {e}")
         sys.exit(EXIT_FAILED)
@@ -311,13 +328,11 @@ def _summarise(report) -> None:
 @optimize_options
 def refine(target, init_svg, output, report, comparison, config_file, quiet, **options):
     """Optimise INIT_SVG's control points, colours and stroke widths to match TARGET."""
-    from vecfit.jobs.fit import Outputs
-    from vecfit.jobs.refine import run as run_refine
+    from vecfit.jobs.protocol import Inputs, Outputs
 
     config = _resolve_config("refine", None, config_file, options)
-    outputs = Outputs.beside(Path(target), output, report, comparison)
-    _run_job("refine", config["optimize"]["iterations"], quiet,
-             lambda bar: run_refine(target, init_svg, config, outputs, progress=bar))
+    inputs = Inputs(image=target, svg=init_svg)
+    _run_job("refine", inputs, config, Outputs.beside(inputs.main, output, report, comparison), quiet)
 
 
 
@@ -335,16 +350,14 @@ def refine(target, init_svg, output, report, comparison, config_file, quiet, **o
 def trace(target, preset, paths, colors, min_area, tolerance, refine, output, report, comparison,
           config_file, quiet, **options):
     """Trace TARGET into an SVG (colour regions fitted with cubic curves), then refine it."""
-    from vecfit.jobs.fit import Outputs
-    from vecfit.jobs.trace import run as run_trace
+    from vecfit.jobs.protocol import Inputs, Outputs
 
+    if not refine:
+        options["iterations"] = 0  # the trace written as it is
     config = _resolve_config("trace", preset, config_file, options, extra={"trace": {
         "paths": paths, "colors": colors, "min_area": min_area, "tolerance": tolerance}})
-    outputs = Outputs.beside(Path(target), output, report, comparison)
-    iterations = config["optimize"]["iterations"] if refine else 0
-    status = None if quiet else _echo_err
-    _run_job("refine", iterations, quiet,
-             lambda bar: run_trace(target, config, outputs, progress=bar, refine=refine, status=status))
+    inputs = Inputs(image=target)
+    _run_job("trace", inputs, config, Outputs.beside(inputs.main, output, report, comparison), quiet)
 
 
 @main.command()
@@ -359,14 +372,12 @@ def trace(target, preset, paths, colors, min_area, tolerance, refine, output, re
 def paint(target, paths, kind, preset, frames, output, report, comparison, config_file, quiet,
           **options):
     """Paint TARGET with random strokes or shapes fitted by gradient descent."""
-    from vecfit.jobs.fit import Outputs
-    from vecfit.jobs.paint import run as run_paint
+    from vecfit.jobs.protocol import Inputs, Outputs
 
     config = _resolve_config("paint", preset, config_file, options,
                              extra={"paint": {"paths": paths, "kind": kind}})
-    outputs = Outputs.beside(Path(target), output, report, comparison)
-    _run_job("paint", config["optimize"]["iterations"], quiet,
-             lambda bar: run_paint(target, config, outputs, progress=bar, frames=frames))
+    inputs = Inputs(image=target)
+    _run_job("paint", inputs, config, Outputs.beside(inputs.main, output, report, comparison, frames), quiet)
 
 
 @main.command()
@@ -381,13 +392,11 @@ def edit(init_svg, edited, mask, output, report, comparison, config_file, quiet,
     parameters are fitted to EDITED, changing as little as possible outside the edit.
     Writes NAME.vecfit.svg (elements, ids and groups kept), a report and a comparison
     picture (original | edited | result | difference)."""
-    from vecfit.jobs.edit import run as run_edit
-    from vecfit.jobs.fit import Outputs
+    from vecfit.jobs.protocol import Inputs, Outputs
 
     config = _resolve_config("edit", None, config_file, options)
-    outputs = Outputs.beside(Path(edited), output, report, comparison)
-    _run_job("edit", config["optimize"]["iterations"], quiet,
-             lambda bar: run_edit(edited, init_svg, config, outputs, progress=bar, mask=mask))
+    inputs = Inputs(image=edited, svg=init_svg, mask=mask)
+    _run_job("edit", inputs, config, Outputs.beside(inputs.main, output, report, comparison), quiet)
 
 @main.command()
 @click.argument("svg", type=click.Path(dir_okay=False))
@@ -402,28 +411,14 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
     group kept), a report and a comparison picture (input | plain scaling | retargeted).
     --iterations N sets the Adam iterations of the whole run, divided between the rounds
     and the final fit as configs/retarget.toml divides them."""
-    from vecfit.jobs.fit import Outputs
-    from vecfit.jobs.retarget import run as run_retarget
+    from vecfit.jobs.protocol import Inputs, Outputs
 
+    # --iterations is the whole run's: the job divides it between its rounds
+    total, options["iterations"] = options["iterations"], None
     config = _resolve_config("retarget", None, config_file, options,
-                             extra={"retarget": {"width": width, "height": height}})
-    outputs = Outputs.beside(Path(svg), output, report, comparison)
-    r = config["retarget"]
-    rounds = r["steps"] * (2 if height is not None else 1)
-    if options["iterations"] is not None:
-        _divide_iterations(r, rounds, options["iterations"])
-    _run_job("retarget", rounds * r["iterations_per_step"] + r["final_iterations"], quiet,
-             lambda bar: run_retarget(svg, config, outputs, progress=bar))
-
-
-def _divide_iterations(r: dict, rounds: int, total: int) -> None:
-    """retarget --iterations N: N Adam iterations in all, divided between the rounds and the
-    final fit in the proportions of the config (40 a round and 60 at the end by default: 150
-    gives 20 a round and 30 at the end)."""
-    planned = rounds * r["iterations_per_step"] + r["final_iterations"]
-    per_round = total * r["iterations_per_step"] // planned if planned else 0
-    r["iterations_per_step"] = per_round
-    r["final_iterations"] = total - rounds * per_round
+                             extra={"retarget": {"width": width, "height": height, "iterations": total}})
+    inputs = Inputs(svg=svg)
+    _run_job("retarget", inputs, config, Outputs.beside(inputs.main, output, report, comparison), quiet)
 
 
 # ------------------------------------------------------------------------------ batch

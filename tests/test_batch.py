@@ -234,24 +234,24 @@ def test_interrupted_image_is_not_taken_as_finished(folder, tmp_path, monkeypatc
     assert json.loads((out / "b.report.json").read_text())["interrupted"] is False
 
 
-# Job functions standing in for refine (same signature), found by "test_batch:NAME" in
+# Job functions standing in for refine (the job protocol's signature), found by "test_batch:NAME" in
 # this process or in a worker process.
 
-def exploding_refine(target, svg, config, outputs, progress=None):
-    if Path(target).stem == "a":
+def exploding_refine(inputs, config, outputs, progress=None):
+    if inputs.image.stem == "a":
         raise RuntimeError("boom")
     from vecfit.jobs.refine import run as refine
-    report = refine(target, svg, config, outputs, progress=progress)
-    if Path(target).stem == "b":
+    report = refine(inputs, config, outputs, progress=progress)
+    if inputs.image.stem == "b":
         report["optimized"]["mse"] = math.nan
     return report
 
 
-def crashing_refine(target, svg, config, outputs, progress=None):
-    if Path(target).stem == "crash":
+def crashing_refine(inputs, config, outputs, progress=None):
+    if inputs.image.stem == "crash":
         os._exit(3)  # as a crash in native code would end the worker
     from vecfit.jobs.refine import run as refine
-    return refine(target, svg, config, outputs, progress=progress)
+    return refine(inputs, config, outputs, progress=progress)
 
 
 def test_unexpected_exceptions_and_nan_are_recorded(folder, tmp_path):

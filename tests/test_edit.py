@@ -255,7 +255,7 @@ def test_batch_edit_pairs_each_edited_image_with_its_svg(drawing, tmp_path):
 
 def test_ctrl_c_writes_the_best_result_so_far(drawing, tmp_path):
     from vecfit.jobs.edit import run as edit
-    from vecfit.jobs.fit import Outputs
+    from vecfit.jobs.protocol import Inputs, Outputs
 
     def stop(progress):
         if progress.iteration == 5:
@@ -263,7 +263,7 @@ def test_ctrl_c_writes_the_best_result_so_far(drawing, tmp_path):
 
     config = resolve("edit", overrides={"optimize": {"threads": 2, "iterations": 50}})
     outputs = Outputs.beside(drawing / "edited.png", tmp_path / "stopped.svg")
-    report = edit(drawing / "edited.png", drawing / "drawing.svg", config, outputs, progress=stop)
+    report = edit(Inputs(image=drawing / "edited.png", svg=drawing / "drawing.svg"), config, outputs, progress=stop)
     assert report["interrupted"] is True and report["iterations"] == 5
     assert structure(outputs.svg) == structure(drawing / "drawing.svg")
     assert json.loads(outputs.report.read_text())["interrupted"] is True

@@ -163,7 +163,7 @@ def test_ctrl_c_writes_the_best_result_so_far(picture):
     """Interrupted in the first round: the SVG is written at that round's width, with
     every element, and the report says so."""
     from vecfit.jobs.config import resolve
-    from vecfit.jobs.fit import Outputs
+    from vecfit.jobs.protocol import Inputs, Outputs
     from vecfit.jobs.retarget import run as retarget
 
     calls = []
@@ -173,9 +173,10 @@ def test_ctrl_c_writes_the_best_result_so_far(picture):
         if len(calls) == 10:
             raise KeyboardInterrupt
 
-    config = resolve("retarget", config_file=picture / "fast.toml", overrides={"optimize": {"threads": 2}})
+    config = resolve("retarget", config_file=picture / "fast.toml",
+                     overrides={"optimize": {"threads": 2}, "retarget": {"width": "50%"}})
     outputs = Outputs.beside(picture / "picture.svg", picture / "stopped.svg")
-    report = retarget(picture / "picture.svg", config, outputs, progress=stop, width="50%")
+    report = retarget(Inputs(svg=picture / "picture.svg"), config, outputs, progress=stop)
     assert report["interrupted"] is True and report["iterations"] == 10
     width = float(ET.parse(outputs.svg).getroot().get("width"))
     assert width == pytest.approx(72)  # stopped in the first of two rounds: half the seams

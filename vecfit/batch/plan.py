@@ -15,17 +15,16 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from vecfit.jobs.fit import Outputs, same_path
+from vecfit.jobs.protocol import JOB_MODULES, Inputs, Outputs, same_path
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp")
 SVG_SUFFIXES = (".svg", ".svgz")
 MODES = ("refine", "trace", "paint", "edit", "retarget")
 PAIRED = ("refine", "edit")  # modes that pair each image with the SVG of its name
 ON_SVGS = ("retarget",)      # modes whose inputs are the SVGs in IN_DIR, not images
-# The job function of each mode, as "module:function", imported where the task runs.
-JOBS = {"refine": "vecfit.jobs.refine:run", "trace": "vecfit.jobs.trace:run",
-        "paint": "vecfit.jobs.paint:run", "edit": "vecfit.jobs.edit:run",
-        "retarget": "vecfit.jobs.retarget:run"}
+# The job function of each mode (vecfit.jobs.protocol), as "module:function", imported
+# where the task runs.
+JOBS = {mode: f"{JOB_MODULES[mode]}:run" for mode in MODES}
 
 # Statuses of a summary row.
 DONE = "done"
@@ -59,6 +58,11 @@ class Task:
 
     def outputs(self) -> Outputs:
         return Outputs(Path(self.svg), Path(self.report), Path(self.comparison))
+
+    def inputs(self) -> Inputs:
+        if self.mode in ON_SVGS:  # the "image" is the SVG to work on
+            return Inputs(svg=Path(self.image))
+        return Inputs(image=Path(self.image), svg=None if self.init_svg is None else Path(self.init_svg))
 
 
 @dataclass

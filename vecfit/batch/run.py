@@ -1,8 +1,8 @@
 """Running a batch: the plan made, the images handed to an executor, the summary
 written, stale temporaries swept; resumable after Ctrl-C or a crash.
 
-The per-image work is the commands' own job functions (vecfit.jobs.refine.run,
-vecfit.jobs.trace.run, vecfit.jobs.paint.run, vecfit.jobs.edit.run), called by vecfit.batch.work.run_task."""
+The per-image work is the commands' own job functions (vecfit.jobs.protocol: every
+job run alike), called by vecfit.batch.work.run_task."""
 from __future__ import annotations
 
 import copy
@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from vecfit.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, VecfitError
-from vecfit.jobs.fit import same_path
+from vecfit.jobs.protocol import same_path
 
 from .plan import FAILED, INTERRUPTED, MODES, NOT_RUN, PAIRED, UNPAIRED, make_plan, result_row
 from .summary import SUMMARY_FILES, THUMBS, count, write_all

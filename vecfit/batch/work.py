@@ -1,5 +1,5 @@
 """The per-image function that runs where the work is done: in this process, in a worker
-process of this machine or on a Dask worker. It calls the command's job function and
+process of this machine or on a Dask worker. It calls the command's job function (vecfit.jobs.protocol) and
 turns whatever happens into a summary row; it never raises for one image's trouble.
 
 Ctrl-C in a worker process: the first SIGINT while a job runs raises KeyboardInterrupt
@@ -69,11 +69,7 @@ def _remove_outputs(task: Task) -> None:
 
 
 def _call(task: Task):
-    job = load_job(task.job)
-    outputs = task.outputs()
-    if task.init_svg is not None:  # refine, edit: the image and its SVG
-        return job(task.image, task.init_svg, task.config, outputs, progress=None)
-    return job(task.image, task.config, outputs, progress=None)
+    return load_job(task.job)(task.inputs(), task.config, task.outputs(), progress=None)
 
 
 def run_task(task: Task) -> dict:

@@ -40,6 +40,7 @@ class RetargetSettings:
     steps: int = 6                 # carve-and-fit rounds
     iterations_per_step: int = 40  # Adam iterations fitting each round's carved image
     final_iterations: int = 60     # more at the end, against the last carved image
+    iterations: int = 0            # > 0: the whole run's iterations, divided as the two above
     work_size: int = 512           # carve and fit at this longest side (0: the SVG's size)
     foreground: float = 1.0        # seam energy added per pixel unlike the bare canvas
 
@@ -47,7 +48,7 @@ class RetargetSettings:
     def check(self) -> None:
         if self.steps < 1:
             raise VecfitError(f"retarget.steps must be at least 1, not {self.steps}")
-        for name in ("iterations_per_step", "final_iterations", "work_size"):
+        for name in ("iterations_per_step", "final_iterations", "iterations", "work_size"):
             if getattr(self, name) < 0:
                 raise VecfitError(f"retarget.{name} must be 0 or more, not {getattr(self, name)}")
         if not (math.isfinite(self.foreground) and self.foreground >= 0):

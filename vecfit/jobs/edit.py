@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import math
 import time
-from pathlib import Path
 
 import numpy as np
 import torch
@@ -27,7 +26,8 @@ from vecfit.svg.numbers import hex_color
 from vecfit.svg.write import write_svg
 
 from .config import settings_of
-from .fit import Outputs, _render_full, background_for, load_scene_to_fit, load_target
+from .fit import _render_full, background_for, load_scene_to_fit, load_target
+from .protocol import Inputs, Outputs, listener
 
 MOVED_PX = 0.1        # an element counts as changed when a length moved this many pixels
 RECOLOURED = 1.5 / 255  # ... or a colour channel more than a step of #rrggbb
@@ -84,13 +84,15 @@ def changed_elements(scene: Scene, before: dict, width: int, height: int) -> lis
     return out
 
 
-def run(edited_path, svg_path, config: dict, outputs: Outputs, progress=None, mask=None) -> dict:
-    """`vecfit edit`: fit SVG_PATH to EDITED_PATH, changing as little as it can outside the
-    changed region (computed, or ``mask``, a PNG where white marks it). Writes the SVG, the
-    comparison picture (original | edited | result | difference) and the report (last)."""
+def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
+    """`vecfit edit`: fit the SVG (inputs.svg) to the edited render (inputs.image), changing
+    as little as it can outside the changed region (computed, or inputs.mask, a PNG where
+    white marks it). Writes the SVG, the comparison picture (original | edited | result |
+    difference) and the report (last)."""
     started = time.perf_counter()
-    edited_path, svg_path = Path(edited_path), Path(svg_path)
-    outputs.check_against(edited_path, svg_path, mask)
+    inputs.need("edit", "image", "svg")
+    edited_path, svg_path, mask, progress = inputs.image, inputs.svg, inputs.mask, listener(progress)
+    outputs.check_against(inputs)
     outputs.report.unlink(missing_ok=True)  # a report marks a finished run
     target = load_target(edited_path)
     scene, document = load_scene_to_fit(svg_path)
@@ -136,6 +138,7 @@ def run(edited_path, svg_path, config: dict, outputs: Outputs, progress=None, ma
     before = {id(t): t.detach().clone() for k in kinds for t in scene.parameters()[k]}
 
     goal = Target(torch.from_numpy(small), background, torch.from_numpy(weight))
+    progress.start(settings.iterations)
     result = optimize(scene, goal, settings, progress=progress, penalty=penalty)
     final_image = original_image if result.iterations == 0 else _render_full(scene, w, h, opt).numpy()
 

@@ -6,8 +6,6 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import torch
@@ -27,44 +25,11 @@ from vecfit.svg.document import SvgDocument
 from vecfit.svg.read import read_svg, scene_of
 from vecfit.svg.write import write_svg
 
+from .protocol import Outputs, listener
+
 OPAQUE = 0.999  # a target whose every alpha is at least this is treated as opaque
 ASPECT_TOLERANCE = 0.01
 MIN_SIDE = 11
-
-
-@dataclass
-class Outputs:
-    svg: Path
-    report: Path
-    comparison: Path
-
-    @classmethod
-    def beside(cls, target: Path, svg: Path | None = None, report: Path | None = None,
-               comparison: Path | None = None) -> "Outputs":
-        """Defaults: NAME.vecfit.svg next to the target; the report and the picture
-        take the SVG's name with .report.json and .compare.png."""
-        svg = Path(svg) if svg else target.with_name(target.stem + ".vecfit.svg")
-        stem = svg.with_suffix("") if svg.suffix.lower() in (".svg", ".svgz") else svg
-        return cls(svg, Path(report) if report else stem.with_name(stem.name + ".report.json"),
-                   Path(comparison) if comparison else stem.with_name(stem.name + ".compare.png"))
-
-    def check_against(self, *inputs) -> None:
-        """Refuses outputs that would overwrite an input or each other."""
-        paths = [self.svg, self.report, self.comparison]
-        for out in paths:
-            for src in inputs:
-                if src is not None and same_path(out, Path(src)):
-                    raise VecfitError(f"{out}: output would overwrite the input {src}; choose another name")
-        if len({p.resolve() for p in paths}) < len(paths):
-            raise VecfitError("the SVG, report and comparison outputs must be different files")
-
-
-def same_path(a: Path, b: Path) -> bool:
-    """Whether two paths name the same file or folder (False when one cannot be resolved)."""
-    try:
-        return a.resolve() == b.resolve()
-    except OSError:
-        return False
 
 
 # ------------------------------------------------------------------------- target
@@ -142,6 +107,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     extra report entries (a callable value is called when the report is made); ``hooks``
     and ``keep_alpha`` go to the optimisation loop."""
     started = time.perf_counter()
+    progress = listener(progress)
     # The report marks a finished run: an old one must not sit beside new outputs if this
     # run dies before it writes its own.
     outputs.report.unlink(missing_ok=True)
@@ -162,6 +128,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     initial_image = _render_full(scene, sw, sh, opt)
     initial_rgb = to_rgb(initial_image.numpy(), background)
     initial = compare(initial_rgb, target_rgb)
+    progress.start(settings.iterations)
     result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
     final_image = initial_image if result.iterations == 0 else _render_full(scene, sw, sh, opt)
     final_rgb = to_rgb(final_image.numpy(), background)

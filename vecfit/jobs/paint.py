@@ -2,19 +2,20 @@
 loop of `vecfit refine`, with re-seeding and optional frames."""
 from __future__ import annotations
 
-from pathlib import Path
-
 from vecfit.initial.strokes import PaintSettings, Reseeder, initial_document
 from vecfit.io.frames import FrameSaver
 
 from .config import settings_of
-from .fit import Outputs, fit_and_write, generated_scene, load_target
+from .fit import fit_and_write, generated_scene, load_target
+from .protocol import Inputs, Outputs
 
 
-def run(target_path, config: dict, outputs: Outputs, progress=None, frames=None) -> dict:
-    """`vecfit paint`: writes SVG, report and comparison (and frames into ``frames``)."""
-    target_path = Path(target_path)
-    outputs.check_against(target_path)
+def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
+    """`vecfit paint`: random strokes or shapes fitted to inputs.image; writes SVG, report
+    and comparison (and frames into outputs.frames, when given)."""
+    inputs.need("paint", "image")
+    target_path, frames = inputs.image, outputs.frames
+    outputs.check_against(inputs)
     target = load_target(target_path)
     settings = settings_of(PaintSettings, config["paint"], seed=config["optimize"]["seed"])
     reseeder = Reseeder(settings, config["optimize"]["iterations"])

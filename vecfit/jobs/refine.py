@@ -2,15 +2,16 @@
 vecfit.jobs.fit)."""
 from __future__ import annotations
 
-from pathlib import Path
+from .fit import check_sizes, fit_and_write, load_scene_to_fit, load_target
+from .protocol import Inputs, Outputs
 
-from .fit import Outputs, check_sizes, fit_and_write, load_scene_to_fit, load_target
 
-
-def run(target_path, svg_path, config: dict, outputs: Outputs, progress=None) -> dict:
-    """`vecfit refine`: load, check and fit; see vecfit.jobs.fit.fit_and_write."""
-    target_path, svg_path = Path(target_path), Path(svg_path)
-    outputs.check_against(target_path, svg_path)
+def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
+    """`vecfit refine`: the SVG (inputs.svg) fitted to the image (inputs.image); see
+    vecfit.jobs.fit.fit_and_write and the job protocol (protocol.py)."""
+    inputs.need("refine", "image", "svg")
+    target_path, svg_path = inputs.image, inputs.svg
+    outputs.check_against(inputs)
     target = load_target(target_path)
     scene, document = load_scene_to_fit(svg_path)
     check_sizes(scene, target, svg_path, target_path)

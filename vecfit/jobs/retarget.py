@@ -14,7 +14,6 @@ from __future__ import annotations
 import math
 import re
 import time
-from pathlib import Path
 
 import cv2
 import numpy as np
@@ -34,7 +33,8 @@ from vecfit.svg.numbers import hex_color
 from vecfit.svg.write import write_svg
 
 from .config import settings_of
-from .fit import Outputs, background_for, load_scene_to_fit
+from .fit import background_for, load_scene_to_fit
+from .protocol import Inputs, Outputs, listener
 
 MIN_SIDE = 11
 _SIZE = re.compile(r"\s*(\d+(?:\.\d*)?|\.\d+)\s*(%|px)?\s*$")
@@ -55,18 +55,28 @@ def _rounds(total: int, steps: int) -> list[int]:
     return [total // steps + (1 if i < total % steps else 0) for i in range(steps)] if total else []
 
 
-def run(svg_path, config: dict, outputs: Outputs, progress=None, width=None, height=None) -> dict:
-    """`vecfit retarget`: writes the resized SVG, the comparison picture (input | plain
-    scaling | retargeted) and the report (last)."""
+def divided_iterations(total: int, rounds: int, per_round: int, final: int) -> tuple[int, int]:
+    """``total`` Adam iterations divided between ``rounds`` rounds and the final fit in the
+    proportions of ``per_round`` and ``final`` (40 a round and 60 at the end, 6 rounds:
+    150 gives 20 a round and 30 at the end)."""
+    planned = rounds * per_round + final
+    each = total * per_round // planned if planned else 0
+    return each, total - rounds * each
+
+
+def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
+    """`vecfit retarget`: the SVG (inputs.svg) resized to retarget.width / height; writes
+    the resized SVG, the comparison picture (input | plain scaling | retargeted) and the
+    report (last)."""
     started = time.perf_counter()
-    svg_path = Path(svg_path)
-    outputs.check_against(svg_path)
+    inputs.need("retarget", "svg")
+    svg_path, progress = inputs.svg, listener(progress)
+    outputs.check_against(inputs)
     outputs.report.unlink(missing_ok=True)  # a report marks a finished run
     retarget = settings_of(RetargetSettings, config["retarget"])
     retarget.check()
-    # (arguments win over the config's retarget.width / height, which batch runs use)
-    width = width if width is not None else (str(retarget.width).strip() or None)
-    height = height if height is not None else (str(retarget.height).strip() or None)
+    width = str(retarget.width).strip() or None
+    height = str(retarget.height).strip() or None
     if width is None and height is None:
         raise VecfitError("no new size: give --width (or --height), or retarget.width in the config")
     scene, document = load_scene_to_fit(svg_path)
@@ -110,6 +120,12 @@ def run(svg_path, config: dict, outputs: Outputs, progress=None, width=None, hei
                        salience=retarget.foreground * foreground(look, empty))
     plan = [(0, chunk) for chunk in _rounds(len(seams_w), retarget.steps)]
     plan += [(1, chunk) for chunk in _rounds(len(seams_h), retarget.steps)]
+    if retarget.iterations > 0:  # the whole run's iterations, divided as the config divides them
+        retarget.iterations_per_step, retarget.final_iterations = divided_iterations(
+            retarget.iterations, len(plan), retarget.iterations_per_step, retarget.final_iterations)
+        config = {**config, "retarget": {**config["retarget"], "iterations_per_step": retarget.iterations_per_step,
+                                         "final_iterations": retarget.final_iterations}}
+    progress.start(len(plan) * retarget.iterations_per_step + retarget.final_iterations)
 
     loop = Settings(**{**settings.__dict__, "iterations": retarget.iterations_per_step})
     cur_w, cur_h = ww, wh

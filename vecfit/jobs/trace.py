@@ -2,32 +2,27 @@
 it with the same loop as `vecfit refine` (vecfit.jobs.fit.fit_and_write)."""
 from __future__ import annotations
 
-from pathlib import Path
-
 from vecfit.errors import VecfitError
 from vecfit.initial.trace import TraceSettings, trace_image
 from vecfit.scene import Rect, Solid
 
 from .config import settings_of
-from .fit import Outputs, fit_and_write, generated_scene, load_target
+from .fit import fit_and_write, generated_scene, load_target
+from .protocol import Inputs, Outputs, listener
 
 
-def run(target_path, config: dict, outputs: Outputs, progress=None, refine: bool = True,
-          status=None) -> dict:
-    """`vecfit trace`: trace TARGET, refine the trace (unless ``refine`` is False, which
-    writes the trace as it is, with its report), write SVG, report and comparison."""
-    target_path = Path(target_path)
-    outputs.check_against(target_path)
+def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
+    """`vecfit trace`: trace the image, refine the trace (optimize.iterations 0 writes the
+    trace as it is, with its report), write SVG, report and comparison."""
+    inputs.need("trace", "image")
+    target_path, progress = inputs.image, listener(progress)
+    outputs.check_against(inputs)
     target = load_target(target_path)
     settings = settings_of(TraceSettings, config["trace"], seed=config["optimize"]["seed"])
-    if status is not None:
-        status(f"tracing {target_path} ({target.shape[1]}x{target.shape[0]})")
+    progress.status(f"tracing {target_path} ({target.shape[1]}x{target.shape[0]})")
     traced = trace_image(target, settings)
-    if status is not None:
-        status(f"traced: {traced.paths} paths, {traced.segments} segments, {traced.colors} colours "
-               f"in {traced.seconds:.1f} s")
-    if not refine:
-        config = {**config, "optimize": {**config["optimize"], "iterations": 0}}
+    progress.status(f"traced: {traced.paths} paths, {traced.segments} segments, {traced.colors} colours "
+                    f"in {traced.seconds:.1f} s")
     scene = generated_scene(traced.document)
     if not scene.shapes:
         raise VecfitError(f"{target_path}: nothing to trace (the image is fully transparent)")

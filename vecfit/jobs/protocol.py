@@ -1,0 +1,122 @@
+"""The one shape of every job, for the command line, batch and Python alike:
+
+    report = run(inputs, config, outputs, progress)
+
+``inputs`` names the files a job reads (Inputs), ``config`` is the resolved settings
+(config.resolve), ``outputs`` the files it writes (Outputs), ``progress`` an optional
+listener (Progress) that the job tells how many Adam iterations it will run before it
+runs them, then each iteration, and what it is doing. The report is a dict, also written
+as JSON last (a report on disk marks a finished run).
+"""
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from vecfit.errors import VecfitError
+
+# The jobs, by command name: each module has run(inputs, config, outputs, progress=None).
+JOB_MODULES = {name: f"vecfit.jobs.{name}" for name in ("refine", "trace", "paint", "edit", "retarget")}
+
+
+def job_function(name: str) -> Callable[..., dict]:
+    """The run function of the job called ``name`` (its module imported only now)."""
+    return importlib.import_module(JOB_MODULES[name]).run
+
+
+@dataclass(frozen=True)
+class Inputs:
+    image: Path | None = None  # the target (refine, trace, paint) or the edited render (edit)
+    svg: Path | None = None    # the SVG to start from (refine, edit, retarget)
+    mask: Path | None = None   # edit: white where the edit is (default: where it differs)
+
+    def __post_init__(self):
+        for name in ("image", "svg", "mask"):
+            value = getattr(self, name)
+            if value is not None and not isinstance(value, Path):
+                object.__setattr__(self, name, Path(value))
+
+    def need(self, job: str, *names: str) -> None:
+        missing = [n for n in names if getattr(self, n) is None]
+        if missing:
+            raise VecfitError(f"{job}: no {' and no '.join(missing)} given")
+
+    @property
+    def main(self) -> Path:
+        """The input that outputs are named after: the image, else the SVG."""
+        return self.image if self.image is not None else self.svg
+
+    def files(self) -> list[Path]:
+        return [p for p in (self.image, self.svg, self.mask) if p is not None]
+
+
+@dataclass
+class Outputs:
+    svg: Path
+    report: Path
+    comparison: Path
+    frames: Path | None = None  # paint: a folder for frame_NNNNN.png and a GIF
+
+    @classmethod
+    def beside(cls, main: Path, svg: Path | None = None, report: Path | None = None,
+               comparison: Path | None = None, frames: Path | None = None) -> "Outputs":
+        """Defaults: NAME.vecfit.svg next to ``main`` (the input outputs are named after);
+        the report and the picture take the SVG's name with .report.json and .compare.png."""
+        main = Path(main)
+        svg = Path(svg) if svg else main.with_name(main.stem + ".vecfit.svg")
+        stem = svg.with_suffix("") if svg.suffix.lower() in (".svg", ".svgz") else svg
+        return cls(svg, Path(report) if report else stem.with_name(stem.name + ".report.json"),
+                   Path(comparison) if comparison else stem.with_name(stem.name + ".compare.png"),
+                   None if frames is None else Path(frames))
+
+    def check_against(self, inputs: Inputs) -> None:
+        """Refuses outputs that would overwrite an input or each other."""
+        paths = [self.svg, self.report, self.comparison]
+        for out in paths:
+            for src in inputs.files():
+                if same_path(out, src):
+                    raise VecfitError(f"{out}: output would overwrite the input {src}; choose another name")
+        if len({p.resolve() for p in paths}) < len(paths):
+            raise VecfitError("the SVG, report and comparison outputs must be different files")
+
+
+def same_path(a: Path, b: Path) -> bool:
+    """Whether two paths name the same file or folder (False when one cannot be resolved)."""
+    try:
+        return a.resolve() == b.resolve()
+    except OSError:
+        return False
+
+
+class Progress:
+    """What a job tells its listener; subclass and override what you need. A plain
+    callable is accepted too (see ``listener``): it is called per iteration."""
+
+    def start(self, iterations: int) -> None:
+        """Before optimising: the Adam iterations the job will run in all."""
+
+    def __call__(self, step) -> None:
+        """After each iteration (vecfit.fitting.loop.Progress: iteration, loss, ...)."""
+
+    def status(self, message: str) -> None:
+        """A line on what the job is doing (tracing, ...)."""
+
+
+class _Calls(Progress):
+    def __init__(self, function):
+        self.function = function
+
+    def __call__(self, step) -> None:
+        self.function(step)
+
+
+def listener(progress) -> Progress:
+    """``progress`` as a Progress: None listens to nothing, a plain callable gets the
+    iterations."""
+    if progress is None:
+        return Progress()
+    if isinstance(progress, Progress) or all(hasattr(progress, a) for a in ("start", "status")):
+        return progress
+    return _Calls(progress)
