@@ -231,20 +231,32 @@ class Scene:
 
 
 def _copied(value, memo: dict):
-    """``value`` with every tensor and array cloned once (by identity, through ``memo``)."""
+    """``value`` with every tensor and array cloned once (by identity, through ``memo``,
+    so that what is shared stays shared). Dataclasses are copied shallowly and their
+    fields that hold data replaced (a generic field-by-field rebuild took a third of
+    reading a 3,000-path SVG)."""
+    key = id(value)
+    if key in memo:
+        return memo[key]
     if isinstance(value, torch.Tensor):
-        if id(value) not in memo:
-            memo[id(value)] = value.detach().clone()
-        return memo[id(value)]
-    if isinstance(value, np.ndarray):
-        return value.copy()
-    if isinstance(value, list):
+        out = value.detach().clone()
+    elif isinstance(value, np.ndarray):
+        out = value.copy()
+    elif isinstance(value, list):
         return [_copied(v, memo) for v in value]
-    if isinstance(value, dict):
+    elif isinstance(value, dict):
         return {k: _copied(v, memo) for k, v in value.items()}
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        if id(value) not in memo:  # a paint shared by shapes stays shared
-            memo[id(value)] = dataclasses.replace(value, **{
-                f.name: _copied(getattr(value, f.name), memo) for f in dataclasses.fields(value)})
-        return memo[id(value)]
-    return value  # numbers, strings, tuples of them, None
+    elif dataclasses.is_dataclass(value) and not isinstance(value, type):
+        out = object.__new__(type(value))
+        fields = dict(value.__dict__)
+        for k, v in fields.items():
+            if v is not None and not isinstance(v, _PLAIN):
+                fields[k] = _copied(v, memo)
+        out.__dict__ = fields
+    else:
+        return value  # numbers, strings, tuples of them
+    memo[key] = out
+    return out
+
+
+_PLAIN = (str, int, float, bool, tuple)
