@@ -45,7 +45,7 @@ def _counting_parses():
 def _dense_trace(folder: Path, paths: int) -> tuple[Path, Path]:
     from skimage import data
 
-    from vecfit.initial.trace import TraceSettings, trace_image
+    from vecfit.initial.tracer import TraceSettings, trace_image
     image = data.coffee()
     target = folder / "coffee.png"
     Image.fromarray(image).save(target)

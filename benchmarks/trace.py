@@ -51,7 +51,7 @@ def render_svg(svg: str, width: int, height: int) -> np.ndarray:
 def measure(image: np.ndarray, settings) -> dict:
     from skimage.metrics import peak_signal_noise_ratio
 
-    from vecfit.initial.trace import trace_image
+    from vecfit.initial.tracer import trace_image
 
     start = time.perf_counter()
     result = trace_image(image, settings)
@@ -80,7 +80,7 @@ def main():
     budgets = [int(b) for b in args.budgets.split(",")]
     images = args.images.split(",")
 
-    from vecfit.initial.trace import TraceSettings
+    from vecfit.initial.tracer import TraceSettings
 
     defaults = TraceSettings()
     print(f"defaults: colors={defaults.colors} min_area={defaults.min_area} "

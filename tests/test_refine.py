@@ -424,7 +424,7 @@ def test_settings_defaults_are_the_config_defaults():
 @pytest.fixture(scope="module")
 def small_trace(tmp_path_factory):
     """skimage's chelsea at 160 x 106 and a 40-path trace of it (vecfit's tracer)."""
-    from vecfit.initial.trace import TraceSettings, trace_image
+    from vecfit.initial.tracer import TraceSettings, trace_image
     png = photo_png(tmp_path_factory, "chelsea", (160, 106))
     image = load_target(png)
     return image, trace_image(image, TraceSettings(paths=40)).svg

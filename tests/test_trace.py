@@ -10,8 +10,8 @@ from skimage.metrics import peak_signal_noise_ratio
 
 import vecfit
 from vecfit import VecfitError
-from vecfit.initial.trace import TraceResult, TraceSettings, trace_image
-from vecfit.initial.trace.bezier import bezier_at, fit_closed
+from vecfit.initial.tracer import TraceResult, TraceSettings, trace_image
+from vecfit.initial.tracer.bezier import bezier_at, fit_closed
 
 
 # ----------------------------------------------------------------------------- helpers

@@ -23,7 +23,7 @@ __all__ = ["Circle", "Ellipse", "Group", "LinearGradient", "Path", "RadialGradie
            "Shape", "Solid", "SvgError", "VecfitError", "cuda_device_count", "has_cuda", "load_svg",
            "render", "render_batch", "__version__"]
 
-_LAZY = {"render": ".renderer.raster", "render_batch": ".renderer.batch",
+_LAZY = {"render": ".renderer.raster", "render_batch": ".renderer.many",
          "cuda_device_count": ".renderer.device", "has_cuda": ".renderer.device",
          **{name: ".scene" for name in ("Circle", "Ellipse", "Group", "LinearGradient", "Path",
                                                  "RadialGradient", "Rect", "Scene", "Shape", "Solid")}}

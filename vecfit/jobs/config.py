@@ -117,8 +117,8 @@ def validate(settings: dict) -> None:
     Settings.from_config(settings["optimize"])
     seed = settings["optimize"]["seed"]
     if "trace" in settings:
-        from vecfit.initial.trace import TraceSettings
-        from vecfit.initial.trace.settings import check_settings
+        from vecfit.initial.tracer import TraceSettings
+        from vecfit.initial.tracer.settings import check_settings
         check_settings(settings_of(TraceSettings, settings["trace"], seed=seed))
     if "paint" in settings:
         from vecfit.initial.strokes import PaintSettings

@@ -1,9 +1,9 @@
-"""The trace job: a raster image traced into an SVG (vecfit.initial.trace), then refined against
+"""The trace job: a raster image traced into an SVG (vecfit.initial.tracer), then refined against
 it with the same loop as `vecfit refine` (vecfit.jobs.fit.fit_and_write)."""
 from __future__ import annotations
 
 from vecfit.errors import VecfitError
-from vecfit.initial.trace import TraceSettings, trace_image
+from vecfit.initial.tracer import TraceSettings, trace_image
 from vecfit.scene import Rect, Solid
 
 from .config import settings_of

@@ -74,13 +74,13 @@ class Packed:
 
 
 class Packer:
-    """``trace`` (optional, vecfit.renderer.persistent.Provenance): told where each scene
+    """``provenance`` (optional, vecfit.renderer.persistent.Provenance): told where each scene
     tensor's values land in the float arrays, so that a fitting loop can refresh them
     without packing again."""
 
-    def __init__(self, scene: Scene, width: int, height: int, trace=None):
+    def __init__(self, scene: Scene, width: int, height: int, provenance=None):
         self.scene = scene
-        self.trace = trace
+        self.provenance = provenance
         self.out = Packed()
         self.canvas = canvas_matrix(scene, width, height)
         self.group_matrix: list[torch.Tensor] = []
@@ -137,8 +137,8 @@ class Packer:
         out = self.out
         g = m
         if paint.units == "objectBoundingBox":
-            if self.trace:
-                self.trace.used_otherwise(*_geometry_tensors(geometry))
+            if self.provenance:
+                self.provenance.used_otherwise(*_geometry_tensors(geometry))
             box = local_bbox(geometry)
             if box is None:
                 return None
@@ -158,26 +158,26 @@ class Packer:
         if isinstance(paint, LinearGradient):
             params = torch.cat([to_paint, paint.start.float(), paint.end.float(), torch.zeros(1)])
             kind = BRUSH_LINEAR
-            if self.trace:
-                self.trace.copy("brush_params", first + 6, paint.start)
-                self.trace.copy("brush_params", first + 8, paint.end)
+            if self.provenance:
+                self.provenance.copy("brush_params", first + 6, paint.start)
+                self.provenance.copy("brush_params", first + 8, paint.end)
         elif isinstance(paint, RadialGradient):
             # SVG 2 semantics, as resvg and browsers draw it: a focal point outside the
             # circle makes a cone, and the area outside the cone is not painted.
             c, f, r = paint.center.float(), paint.focal.float(), paint.radius.float().reshape(1)
             params = torch.cat([to_paint, c, r, f])
             kind = BRUSH_RADIAL
-            if self.trace:
-                self.trace.copy("brush_params", first + 6, paint.center)
-                self.trace.copy("brush_params", first + 8, paint.radius)
-                self.trace.copy("brush_params", first + 9, paint.focal)
+            if self.provenance:
+                self.provenance.copy("brush_params", first + 6, paint.center)
+                self.provenance.copy("brush_params", first + 8, paint.radius)
+                self.provenance.copy("brush_params", first + 9, paint.focal)
         else:
             raise VecfitError(f"unknown paint {type(paint).__name__}")
         colors = paint.colors.float()
         colors = torch.cat([colors[:, :3], colors[:, 3:4] * alpha], dim=1)
-        if self.trace:
-            self.trace.copy("stop_offsets", out.n_stops, paint.offsets)
-            self.trace.colors("stop_colors", out.n_stops * 4, paint.colors, torch.full((len(paint.offsets),), value(alpha)))
+        if self.provenance:
+            self.provenance.copy("stop_offsets", out.n_stops, paint.offsets)
+            self.provenance.colors("stop_colors", out.n_stops * 4, paint.colors, torch.full((len(paint.offsets),), value(alpha)))
         out.brushes.append([kind, out.n_stops, len(paint.offsets)])
         out.brush_params.append(params)
         out.stop_offsets.append(paint.offsets.float())
@@ -232,13 +232,13 @@ class Packer:
             else:
                 factors.append(shape.opacity)
             geometry = shape.geometry
-            if self.trace:
-                self._trace_presence(shape, has_stroke, scale_np[i] > 0)
+            if self.provenance:
+                self._record_presence(shape, has_stroke, scale_np[i] > 0)
             rect = None
             if isinstance(geometry, Rect):
                 rect = geometry
-                if self.trace:
-                    self.trace.rect(rect)
+                if self.provenance:
+                    self.provenance.rect(rect)
                 geometry = rect_as_path(geometry)
                 if geometry is None:
                     continue
@@ -262,21 +262,21 @@ class Packer:
                 out.draws.append([index, DRAW_STROKE, 0, paint, layer,
                                   CAPS[shape.linecap], JOINS[shape.linejoin], per_point])
 
-        paths.finish(out, matrices, scale, self.trace)
+        paths.finish(out, matrices, scale, self.provenance)
         self._finish_brushes(solid_colors, solid_alphas, gradient_rows)
         self._finish_draw_params(stroke_rows, matrices, scale, similar)
         return out
 
-    def _trace_presence(self, shape: Shape, has_stroke: bool, scaled: bool) -> None:
-        """Tells the trace which of the shape's draws exist because of a value that the
+    def _record_presence(self, shape: Shape, has_stroke: bool, scaled: bool) -> None:
+        """Tells the provenance which of the shape's draws exist because of a value that the
         loop may change (a stroke's width above 0, an ellipse's radii)."""
         g = shape.geometry
         if shape.stroke is not None and scaled:
             widths = g.widths if isinstance(g, Path) and g.widths is not None else shape.stroke_width
-            self.trace.present_if_positive(widths, has_stroke)
+            self.provenance.present_if_positive(widths, has_stroke)
         if isinstance(g, (Circle, Ellipse)):
             r = g.radius if isinstance(g, Circle) else g.radii
-            self.trace.present_if_positive(r, value(r.min()) > 0, every=True)
+            self.provenance.present_if_positive(r, value(r.min()) > 0, every=True)
 
     def _add_ellipse(self, geometry, m: torch.Tensor) -> int | None:
         r = geometry.radius.reshape(1).expand(2) if isinstance(geometry, Circle) else geometry.radii
@@ -284,8 +284,8 @@ class Packer:
             return None
         c = affine_apply(m, geometry.center.reshape(1, 2).float())[0]
         axes = m[:2, :2] @ torch.diag(r.float())
-        if self.trace:
-            self.trace.ellipse(len(self.out.ellipses), geometry.center, geometry.radius if isinstance(geometry, Circle)
+        if self.provenance:
+            self.provenance.ellipse(len(self.out.ellipses), geometry.center, geometry.radius if isinstance(geometry, Circle)
                                else geometry.radii, m.detach().numpy())
         self.out.ellipses.append(torch.cat([c, axes.reshape(4)]))
         self.out.shapes.append([SHAPE_ELLIPSE, 0, 0, len(self.out.ellipses) - 1])
@@ -304,9 +304,9 @@ class Packer:
             columns = [_stack([f[k] if k < len(f) else one for f in solid_alphas]) for k in range(depth)]
             alphas = torch.stack(columns).prod(dim=0).reshape(n_solid)
             colors = torch.cat([colors[:, :3], colors[:, 3:4] * alphas[:, None]], dim=1)
-            if self.trace:
+            if self.provenance:
                 for row, (color, a) in enumerate(zip(solid_colors, alphas.detach())):
-                    self.trace.colors("brush_params", row * COLUMNS["brush_params"] + 6, color, a.reshape(1))
+                    self.provenance.colors("brush_params", row * COLUMNS["brush_params"] + 6, color, a.reshape(1))
             ident = torch.eye(2, 3).reshape(1, 6).expand(n_solid, 6)
             out.brush_params.append(torch.cat([ident, colors, torch.zeros(n_solid, 1)], dim=1))
             out.brushes.extend([[BRUSH_SOLID, 0, 0]] * n_solid)
@@ -346,11 +346,11 @@ class Packer:
             stroke_params = torch.cat([(widths * s)[:, None], limits[:, None], metric], dim=1)
             params = params.index_put((rows,), stroke_params)
         keep = getattr(self, "_keep_draws", [True] * n)
-        if self.trace and stroke_rows:
+        if self.provenance and stroke_rows:
             row_after = np.cumsum(keep) - 1  # rows once the draws that paint nothing are dropped
             for (row, i), s_i in zip(stroke_rows, s.detach().numpy()):
                 if keep[row]:
-                    self.trace.scaled("draw_params", int(row_after[row]) * COLUMNS["draw_params"],
+                    self.provenance.scaled("draw_params", int(row_after[row]) * COLUMNS["draw_params"],
                                       self.scene.shapes[i].stroke_width, float(s_i))
         if not all(keep):
             mask = torch.tensor(keep)
@@ -386,19 +386,19 @@ class _PathBatch:
         self.subpath_slot.append(subpath_slot)
         return core_shape
 
-    def finish(self, out: Packed, matrices: torch.Tensor, scale: torch.Tensor, trace=None) -> None:
+    def finish(self, out: Packed, matrices: torch.Tensor, scale: torch.Tensor, provenance=None) -> None:
         if not self.points:
             return
         counts = [len(p) for p in self.points]
-        if trace:
+        if provenance:
             row, m_np, s_np = out.n_points, matrices.detach().numpy(), scale.detach().numpy()
             for points, widths, owner, n, rect in zip(self.points, self.widths, self.owner, counts, self.rects):
                 if rect is not None:
-                    trace.rect_corners("points", row, rect, m_np[owner])
+                    provenance.rect_corners("points", row, rect, m_np[owner])
                 else:
-                    trace.points("points", row, points, m_np[owner])
+                    provenance.points("points", row, points, m_np[owner])
                 if widths is not None:
-                    trace.scaled("point_widths", row, widths, float(s_np[owner]))
+                    provenance.scaled("point_widths", row, widths, float(s_np[owner]))
                 row += n
         local = torch.cat(self.points).float()
         # (numpy: torch's repeat_interleave wakes its thread pool, 0.6 ms a call on 2 busy cores)

@@ -166,15 +166,15 @@ class PersistentPack:
         parameters = scene.parameters()
         if any(id(t) in optimised for kind in NON_AFFINE_KINDS for t in parameters[kind]):
             return None
-        trace = Provenance()
+        provenance = Provenance()
         with torch.enable_grad():  # (the graph serves the check in _agrees)
-            arrays = Packer(scene, width, height, trace=trace).pack().arrays()
+            arrays = Packer(scene, width, height, provenance=provenance).pack().arrays()
         at: dict[int, int] = {}  # id(tensor) -> its first element in x (the kinds side by side)
         offset = 0
         for k in kinds:
             at.update((i, offset + o) for i, o in k.offsets.items())
             offset += k.flat.numel()
-        if any(i in at for i in trace.nonlinear):
+        if any(i in at for i in provenance.nonlinear):
             return None
         packed = [arrays[name].to(torch.float32) for name in FLOAT_INPUTS]
         floats = [f.detach() for f in packed]
@@ -182,7 +182,7 @@ class PersistentPack:
         first_of = dict(zip(FLOAT_INPUTS, starts[:-1]))
         base = torch.cat([f.reshape(-1) for f in floats]) if floats else torch.zeros(0)
         dst, src, coef, constant_at, constant = [], [], [], [], []
-        for r in trace.routes:
+        for r in provenance.routes:
             where = at.get(id(r.tensor))
             if where is None:
                 continue  # a value the loop does not change: the packed one stays
@@ -201,7 +201,7 @@ class PersistentPack:
         pack = cls({k: v for k, v in arrays.items() if k not in FLOAT_INPUTS}, [f.shape for f in floats],
                    base, as_index(dst), as_index(src),
                    torch.from_numpy(np.concatenate(coef)).float() if coef else torch.zeros(0),
-                   _conditions(trace.presence, trace.differences, at))
+                   _conditions(provenance.presence, provenance.differences, at))
         return pack if pack._agrees(kinds, packed) else None
 
     def arrays(self, leaves: list[torch.Tensor]) -> tuple[dict, list[torch.Tensor]]:

@@ -23,7 +23,7 @@ from vecfit import limits
 from vecfit.errors import SvgError
 from vecfit.scene import Group, Scene, Shape
 
-from .brushes import BLACK, Paints, parse_opacity, parse_paint
+from .paints import BLACK, Paints, parse_opacity, parse_paint
 from .color import parse_color
 from .document import SvgDocument
 from .dom import href_id, is_svg, local_name

@@ -27,7 +27,7 @@ from vecfit.io.images import atomic_write
 from vecfit.scene import (Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect,
                                    Scene, Solid)
 
-from .brushes import GRADIENTS
+from .paints import GRADIENTS
 from .document import SvgDocument
 from .dom import local_name
 from .numbers import finite, fmt, hex_color, matrix
