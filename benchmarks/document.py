@@ -50,7 +50,7 @@ def _dense_trace(folder: Path, paths: int) -> tuple[Path, Path]:
     target = folder / "coffee.png"
     Image.fromarray(image).save(target)
     rgba = np.concatenate([image / 255.0, np.ones(image.shape[:2] + (1,))], axis=2).astype(np.float32)
-    traced = trace_image(rgba, TraceSettings(paths=paths))
+    traced = trace_image(rgba, TraceSettings.defaults(paths=paths))
     svg = folder / f"coffee_{traced.paths}.svg"
     svg.write_text(traced.svg)
     return target, svg

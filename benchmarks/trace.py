@@ -82,7 +82,7 @@ def main():
 
     from vecfit.initial.tracer import TraceSettings
 
-    defaults = TraceSettings()
+    defaults = TraceSettings.defaults()
     print(f"defaults: colors={defaults.colors} min_area={defaults.min_area} "
           f"tolerance={defaults.tolerance} corner_angle={defaults.corner_angle} "
           f"blur={defaults.blur} overlap={defaults.overlap} smoothing={defaults.smoothing}")
@@ -95,7 +95,7 @@ def main():
         image = load(name)
         label = f"{name} {image.shape[1]}x{image.shape[0]}"
         for b in budgets:
-            r = measure(image, TraceSettings(paths=b))
+            r = measure(image, TraceSettings.defaults(paths=b))
             psnr[b].append(r["psnr"])
             print(f"{label:16s} {b:6d} {r['paths']:6d} {r['segments']:8d} "
                   f"{r['segments'] / r['paths']:8.1f} {r['seconds']:8.2f} {r['psnr']:8.2f}", flush=True)
@@ -110,8 +110,8 @@ def main():
         rows = []
         for name in images:
             image = load(name)
-            r0 = measure(image, TraceSettings(paths=b, overlap=0))
-            r1 = measure(image, TraceSettings(paths=b))
+            r0 = measure(image, TraceSettings.defaults(paths=b, overlap=0))
+            r1 = measure(image, TraceSettings.defaults(paths=b))
             rows.append((r0["psnr"], r1["psnr"]))
             print(f"{name:16s} {r0['psnr']:8.2f} {r1['psnr']:8.2f}", flush=True)
         print(f"{'mean':16s} {np.mean([r[0] for r in rows]):8.2f} {np.mean([r[1] for r in rows]):8.2f}")

@@ -54,7 +54,7 @@ def two_discs(left=12.0, right=36.0):
 
 
 def quick(iterations=40):
-    return Settings(iterations=iterations, samples=2, threads=2, coarse=0.0, lr_warmup=0,
+    return Settings.defaults(iterations=iterations, samples=2, threads=2, coarse=0.0, lr_warmup=0,
                     lr={"points": 1.0, "colors": 0.0, "radii": 0.0})
 
 

@@ -67,7 +67,7 @@ def test_fit_holds_the_outlines(tmp_path):
     for weight in (0.0, 1.0):
         scene = _scene(tmp_path)
         start = _polygon_length(scene)
-        optimize(scene, target, Settings(iterations=30, threads=1, coarse=0.0, outline=weight,
+        optimize(scene, target, Settings.defaults(iterations=30, threads=1, coarse=0.0, outline=weight,
                                          lr={"points": 1.0, "colors": 0.02}))
         grown[weight] = _polygon_length(scene) / start
     assert grown[0.0] > 1.05  # noise makes handles wander ...

@@ -65,9 +65,9 @@ def test_paint_shapes_and_resvg_agrees(astronaut, tmp_path):
 
 def test_initial_svg_is_random_but_reproducible():
     target = np.ones((40, 60, 4), np.float32)
-    a = initial_document(target, PaintSettings(paths=10, seed=1)).text()
-    assert a == initial_document(target, PaintSettings(paths=10, seed=1)).text()
-    assert a != initial_document(target, PaintSettings(paths=10, seed=2)).text()
+    a = initial_document(target, PaintSettings.defaults(paths=10, seed=1)).text()
+    assert a == initial_document(target, PaintSettings.defaults(paths=10, seed=1)).text()
+    assert a != initial_document(target, PaintSettings.defaults(paths=10, seed=2)).text()
     assert a.count("<path") == 10 and 'viewBox="0 0 60 40"' in a
 
 
@@ -90,7 +90,7 @@ def test_reseeding_moves_wasted_strokes_to_the_error():
     target = Target(torch.from_numpy(goal), (1.0, 1.0, 1.0, 1.0))
     resets = []
     before = healthy.geometry.points.clone()
-    reseeder = Reseeder(PaintSettings(reseed_every=10, radius=0.1), iterations=100)
+    reseeder = Reseeder(PaintSettings.defaults(reseed_every=10, radius=0.1), iterations=100)
     with torch.no_grad():
         reseeder(Step(9, image, scene, target, resets.append))
     assert reseeder.reseeded == 2 and reseeder.history == [(10, 2)]
@@ -101,7 +101,7 @@ def test_reseeding_moves_wasted_strokes_to_the_error():
         assert s.stroke.color.tolist() == pytest.approx([1.0, 0.0, 0.0, 1.0])
     assert {id(t) for t in resets} >= {id(off.geometry.points), id(faded.stroke.color)}
     # not in the last fifth of a run: the final primitives settle undisturbed
-    late = Reseeder(PaintSettings(reseed_every=10), iterations=100)
+    late = Reseeder(PaintSettings.defaults(reseed_every=10), iterations=100)
     off.geometry.points -= 100
     with torch.no_grad():
         late(Step(89, image, scene, target, resets.append))

@@ -114,7 +114,7 @@ def test_adobe_trace_bit_identical(name):
         pytest.skip("shared data not here")
     scene = load_svg(svg)
     w, h = int(scene.width) // 2, int(scene.height) // 2
-    kinds = parameter_kinds(scene, loop._default_rates(), w, h)
+    kinds = parameter_kinds(scene, loop.Settings.defaults().lr, w, h)
     pack = PersistentPack.build(scene, w, h, kinds)
     image, grads = _image_and_gradients(scene, kinds, w, h, None)
     image2, grads2 = _image_and_gradients(scene, kinds, w, h, pack)
@@ -164,7 +164,7 @@ def test_loop_same_fit_either_way(tmp_path, monkeypatch):
         monkeypatch.setattr(loop, "PERSISTENT_PACK", persistent)
         scene = _scene(tmp_path)
         lr = dict(RATES)
-        result = optimize(scene, target, Settings(iterations=12, threads=2, lr=lr, coarse=0.0))
+        result = optimize(scene, target, Settings.defaults(iterations=12, threads=2, lr=lr, coarse=0.0))
         results.append((result.losses, scene.shapes[1].geometry.points.detach().clone()))
     (losses_a, points_a), (losses_b, points_b) = results
     assert losses_a == pytest.approx(losses_b, rel=1e-5)
@@ -179,7 +179,7 @@ def test_loop_same_seed_same_result(tmp_path):
     runs = []
     for threads in (2, 2, 1, 3):
         scene = _scene(tmp_path)
-        result = optimize(scene, target, Settings(iterations=10, threads=threads, lr=dict(RATES), coarse=0.0))
+        result = optimize(scene, target, Settings.defaults(iterations=10, threads=threads, lr=dict(RATES), coarse=0.0))
         runs.append((result.losses, torch.cat([t.detach().reshape(-1) for ts in scene.parameters().values()
                                                for t in ts])))
     assert runs[0][0] == runs[1][0] and torch.equal(runs[0][1], runs[1][1])

@@ -266,7 +266,7 @@ def test_nan_loss_never_reaches_the_scene(monkeypatch):
 
     monkeypatch.setitem(losses.__dict__, "l2", flaky)
     scene = _circle_scene()
-    result = optimize(scene, _disc_target(), Settings(iterations=12, lr_warmup=0, samples=2, threads=1,
+    result = optimize(scene, _disc_target(), Settings.defaults(iterations=12, lr_warmup=0, samples=2, threads=1,
                                                       lr={"points": 1.0, "colors": 0.05, "radii": 1.0}))
     assert result.skipped_steps == 2
     assert math.isnan(result.losses[2]) and math.isnan(result.losses[3])
@@ -288,7 +288,7 @@ def test_nan_gradient_is_refused(monkeypatch):
 
     monkeypatch.setattr(adam.ParameterKind, "gradient", poisoned)
     scene = _circle_scene()
-    result = optimize(scene, _disc_target(), Settings(iterations=6, lr_warmup=0, threads=1, lr={"points": 1.0}))
+    result = optimize(scene, _disc_target(), Settings.defaults(iterations=6, lr_warmup=0, threads=1, lr={"points": 1.0}))
     assert result.skipped_steps == 1
     assert torch.isfinite(scene.shapes[0].geometry.center).all()
 
@@ -302,7 +302,7 @@ def test_interrupt_keeps_the_best_so_far():
         if p.iteration == 8:
             raise KeyboardInterrupt
 
-    result = optimize(scene, _disc_target(), Settings(iterations=50, lr_warmup=0, threads=1,
+    result = optimize(scene, _disc_target(), Settings.defaults(iterations=50, lr_warmup=0, threads=1,
                                                       lr={"points": 1.0, "colors": 0.05}),
                       progress=progress)
     assert result.interrupted and result.iterations == 8
@@ -345,7 +345,7 @@ def test_learning_rates_are_in_pixels_whatever_the_svg_units():
         view = torch.diag(torch.tensor([1 / unit, 1 / unit, 1.0]))
         scene = Scene(40, 32, [shape], view=view)
         start = shape.geometry.center.clone()
-        optimize(scene, _disc_target(), Settings(iterations=1, lr_warmup=0, threads=1, lr_decay=1.0,
+        optimize(scene, _disc_target(), Settings.defaults(iterations=1, lr_warmup=0, threads=1, lr_decay=1.0,
                                                  lr={"points": 0.5}))
         # the best of (initial, after one step) is kept: take the step's size in pixels
         moved.append(float((shape.geometry.center - start).abs().max()) / unit)
@@ -359,7 +359,7 @@ def test_bounds_hold_after_steps():
                                                                          [0, 0, 1, 1]]))
     shape = Shape(Circle(torch.tensor([20.0, 16.0]), torch.tensor(10.0)), fill=grad)
     scene = Scene(40, 32, [shape])
-    optimize(scene, _disc_target(), Settings(iterations=15, lr_warmup=0, threads=1,
+    optimize(scene, _disc_target(), Settings.defaults(iterations=15, lr_warmup=0, threads=1,
                                              lr={"colors": 0.5, "stop_offsets": 0.2, "radii": 4.0}))
     assert float(grad.colors.min()) >= 0 and float(grad.colors.max()) <= 1
     offs = grad.offsets
@@ -383,18 +383,18 @@ def test_ssim_loss_matches_scikit_image():
 @pytest.mark.parametrize("loss,factor", [("l1", 0.6), ("ssim", 0.9), ("pyramid", 0.6)])
 def test_other_losses_also_fit(loss, factor):
     scene = _circle_scene()
-    result = optimize(scene, _disc_target(), Settings(iterations=25, lr_warmup=0, threads=1, loss=loss,
+    result = optimize(scene, _disc_target(), Settings.defaults(iterations=25, lr_warmup=0, threads=1, loss=loss,
                                                       lr={"points": 1.0, "colors": 0.05, "radii": 0.5}))
     assert result.best_loss < factor * result.losses[0]
 
 
 def test_settings_are_checked():
     with pytest.raises(VecfitError, match="unknown parameter kind"):
-        Settings(lr={"pointz": 1.0}).check()
+        Settings.defaults(lr={"pointz": 1.0}).check()
     with pytest.raises(VecfitError, match="loss must be one of"):
-        Settings(loss="l3").check()
+        Settings.defaults(loss="l3").check()
     with pytest.raises(VecfitError, match="nothing to optimise"):
-        optimize(_circle_scene(), _disc_target(), Settings(iterations=2, lr_warmup=0, lr={"points": 0.0}))
+        optimize(_circle_scene(), _disc_target(), Settings.defaults(iterations=2, lr_warmup=0, lr={"points": 0.0}))
 
 
 def test_target_is_compared_over_an_explicit_background():
@@ -414,9 +414,24 @@ def test_translucent_background_is_a_usage_error(tmp_path):
 
 
 def test_settings_defaults_are_the_config_defaults():
-    """The Python API's Settings() starts where `vecfit refine` does."""
-    from vecfit.jobs.config import configs_dir, read_toml
-    assert Settings() == Settings.from_config(read_toml(configs_dir() / "refine.toml")["optimize"])
+    """The Python API's Settings.defaults() starts where `vecfit refine` does, and no
+    settings class holds defaults of its own: they live only in configs/."""
+    import dataclasses
+
+    from vecfit.editing.settings import EditSettings, RetargetSettings
+    from vecfit.initial.strokes import PaintSettings
+    from vecfit.initial.tracer import TraceSettings
+    from vecfit.jobs.config import configs_dir, read_toml, resolve, settings_of
+    assert Settings.defaults() == Settings.from_config(read_toml(configs_dir() / "refine.toml")["optimize"])
+    for command, cls in (("trace", TraceSettings), ("paint", PaintSettings), ("edit", EditSettings),
+                         ("retarget", RetargetSettings)):
+        assert all(f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+                   for f in dataclasses.fields(cls))
+        config = resolve(command)
+        seed = {"seed": config["optimize"]["seed"]} if "seed" in {f.name for f in dataclasses.fields(cls)} else {}
+        assert cls.defaults() == settings_of(cls, config[command], **seed)
+        assert Settings.defaults() != Settings.defaults(iterations=3) and Settings.defaults(iterations=3).iterations == 3
+    assert all(f.default is dataclasses.MISSING for f in dataclasses.fields(Settings))
 
 
 # ------------------------------------------------------------------ coarse to fine, timings
@@ -427,7 +442,7 @@ def small_trace(tmp_path_factory):
     from vecfit.initial.tracer import TraceSettings, trace_image
     png = photo_png(tmp_path_factory, "chelsea", (160, 106))
     image = load_target(png)
-    return image, trace_image(image, TraceSettings(paths=40)).svg
+    return image, trace_image(image, TraceSettings.defaults(paths=40)).svg
 
 
 def test_coarse_to_fine_gains_like_full_size(small_trace, tmp_path):
@@ -440,7 +455,7 @@ def test_coarse_to_fine_gains_like_full_size(small_trace, tmp_path):
     gains, times, initial = {}, {}, None
     for coarse in (0.0, 0.5):
         scene = quiet_load(tmp_path / "t.svg")
-        result = optimize(scene, target, Settings(iterations=60, threads=2, seed=3, coarse=coarse))
+        result = optimize(scene, target, Settings.defaults(iterations=60, threads=2, seed=3, coarse=coarse))
         assert len(result.losses) == len(result.iteration_seconds) == 60
         assert result.coarse_iterations == (30 if coarse else 0)
         initial = initial or result.losses[0]  # at full size (the first run has no coarse part)
@@ -456,7 +471,7 @@ def test_coarse_needs_pixels_for_every_shape(small_peppers):
     it is fitted at full size throughout."""
     scene = quiet_load(small_peppers / "peppers.svg")
     target = Target(torch.from_numpy(load_target(small_peppers / "peppers.png")), (1.0, 1.0, 1.0, 1.0))
-    assert optimize(scene, target, Settings(iterations=2, threads=2, coarse=0.5)).coarse_iterations == 0
+    assert optimize(scene, target, Settings.defaults(iterations=2, threads=2, coarse=0.5)).coarse_iterations == 0
 
 
 def test_coarse_best_is_taken_at_full_size():
@@ -467,7 +482,7 @@ def test_coarse_best_is_taken_at_full_size():
     scene.view = torch.diag(torch.tensor([4.0, 4.0, 1.0]))  # the same picture, 4x larger
     big = torch.nn.functional.interpolate(_disc_target().image.permute(2, 0, 1)[None], scale_factor=4)
     target = Target(big[0].permute(1, 2, 0).contiguous(), (1.0, 1.0, 1.0, 1.0))
-    result = optimize(scene, target, Settings(iterations=20, lr_warmup=0, threads=1, coarse=0.5,
+    result = optimize(scene, target, Settings.defaults(iterations=20, lr_warmup=0, threads=1, coarse=0.5,
                                               lr={"points": 1.0}))
     assert result.coarse_iterations == 10
     fine = result.losses[10:]
@@ -482,20 +497,20 @@ def test_the_last_iteration_is_at_full_size(iterations, coarse, expected):
     scene.view = torch.diag(torch.tensor([4.0, 4.0, 1.0]))
     big = torch.nn.functional.interpolate(_disc_target().image.permute(2, 0, 1)[None], scale_factor=4)
     target = Target(big[0].permute(1, 2, 0).contiguous(), (1.0, 1.0, 1.0, 1.0))
-    result = optimize(scene, target, Settings(iterations=iterations, lr_warmup=0, threads=1, coarse=coarse,
+    result = optimize(scene, target, Settings.defaults(iterations=iterations, lr_warmup=0, threads=1, coarse=coarse,
                                               lr={"points": 1.0}))
     assert result.coarse_iterations == expected
 
 
 def test_small_targets_are_fitted_at_full_size():
-    result = optimize(_circle_scene(), _disc_target(), Settings(iterations=4, threads=1, coarse=0.5))
+    result = optimize(_circle_scene(), _disc_target(), Settings.defaults(iterations=4, threads=1, coarse=0.5))
     assert result.coarse_iterations == 0
 
 
 @pytest.mark.parametrize("coarse", [1.0, 1.5, -0.1])
 def test_coarse_setting_is_checked(coarse):
     with pytest.raises(VecfitError, match="coarse"):
-        Settings(coarse=coarse).check()
+        Settings.defaults(coarse=coarse).check()
 
 
 def test_stopwatch_laps_every_iteration_with_the_cores_phases():
@@ -503,7 +518,7 @@ def test_stopwatch_laps_every_iteration_with_the_cores_phases():
     from vecfit.renderer.stopwatch import Stopwatch
     _core.phase_seconds()
     with Stopwatch() as watch:
-        result = optimize(_circle_scene(), _disc_target(), Settings(iterations=5, lr_warmup=0, threads=1,
+        result = optimize(_circle_scene(), _disc_target(), Settings.defaults(iterations=5, lr_warmup=0, threads=1,
                                                                      lr={"points": 1.0}))
     assert len(watch.laps) == 5
     for lap, seconds in zip(watch.laps, result.iteration_seconds):

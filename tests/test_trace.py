@@ -98,7 +98,7 @@ def flat_shapes() -> np.ndarray:
 @pytest.mark.parametrize("tolerance,bar", [(1.0, 28.5), (0.5, 30.5)])
 def test_flat_shapes_trace_closely_with_few_paths(tmp_path, tolerance, bar):
     image = flat_shapes()
-    result = trace_image(image, TraceSettings(tolerance=tolerance))
+    result = trace_image(image, TraceSettings.defaults(tolerance=tolerance))
     # background rect, disc, rectangle, ring, and the ring's hole (drawn on top of it)
     assert result.paths == count_shapes(result.svg) == 5
     assert result.colors == 4  # the hole has the background's colour
@@ -133,9 +133,9 @@ def test_path_budget_is_respected():
     full = trace_image(image)
     assert full.paths > 60  # a busy picture: the budget below has work to do
     for budget in (1, 20):
-        result = trace_image(image, TraceSettings(paths=budget))
+        result = trace_image(image, TraceSettings.defaults(paths=budget))
         assert result.paths == count_shapes(result.svg) <= budget
-    assert re.search(r"<rect\b", trace_image(image, TraceSettings(paths=1)).svg)
+    assert re.search(r"<rect\b", trace_image(image, TraceSettings.defaults(paths=1)).svg)
 
 
 def test_transparent_background_stays_transparent(tmp_path):
@@ -204,7 +204,7 @@ def test_overlap_closes_seams_on_a_photo(tmp_path):
     image = small_photo("astronaut", (96, 96))
     quality = {}
     for overlap in (0, 1):
-        out = render(trace_image(image, TraceSettings(overlap=overlap)), 96, 96, tmp_path)
+        out = render(trace_image(image, TraceSettings.defaults(overlap=overlap)), 96, 96, tmp_path)
         quality[overlap] = psnr(image[..., :3], out[..., :3])
     assert quality[1] >= quality[0] + 1.5
     assert quality[1] >= 21
@@ -212,13 +212,13 @@ def test_overlap_closes_seams_on_a_photo(tmp_path):
 
 def test_deterministic_for_a_seed():
     image = small_photo("astronaut", (64, 64))
-    a = trace_image(image, TraceSettings(paths=40, seed=3))
-    b = trace_image(image, TraceSettings(paths=40, seed=3))
+    a = trace_image(image, TraceSettings.defaults(paths=40, seed=3))
+    b = trace_image(image, TraceSettings.defaults(paths=40, seed=3))
     assert a.svg == b.svg and a.segments == b.segments
 
 
 def test_result_counts_match_the_svg():
-    result = trace_image(flat_shapes(), TraceSettings(paths=3))
+    result = trace_image(flat_shapes(), TraceSettings.defaults(paths=3))
     assert result.paths == count_shapes(result.svg) <= 3
     assert result.segments == result.svg.count("C") + 4 * result.svg.count("<rect")
     assert result.colors == len(set(re.findall(r'fill="(#[0-9a-f]{6})"', result.svg)))
@@ -232,7 +232,7 @@ def test_result_counts_match_the_svg():
 def test_palette_limits_the_colours():
     image = small_photo("chelsea", (96, 64))
     assert trace_image(image).colors > 50  # each region its own mean colour
-    result = trace_image(image, TraceSettings(colors=6, palette=True))
+    result = trace_image(image, TraceSettings.defaults(colors=6, palette=True))
     assert 2 <= result.colors <= 6
 
 
@@ -267,4 +267,4 @@ def test_bad_images_are_refused(image):
 ])
 def test_nonsense_settings_are_refused(settings):
     with pytest.raises(VecfitError, match="trace setting"):
-        trace_image(np.ones((8, 8, 4), np.float32), TraceSettings(**settings))
+        trace_image(np.ones((8, 8, 4), np.float32), TraceSettings.defaults(**settings))

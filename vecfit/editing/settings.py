@@ -6,18 +6,25 @@ import math
 from dataclasses import dataclass
 
 from vecfit.errors import VecfitError
+from vecfit.io.configs import defaults
 
 
 @dataclass
 class EditSettings:
-    changed_weight: float = 10.0  # loss weight of a changed pixel (an unchanged one: 1)
-    anchor: float = 100.0         # penalty on changing what acts only outside the changed region
-    anchor_free: float = 10.0      # ... and lengths acting inside it (see vecfit.fitting.anchor)
-    anchor_free_colors: float = 100.0  # ... and colours acting inside it
-    threshold: float = 0.1        # a pixel changed where a channel differs by more than this
-    min_area: int = 4             # changed specks smaller than this (pixels) are no edit
-    grow: int = 2                 # the changed region grown by this many pixels
-    reach: int = 2                # elements acting this close to the changed region are free
+    changed_weight: float      # loss weight of a changed pixel (an unchanged one: 1)
+    anchor: float              # penalty on changing what acts only outside the changed region
+    anchor_free: float         # ... and lengths acting inside it (see vecfit.fitting.anchor)
+    anchor_free_colors: float  # ... and colours acting inside it
+    threshold: float           # a pixel changed where a channel differs by more than this
+    min_area: int              # changed specks smaller than this (pixels) are no edit
+    grow: int                  # the changed region grown by this many pixels
+    reach: int                 # elements acting this close to the changed region are free
+
+    @classmethod
+    def defaults(cls, **changes) -> "EditSettings":
+        """The defaults of configs/edit.toml ([edit]), with ``changes``."""
+        table = defaults("edit", "edit")
+        return cls(**{**table, **changes})
 
     def check(self) -> None:
         for name in ("changed_weight", "anchor", "anchor_free", "anchor_free_colors", "threshold"):
@@ -35,15 +42,20 @@ class EditSettings:
 
 @dataclass
 class RetargetSettings:
-    width: str = ""                # new width: pixels or a percentage ("": unchanged)
-    height: str = ""               # new height, likewise
-    steps: int = 6                 # carve-and-fit rounds
-    iterations_per_step: int = 40  # Adam iterations fitting each round's carved image
-    final_iterations: int = 60     # more at the end, against the last carved image
-    iterations: int = 0            # > 0: the whole run's iterations, divided as the two above
-    work_size: int = 512           # carve and fit at this longest side (0: the SVG's size)
-    foreground: float = 1.0        # seam energy added per pixel unlike the bare canvas
+    width: str                # new width: pixels or a percentage ("": unchanged)
+    height: str               # new height, likewise
+    steps: int                # carve-and-fit rounds
+    iterations_per_step: int  # Adam iterations fitting each round's carved image
+    final_iterations: int     # more at the end, against the last carved image
+    iterations: int           # > 0: the whole run's iterations, divided as the two above
+    work_size: int            # carve and fit at this longest side (0: the SVG's size)
+    foreground: float         # seam energy added per pixel unlike the bare canvas
 
+    @classmethod
+    def defaults(cls, **changes) -> "RetargetSettings":
+        """The defaults of configs/retarget.toml ([retarget]), with ``changes``."""
+        table = defaults("retarget", "retarget")
+        return cls(**{**table, **changes})
 
     def check(self) -> None:
         if self.steps < 1:

@@ -20,6 +20,7 @@ import torch
 
 from vecfit.errors import NonFiniteScene, VecfitError
 from vecfit.io.compositing import composite_torch
+from vecfit.io.configs import defaults
 from vecfit.io.images import downscaled, downscaled_weight
 from vecfit.renderer import device as devices
 from vecfit.renderer.persistent import PersistentPack
@@ -44,30 +45,31 @@ PARAMETER_KINDS = ("points", "colors", "stroke_widths", "opacities", "radii", "g
                    "gradient_radii", "stop_offsets", "transforms")
 
 
-def _default_rates() -> dict:
-    return {"points": 2.0, "colors": 0.02, "stroke_widths": 0.1, "opacities": 0.0, "radii": 1.0,
-            "gradient_points": 2.0, "gradient_radii": 1.0, "stop_offsets": 0.005, "transforms": 0.0}
-
-
 @dataclass
 class Settings:
-    """The loop's settings. The defaults are those of configs/refine.toml's [optimize]
-    table (a test holds them equal), so the Python API and the CLI start alike."""
-    iterations: int = 250
-    loss: str = "l2"
-    mode: str = "mc"
-    samples: int = 2
-    boundary_samples: float = 2.0
-    interior_samples: int = 1  # of the N x N samples per pixel, those the backward revisits (0: all)
-    seed: int = 0
-    threads: int = 0
-    device: str = "auto"
-    lr_decay: float = 0.1
-    lr_warmup: int = 20
-    fixed_alpha: bool = False
-    coarse: float = 0.6  # fraction of the iterations run at half the size (coarse to fine)
-    outline: float = 0.0  # weight of the cost on outlines growing (outline.py), per px of growth per px
-    lr: dict = field(default_factory=_default_rates)
+    """The loop's settings. Their defaults are configs/refine.toml's [optimize] table
+    (``defaults()``), so the Python API and the CLI start alike."""
+    iterations: int
+    loss: str
+    mode: str
+    samples: int
+    boundary_samples: float
+    interior_samples: int  # of the N x N samples per pixel, those the backward revisits (0: all)
+    seed: int
+    threads: int
+    device: str
+    lr_decay: float
+    lr_warmup: int
+    fixed_alpha: bool
+    coarse: float  # fraction of the iterations run at half the size (coarse to fine)
+    outline: float  # weight of the cost on outlines growing (outline.py), per px of growth per px
+    lr: dict
+
+    @classmethod
+    def defaults(cls, **changes) -> "Settings":
+        """configs/refine.toml's [optimize] settings, with ``changes`` (``lr`` replaces the
+        whole table of rates)."""
+        return cls.from_config({**defaults("refine", "optimize"), **changes})
 
     @classmethod
     def from_config(cls, table: dict) -> "Settings":

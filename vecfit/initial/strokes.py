@@ -20,6 +20,7 @@ import numpy as np
 import torch
 
 from vecfit.errors import VecfitError
+from vecfit.io.configs import defaults
 from vecfit.scene import Path as PathGeometry
 from vecfit.svg.document import SvgDocument
 from vecfit.svg.pathdata import format_path_data
@@ -29,19 +30,25 @@ PRIMITIVE_KINDS = ("strokes", "shapes")
 
 @dataclass
 class PaintSettings:
-    paths: int = 256
-    kind: str = "strokes"
-    stroke_segments: int = 3        # strokes: 1 to this many cubic segments
-    shape_segments_min: int = 3     # shapes: closed paths of min..max cubic segments
-    shape_segments_max: int = 5
-    min_width: float = 1.0          # stroke widths drawn uniformly in [min, max] pixels
-    max_width: float = 5.0
-    radius: float = 0.05            # control-point spread, as a fraction of the longer side
-    reseed_every: int = 50          # 0: never re-seed
-    reseed_alpha: float = 0.05
-    reseed_width: float = 0.3
-    frames_every: int = 5
-    seed: int = 0
+    paths: int
+    kind: str
+    stroke_segments: int     # strokes: 1 to this many cubic segments
+    shape_segments_min: int  # shapes: closed paths of min..max cubic segments
+    shape_segments_max: int
+    min_width: float         # stroke widths drawn uniformly in [min, max] pixels
+    max_width: float
+    radius: float            # control-point spread, as a fraction of the longer side
+    reseed_every: int        # 0: never re-seed
+    reseed_alpha: float
+    reseed_width: float
+    frames_every: int
+    seed: int
+
+    @classmethod
+    def defaults(cls, **changes) -> "PaintSettings":
+        """The defaults of configs/paint.toml ([paint], and [optimize]'s seed), with ``changes``."""
+        table = {**defaults("paint", "paint"), "seed": defaults("paint", "optimize")["seed"]}
+        return cls(**{**table, **changes})
 
     def check(self) -> None:
         if self.kind not in PRIMITIVE_KINDS:

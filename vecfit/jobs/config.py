@@ -10,37 +10,9 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import importlib.resources
-import tomllib
 
 from vecfit.errors import VecfitError
-
-
-def configs_dir():
-    """The default settings: the package vecfit.configs, which the wheel and the editable
-    install both map to the repository's configs/ (pyproject.toml's wheel.packages)."""
-    try:
-        root = importlib.resources.files("vecfit.configs")
-    except ModuleNotFoundError:
-        root = None
-    if root is None or not (root / "refine.toml").is_file():
-        raise VecfitError("the default settings (vecfit/configs/refine.toml) are missing from "
-                          "this installation: reinstall vecfit")
-    return root
-
-
-def read_toml(path) -> dict:
-    try:
-        with open(path, "rb") as f:
-            return tomllib.load(f)
-    except FileNotFoundError:
-        raise VecfitError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise VecfitError(f"{path}: is a folder, not a TOML file") from None
-    except tomllib.TOMLDecodeError as e:
-        raise VecfitError(f"{path}: not valid TOML ({e})") from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise VecfitError(f"{path}: cannot read ({e})") from None
+from vecfit.io.configs import configs_dir, read_toml
 
 
 def merge(base: dict, changes: dict, schema: dict, source: str, prefix: str = "") -> dict:

@@ -6,42 +6,50 @@ import numbers
 from dataclasses import dataclass, fields
 
 from vecfit.errors import VecfitError
+from vecfit.io.configs import defaults
 
 
 @dataclass
 class TraceSettings:
-    """Knobs of trace_image. The defaults were chosen by measuring PSNR, path and segment
-    counts on skimage's astronaut, chelsea, coffee and rocket (benchmarks/trace.py)."""
+    """Knobs of trace_image. Their defaults are configs/trace.toml's (``defaults()``),
+    chosen by measuring PSNR, path and segment counts on skimage's astronaut, chelsea,
+    coffee and rocket (benchmarks/trace.py)."""
 
-    colors: int = 48
+    colors: int
     """k of the colour quantisation: the colour classes regions start from (regions are
     then painted with their own mean colour, so the picture has more colours than k)."""
-    paths: int = 1000
+    paths: int
     """Path budget: at most this many shapes (a background rect counts as one)."""
-    min_area: float = 8.0
+    min_area: float
     """Speckle removal: regions smaller than this many pixels are merged into neighbours."""
-    tolerance: float = 1.0
+    tolerance: float
     """Largest distance in pixels between an outline and its Bézier fit."""
-    corner_angle: float = 135.0
+    corner_angle: float
     """An outline turning sharper than this (degrees; 180 is straight) gets a corner."""
-    blur: float = 0.0
+    blur: float
     """Gaussian blur (sigma, pixels) of the image before quantisation; 0 for none."""
-    overlap: int = 1
+    overlap: int
     """Pixels each shape reaches under the shapes drawn on top of it (closes seams)."""
-    smoothing: float = 1.0
+    smoothing: float
     """Gaussian sigma (pixels) by which outlines are smoothed before fitting, to iron out
     the pixel staircase."""
-    merge_thin: bool = True
+    merge_thin: bool
     """Merge one-pixel-wide slivers that are blends of their neighbours (the anti-aliased
     rim between two flat colours) like speckles."""
-    subpixel: bool = True
+    subpixel: bool
     """Place edges between pixels where the target's anti-aliasing says they lie."""
-    palette: bool = False
+    palette: bool
     """Paint each region with its colour class's average colour, so the picture has at
     most `colors` colours (a poster look), instead of the region's own mean colour
     (closer to the image)."""
-    seed: int = 0
+    seed: int
     """Seed of the k-means sampling and initialisation: equal seeds give equal output."""
+
+    @classmethod
+    def defaults(cls, **changes) -> "TraceSettings":
+        """The defaults of configs/trace.toml ([trace], and [optimize]'s seed), with ``changes``."""
+        table = {**defaults("trace", "trace"), "seed": defaults("trace", "optimize")["seed"]}
+        return cls(**{**table, **changes})
 
 
 @dataclass

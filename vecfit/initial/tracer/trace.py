@@ -46,20 +46,21 @@ def check_image(image) -> np.ndarray:
     return a
 
 
-def trace_image(image: np.ndarray, settings: TraceSettings = TraceSettings(),
+def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
                 progress=None) -> TraceResult:
     """Trace an image into an SVG document (vecfit.svg.document).
 
     image: float32 RGBA [H, W, 4], straight alpha in [0, 1] (what vecfit.io.images.load_rgba
     returns). Pixels with alpha >= 0.5 are traced as opaque shapes; the others get no shape,
-    so a transparent background stays transparent. Raises VecfitError for a bad image or
-    settings.
+    so a transparent background stays transparent. settings: None for the defaults
+    (TraceSettings.defaults()). Raises VecfitError for a bad image or settings.
 
     progress, if given, is called as progress(stage, fraction): stage is one of
     "quantise", "regions", "order", "outline", "fit", fraction how much of the whole
     trace is done, in [0, 1].
     """
     start = time.perf_counter()
+    settings = TraceSettings.defaults() if settings is None else settings
     check_settings(settings)
     image = check_image(image)
     s = settings
