@@ -226,147 +226,181 @@ def optimize(scene: Scene, target: Target, settings: Settings,
     settings.check()
     if target.weight is not None:
         losses.weighted(settings.loss)  # refuses a loss that takes no weight, before any work
-    loss_fn = losses.get(settings.loss)
-    height, width = target.image.shape[:2]
-    fine_from, levels = _levels(target, settings, len(scene.shapes))
-    device = devices.device_name(devices.resolve(settings.device))  # "auto" settled once
-    kinds = parameter_kinds(scene, settings.lr, width, height, settings.fixed_alpha, keep_alpha)
-    if not kinds:
-        raise VecfitError("nothing to optimise: the scene has no parameters with a learning rate above 0")
-    adam = Adam(kinds, settings.iterations, settings.lr_decay, settings.lr_warmup)
-    best = [k.flat.clone() for k in kinds]
-    best_loss = math.inf
-    curve: list[float] = []
-    times: list[float] = []
-    skipped = 0
-    interrupted = False
-    start = time.perf_counter()
+    return _Fit(scene, target, settings, hooks, keep_alpha, penalty).run(progress)
 
-    points = next((i for i, k in enumerate(kinds) if k.name == "points"), None)
-    outline = None
-    if settings.outline > 0 and points is not None:
-        outline = OutlineCost(scene, kinds[points], width, height, settings.outline) or None
 
-    frame = {}
-    packs: dict = {}  # (width, height) -> PersistentPack, or None where it does not apply
-    leaves: list = []  # this iteration's kinds' flat tensors as autograd leaves
+class _Fit:
+    """One run of the loop: its parameter kinds, Adam, the best parameters so far, the
+    packs per image size, and the iterations."""
 
-    def level(iteration: int) -> tuple[Target, torch.Tensor]:
-        return levels[iteration >= fine_from]
+    def __init__(self, scene, target, settings, hooks, keep_alpha, penalty):
+        self.scene, self.target, self.settings = scene, target, settings
+        self.hooks, self.penalty = hooks, penalty
+        self.loss_fn = losses.get(settings.loss)
+        height, width = target.image.shape[:2]
+        self.fine_from, self.levels = _levels(target, settings, len(scene.shapes))
+        self.device = devices.device_name(devices.resolve(settings.device))  # "auto" settled once
+        self.kinds = kinds = parameter_kinds(scene, settings.lr, width, height, settings.fixed_alpha, keep_alpha)
+        if not kinds:
+            raise VecfitError("nothing to optimise: the scene has no parameters with a learning rate above 0")
+        self.adam = Adam(kinds, settings.iterations, settings.lr_decay, settings.lr_warmup)
+        self.best = [k.flat.clone() for k in kinds]
+        self.best_loss = math.inf
+        self.points = next((i for i, k in enumerate(kinds) if k.name == "points"), None)
+        self.outline = None
+        if settings.outline > 0 and self.points is not None:
+            self.outline = OutlineCost(scene, kinds[self.points], width, height, settings.outline) or None
+        self.image = None  # the last render, detached (for hooks)
+        self.packs: dict = {}  # (width, height) -> PersistentPack, or None where it does not apply
+        self.leaves: list = []  # this iteration's kinds' flat tensors as autograd leaves
+        self.where = {id(t): (i, k.offsets[id(t)], t.numel()) for i, k in enumerate(kinds) for t in k.tensors}
+        self.skipped = 0  # steps refused for a non-finite loss, gradient or parameter
 
-    def packed(w: int, h: int):
+    # ------------------------------------------------------------- one evaluation
+
+    def level(self, iteration: int) -> tuple[Target, torch.Tensor]:
+        return self.levels[iteration >= self.fine_from]
+
+    def packed(self, w: int, h: int):
         if not PERSISTENT_PACK:
             return None
-        pack = packs.get((w, h), False)
-        if pack is False or (pack is not None and not pack.still_valid([k.flat for k in kinds])):
+        pack = self.packs.get((w, h), False)
+        if pack is False or (pack is not None and not pack.still_valid([k.flat for k in self.kinds])):
             with phase("pack"):
-                pack = packs[(w, h)] = PersistentPack.build(scene, w, h, kinds)
-        return pack.arrays(leaves) if pack is not None else None
+                pack = self.packs[(w, h)] = PersistentPack.build(self.scene, w, h, self.kinds)
+        return pack.arrays(self.leaves) if pack is not None else None
 
-    def evaluate(iteration: int, grad: bool):
-        at, goal = level(iteration)
+    def evaluate(self, iteration: int, grad: bool):
+        settings = self.settings
+        at, goal = self.level(iteration)
         h, w = at.image.shape[:2]
-        leaves[:] = [k.flat.detach().requires_grad_(grad) for k in kinds]
+        self.leaves[:] = [k.flat.detach().requires_grad_(grad) for k in self.kinds]
         with torch.set_grad_enabled(grad):
-            image = render(scene, w, h, samples=settings.samples, mode=settings.mode,
-                           seed=settings.seed + iteration, background=target.background,
+            image = render(self.scene, w, h, samples=settings.samples, mode=settings.mode,
+                           seed=settings.seed + iteration, background=self.target.background,
                            threads=settings.threads, boundary_samples=settings.boundary_samples,
-                           interior_samples=settings.interior_samples, device=device,
-                           packed=packed(w, h))
-            frame["image"] = image.detach()
-            loss = at.loss(loss_fn, settings.loss, at.rendered(image), goal)
-            return loss if penalty is None else loss + penalty()
+                           interior_samples=settings.interior_samples, device=self.device,
+                           packed=self.packed(w, h))
+            self.image = image.detach()
+            loss = at.loss(self.loss_fn, settings.loss, at.rendered(image), goal)
+            return loss if self.penalty is None else loss + self.penalty()
 
-    def regularised(loss: torch.Tensor) -> torch.Tensor:
+    def regularised(self, loss: torch.Tensor) -> torch.Tensor:
         """What the step minimises: the loss and the outline cost (the loss curve and the
         best-so-far follow the loss alone: the best image)."""
-        return loss + outline(leaves[points]) if outline is not None else loss
+        return loss + self.outline(self.leaves[self.points]) if self.outline is not None else loss
 
-    where = {id(t): (i, k.offsets[id(t)], t.numel()) for i, k in enumerate(kinds) for t in k.tensors}
+    # ------------------------------------------------------------ the parameters
 
-    def reset(tensor: torch.Tensor) -> None:
-        packs.clear()  # a hook changed the Scene: whatever it changed, pack it anew
-        if id(tensor) in where:
-            i, offset, n = where[id(tensor)]
-            for state in (kinds[i].m, kinds[i].v, kinds[i].steps):
-                state[offset:offset + n] = 0
+    def keep_if_best(self, value: float) -> None:
+        if value < self.best_loss:
+            self.best_loss = value
+            for b, k in zip(self.best, self.kinds):
+                b.copy_(k.flat)
 
-    def restore_best():
-        for k, b in zip(kinds, best):
+    def restore_best(self) -> None:
+        for k, b in zip(self.kinds, self.best):
             k.flat.copy_(b)
 
-    try:
-        with _collecting_new_objects_only():
-            for it in range(settings.iterations):
-                began = time.perf_counter()
-                if it == fine_from and it > 0:
-                    best_loss = math.inf  # losses at the coarse size do not compare with these
-                try:
-                    with phase("forward"):
-                        loss = evaluate(it, grad=True)
-                except NonFiniteScene:
-                    loss = None  # treated like a NaN loss
-                value = float(loss.detach()) if loss is not None else math.nan
-                curve.append(value)
+    def reset(self, tensor: torch.Tensor) -> None:
+        """A hook changed ``tensor``: Adam forgets it, and the Scene is packed anew."""
+        self.packs.clear()
+        if id(tensor) in self.where:
+            i, offset, n = self.where[id(tensor)]
+            for state in (self.kinds[i].m, self.kinds[i].v, self.kinds[i].steps):
+                state[offset:offset + n] = 0
+
+    def gradients(self, loss) -> list | None:
+        """The kinds' gradients of this iteration's loss; None where the loss or a
+        gradient is not finite."""
+        value = float(loss.detach()) if loss is not None else math.nan
+        grads = None
+        if math.isfinite(value):
+            self.keep_if_best(value)
+            if loss.requires_grad:
+                with phase("backward"):
+                    self.regularised(loss).backward()
+            # else nothing drawn depends on the parameters any more (e.g. every shape
+            # shrank to nothing): zero gradients, Adam's momentum still moves them
+            grads = [k.gradient(leaf) for k, leaf in zip(self.kinds, self.leaves)]
+            if not all(torch.isfinite(g).all() for g in grads):
                 grads = None
-                if math.isfinite(value):
-                    if value < best_loss:
-                        best_loss = value
-                        for b, k in zip(best, kinds):
-                            b.copy_(k.flat)
-                    if loss.requires_grad:
-                        with phase("backward"):
-                            regularised(loss).backward()
-                    # else nothing drawn depends on the parameters any more (e.g. every shape
-                    # shrank to nothing): zero gradients, Adam's momentum still moves them
-                    grads = [k.gradient(leaf) for k, leaf in zip(kinds, leaves)]
-                    if not all(torch.isfinite(g).all() for g in grads):
-                        grads = None
-                for k in kinds:
-                    k.zero_grad()
-                leaves.clear()
-                if grads is None:
-                    # A non-finite loss or gradient: go back to the best parameters and try
-                    # again with smaller steps rather than let NaN into the Scene.
-                    skipped += 1
-                    restore_best()
-                    adam.rate *= 0.5
-                    if adam.rate < 1e-4:
+        for k in self.kinds:
+            k.zero_grad()
+        self.leaves.clear()
+        return grads
+
+    # ------------------------------------------------------------------ the run
+
+    def iteration(self, it: int) -> tuple[float, bool]:
+        """One iteration: its loss, and whether to go on (False once a refused step has
+        halved the rate below 1e-4). ``skipped`` counts the refused steps."""
+        if it == self.fine_from and it > 0:
+            self.best_loss = math.inf  # losses at the coarse size do not compare with these
+        try:
+            with phase("forward"):
+                loss = self.evaluate(it, grad=True)
+        except NonFiniteScene:
+            loss = None  # treated like a NaN loss
+        value = float(loss.detach()) if loss is not None else math.nan
+        grads = self.gradients(loss)
+        if grads is None:
+            # A non-finite loss or gradient: go back to the best parameters and try again
+            # with smaller steps rather than let NaN into the Scene.
+            self.refuse_step()
+            return value, self.adam.rate >= 1e-4
+        with torch.no_grad(), phase("adam"):
+            self.adam.step(grads)
+        if not all(torch.isfinite(k.flat).all() for k in self.kinds):
+            self.refuse_step()
+        return value, True
+
+    def refuse_step(self) -> None:
+        self.skipped += 1
+        self.restore_best()
+        self.adam.rate *= 0.5
+
+    def run_hooks(self, it: int) -> None:
+        if self.hooks and self.image is not None:
+            with torch.no_grad(), phase("hooks"):
+                for hook in self.hooks:
+                    hook(Step(it, self.image, self.scene, self.level(it)[0], self.reset))
+                for k in self.kinds:
+                    k.project()
+
+    def run(self, progress) -> Result:
+        settings, kinds = self.settings, self.kinds
+        curve: list[float] = []
+        times: list[float] = []
+        interrupted = False
+        start = time.perf_counter()
+        try:
+            with _collecting_new_objects_only():
+                for it in range(settings.iterations):
+                    began = time.perf_counter()
+                    value, go_on = self.iteration(it)
+                    curve.append(value)
+                    if not go_on:
                         break
-                else:
-                    with torch.no_grad(), phase("adam"):
-                        adam.step(grads)
-                    if not all(torch.isfinite(k.flat).all() for k in kinds):
-                        skipped += 1
-                        restore_best()
-                        adam.rate *= 0.5
-                if hooks and "image" in frame:
-                    with torch.no_grad(), phase("hooks"):
-                        for hook in hooks:
-                            hook(Step(it, frame["image"], scene, level(it)[0], reset))
-                        for k in kinds:
-                            k.project()
-                times.append(time.perf_counter() - began)
-                lap(times[-1])
-                if progress is not None:
-                    progress(Progress(it + 1, settings.iterations, value, best_loss,
-                                      time.perf_counter() - start))
-        # The last step's result has not been measured yet.
-        if settings.iterations > 0:
-            final = evaluate(settings.iterations, grad=False)
-            value = float(final)
-            if math.isfinite(value) and value < best_loss:
-                best_loss = value
-                for b, k in zip(best, kinds):
-                    b.copy_(k.flat)
-    except KeyboardInterrupt:
-        interrupted = True
-    finally:
-        with torch.no_grad():
-            restore_best()
-        for k in kinds:
-            k.release()
-    return Result(losses=curve, best_loss=best_loss, iterations=len(curve),
-                  seconds=time.perf_counter() - start, interrupted=interrupted, skipped_steps=skipped,
-                  parameters={k.name: int(k.flat.numel()) for k in kinds}, iteration_seconds=times,
-                  coarse_iterations=min(fine_from, len(curve)))
+                    self.run_hooks(it)
+                    times.append(time.perf_counter() - began)
+                    lap(times[-1])
+                    if progress is not None:
+                        progress(Progress(it + 1, settings.iterations, value, self.best_loss,
+                                          time.perf_counter() - start))
+            # The last step's result has not been measured yet.
+            if settings.iterations > 0:
+                value = float(self.evaluate(settings.iterations, grad=False))
+                if math.isfinite(value):
+                    self.keep_if_best(value)
+        except KeyboardInterrupt:
+            interrupted = True
+        finally:
+            with torch.no_grad():
+                self.restore_best()
+            for k in kinds:
+                k.release()
+        return Result(losses=curve, best_loss=self.best_loss, iterations=len(curve),
+                      seconds=time.perf_counter() - start, interrupted=interrupted, skipped_steps=self.skipped,
+                      parameters={k.name: int(k.flat.numel()) for k in kinds}, iteration_seconds=times,
+                      coarse_iterations=min(self.fine_from, len(curve)))
