@@ -1,3 +1,5 @@
+"""pytest set-up for the whole suite: OpenMP threads asleep when idle, the helpers beside the
+tests importable, and the end-of-run notes (shared data missing, the conformance table)."""
 import os
 import sys
 from pathlib import Path

@@ -1,2 +1,2 @@
-"""Initial SVGs for the fitting loop: the tracer (trace/) and random strokes or shapes
+"""Initial SVGs for the fitting loop: the tracer (tracer/) and random strokes or shapes
 (strokes.py)."""

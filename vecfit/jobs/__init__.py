@@ -1,2 +1,3 @@
-"""The optimising commands as functions: each makes or reads an initial Scene and ends in
-the shared fit-and-write job (fit.py); config.py resolves their settings."""
+"""The jobs behind the optimising commands, one shape for all (protocol.py: run(inputs,
+config, outputs, progress) -> report): refine, trace, paint, edit, retarget; fit.py is the
+fit-and-write they share, config.py resolves their settings from configs/."""
