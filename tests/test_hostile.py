@@ -2,7 +2,9 @@
 resource limits (vecfit/limits.py): each refusal is one line with the limit in it.
 
 The cases run in the fuzzer's worker process, so that a crash or a hang fails a test
-instead of ending the run. About 25 s in all, most of it the 10^5-segment renders."""
+instead of ending the run. About 50 s in all, most of it the 10^5-segment renders and the
+second campaign's cases (issue 28: wide short targets, scenes that barely touch the
+target, long paths in both modes; the pydiffvg scripts are in test_pydiffvg_scripts.py)."""
 from __future__ import annotations
 
 import math
@@ -241,4 +243,36 @@ def test_scenes_that_barely_touch_the_target(runner, name, svg, mode):
     files = {"target.png": _noise_png(64, 64, seed=2), "in.svg": svg.encode()}
     out = check(runner, ["refine", "target.png", "in.svg", "-o", "out.svg", "--iterations", "3", "--mode", mode,
                          "-q", "--threads", "1", "--samples", "1"], files, FIT_OUTPUTS)
+    assert out["exit_code"] == 0, out["stderr"]
+
+
+def _long_path(n: int, kinds: str, step: float, seed: int = 0) -> str:
+    rng = np.random.default_rng(seed)
+    counts = {"L": 1, "Q": 2, "C": 3}
+    xy = np.array([100.0, 100.0])
+    out = ["M 100 100"]
+    for i in range(n):
+        k = kinds[i % len(kinds)]
+        pts = []
+        for _ in range(counts[k]):
+            xy = np.clip(xy + rng.uniform(-step, step, 2), 0, 200)
+            pts.append(f"{xy[0]:.1f} {xy[1]:.1f}")
+        out.append(k + " ".join(pts))
+    return " ".join(out) + " Z"
+
+
+@pytest.mark.parametrize("name, body", [
+    # 30,000 cubics: the analytical mode measured each curve at every pixel of its box
+    ("cubics", lambda: f'<path d="{_long_path(30_000, "C", 60.0)}" fill="#3a6"/>'),
+    # mixed segments, a gradient fill and a stroke 10^7 wide: every stroke item was listed
+    # in every tile and measured at every pixel (past 20 s and 2 GB)
+    ("mixed-wide-stroke", lambda: '<defs><linearGradient id="g"><stop offset="0" stop-color="red"/><stop offset="1" '
+     f'stop-color="blue"/></linearGradient></defs><path d="{_long_path(30_000, "LQC", 4.0, 1)}" fill="url(#g)" '
+     'stroke="green" stroke-width="1e7"/>'),
+], ids=["cubics", "mixed-wide-stroke"])
+@pytest.mark.parametrize("mode", ["mc", "analytic"])
+def test_long_paths_render_in_both_modes(runner, name, body, mode):
+    svg = f'<svg {NS} width="200" height="200">{body()}</svg>'.encode()
+    out = check(runner, ["render", "in.svg", "-o", "out.png", "--width", "64", "--mode", mode, "--threads", "1"],
+                {"in.svg": svg}, ["out.png"], timeout=20)
     assert out["exit_code"] == 0, out["stderr"]
