@@ -399,7 +399,8 @@ def make_case(seed: int, index: int, seeds: list[Path] | None = None) -> Case:
         files = {name: data, "init.svg": svg}
         args = {"refine": ["refine", name, "init.svg"], "trace": ["trace", name, "--paths", "4"],
                 "paint": ["paint", name, "--paths", "4"], "edit": ["edit", "init.svg", name],
-                "retarget": ["retarget", "init.svg", "--width" if w > h else "--height", "80%"]}[command]
+                "retarget": ["retarget", "init.svg", "--width", "80%"] if w > h else
+                            ["retarget", "init.svg", "--width", "100%", "--height", "80%"]}[command]
         args += ["-o", "out.svg", "--iterations", str(rng.choice([0, 2])), "-q", "--samples", "1", "--threads", "1"]
         if command != "retarget":
             args += ["--max-size", str(rng.choice([48, 512]))]
