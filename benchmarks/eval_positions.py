@@ -89,12 +89,12 @@ def script(steps: int, n: int):
                                                        eval_positions=eval_positions)
         samples = render(256, 256, 0, 0, t + 1, None, *args) / 256
         target_sampled = torch.nn.functional.grid_sample(target.view(1, 1, 256, 256), grid.view(1, -1, 1, 2),
-                                                         mode="nearest")
+                                                         mode="nearest", align_corners=False)
         loss = (samples - target_sampled).pow(2).mean()
         loss.backward()
         optimizer.step()
     seconds = time.perf_counter() - start
-    return seconds, float(radius_n * 256), [round(float(v), 2) for v in center_n * 256]
+    return seconds, float(radius_n.detach()) * 256, [round(float(v), 2) for v in center_n.detach() * 256]
 
 
 def main():
