@@ -41,7 +41,7 @@ fuzz: install
 SANITIZE_BUILD := build/sanitize
 SANITIZE_TESTS := tests/test_render_basics.py tests/test_degenerate.py tests/test_render_vs_reference.py \
 	tests/test_gradients.py tests/test_point_widths.py tests/test_golden.py tests/test_conformance.py \
-	tests/test_hostile.py tests/test_fuzz.py
+	tests/test_hostile.py tests/test_fuzz.py tests/test_long_paths.py tests/test_pydiffvg_scripts.py
 sanitize: install
 	$(PY) -m pip install -q pybind11
 	cmake -S . -B $(SANITIZE_BUILD) -DVECFIT_SANITIZE=ON -DCMAKE_BUILD_TYPE=Release \

@@ -5,7 +5,12 @@ left behind.
 
 Cases are deterministic from (seed, index). SVGs are mutated from tests/golden/ (and the
 conformance corpus in ../shared when it is there) or built from a grammar of hostile
-values; images are broken in the ways image files break. The cases run in a worker
+values; images are broken in the ways image files break. Families added after the second
+campaign (issue 28): images with a side of 1 to 12 px through refine, trace, paint, edit
+and retarget, and renders under 7 px on a side; hundreds to thousands of tiny shapes
+(below a pixel, off the canvas, radii near 0) refined against small targets; one path of
+3,000 to 60,000 segments rendered at 64 px in either mode (20 s: a hang). Clip paths,
+masks, filters and dashes are not drawn yet: their families come when they are. The cases run in a worker
 process that imports vecfit once and calls the command line's main in-process (click's
 runner): starting a Python that imports torch costs 1-2 s a case. The worker is killed
 and restarted after a signal or a time-out, which are recorded as failures.
@@ -282,6 +287,74 @@ def image_case(rng: random.Random) -> tuple[str, bytes]:
     return "photo.png", encoded(Image.fromarray(photo))
 
 
+# ------------------------------------------------- families from the second campaign
+
+def thin_image(rng: random.Random) -> tuple[str, bytes, int, int]:
+    """A photo-like image with one side of 1 to 12 pixels and the other 100 to 700: the
+    jobs' working sizes shrink the long side and must not take the short one below 11."""
+    import io
+
+    import numpy as np
+    from PIL import Image
+    short, long_ = rng.choice([1, 3, 6, 11, 11, 12, 12]), rng.choice([100, 300, 700])
+    w, h = (long_, short) if rng.random() < 0.5 else (short, long_)
+    pixels = (np.random.default_rng(rng.randrange(1 << 30)).random((h, w, 3)) * 255).astype(np.uint8)
+    buf = io.BytesIO()
+    Image.fromarray(pixels).save(buf, format="PNG")
+    return "thin.png", buf.getvalue(), w, h
+
+
+def tiny_shapes_svg(rng: random.Random) -> bytes:
+    """Hundreds to thousands of small shapes (radii 0 to 5, some below a pixel or off the
+    canvas) on a 200-unit canvas: against a small target most parameters barely touch a
+    pixel, and radii crossing 0 make draws come and go."""
+    n = rng.choice([200, 800, 2000])
+    off = rng.random() < 0.2   # every shape off the canvas
+    scale = rng.choice([1.0, 1.0, 0.01])  # 0.01: every shape below a pixel
+    parts = []
+    for _ in range(n):
+        x, y = rng.uniform(0, 200), rng.uniform(0, 200)
+        if off:
+            x += 400
+        r = rng.uniform(0, 5) * scale
+        color = f"#{rng.randrange(1 << 24):06x}"
+        kind = rng.randrange(3)
+        if kind == 0:
+            parts.append(f'<circle cx="{x:.2f}" cy="{y:.2f}" r="{r:.3f}" fill="{color}"/>')
+        elif kind == 1:
+            parts.append(f'<rect x="{x:.2f}" y="{y:.2f}" width="{2 * r:.3f}" height="{r:.3f}" fill="{color}"/>')
+        else:
+            parts.append(f'<path d="M {x:.2f} {y:.2f} q {r:.2f} {-r:.2f} {2 * r:.2f} 0" stroke="{color}" '
+                         f'stroke-width="{r / 2:.3f}" fill="none"/>')
+    return f'<svg {NS} width="200" height="200">{"".join(parts)}</svg>'.encode()
+
+
+def long_path_svg(rng: random.Random) -> bytes:
+    """One path of 3,000 to 60,000 segments (lines, quadratics, cubics or all three), a walk
+    of short or canvas-wide steps, filled with a colour or a gradient, sometimes stroked
+    up to 10^7 wide."""
+    n = rng.choice([3000, 10_000, 30_000, 60_000])
+    kinds = rng.choice(["L", "C", "LQC", "QC"])
+    step = rng.choice([1.0, 4.0, 15.0])
+    counts = {"L": 1, "Q": 2, "C": 3}
+    x = y = 100.0
+    out = [f"M {x:.1f} {y:.1f}"]
+    for i in range(n):
+        k = kinds[i % len(kinds)]
+        pts = []
+        for _ in range(counts[k]):
+            x = min(max(x + rng.uniform(-step, step), 0.0), 200.0)
+            y = min(max(y + rng.uniform(-step, step), 0.0), 200.0)
+            pts.append(f"{x:.1f} {y:.1f}")
+        out.append(k + " ".join(pts))
+    fill = rng.choice(['fill="#3a6"', 'fill="url(#g)"', 'fill="none"'])
+    stroke = rng.choice(["", 'stroke="#000" stroke-width="1"', 'stroke="#000" stroke-width="30"',
+                         'stroke="green" stroke-width="1e7"'])
+    defs = ('<defs><linearGradient id="g"><stop offset="0" stop-color="red"/><stop offset="1" '
+            'stop-color="blue"/></linearGradient></defs>')
+    return (f'<svg {NS} width="200" height="200">{defs}<path d="{" ".join(out)} Z" {fill} {stroke}/></svg>').encode()
+
+
 # ------------------------------------------------------------------------------ cases
 
 @dataclass
@@ -318,11 +391,45 @@ def make_case(seed: int, index: int, seeds: list[Path] | None = None) -> Case:
                  "--samples", "1", "--threads", "1"]
         return Case(index, "image", command, args, files, timeout=60,
                     outputs=["out.svg", "out.report.json", "out.compare.png"])
+    if roll < 0.16:  # an image with a side under 12 px through every fitting command
+        name, data, w, h = thin_image(rng)
+        command = rng.choice(["refine", "trace", "paint", "edit", "retarget"])
+        svg = (f'<svg {NS} viewBox="0 0 {w} {h}"><rect width="{w}" height="{h}" fill="#888"/>'
+               f'<circle cx="{w / 3:g}" cy="{h / 2:g}" r="{min(w, h) / 3:g}" fill="red"/></svg>').encode()
+        files = {name: data, "init.svg": svg}
+        args = {"refine": ["refine", name, "init.svg"], "trace": ["trace", name, "--paths", "4"],
+                "paint": ["paint", name, "--paths", "4"], "edit": ["edit", "init.svg", name],
+                "retarget": ["retarget", "init.svg", "--width", "80%"] if w > h else
+                            ["retarget", "init.svg", "--width", "100%", "--height", "80%"]}[command]
+        args += ["-o", "out.svg", "--iterations", str(rng.choice([0, 2])), "-q", "--samples", "1", "--threads", "1"]
+        if command != "retarget":
+            args += ["--max-size", str(rng.choice([48, 512]))]
+        return Case(index, "thin", command, args, files, timeout=60,
+                    outputs=["out.svg", "out.report.json", "out.compare.png"])
+    if roll < 0.19:  # many tiny shapes refined against a small target
+        import io
+
+        import numpy as np
+        from PIL import Image
+        buf = io.BytesIO()
+        side = rng.choice([11, 16, 64])
+        Image.fromarray((np.random.default_rng(index).random((side, side, 3)) * 255).astype(np.uint8)).save(buf, "PNG")
+        args = ["refine", "target.png", "init.svg", "-o", "out.svg", "--iterations", str(rng.choice([1, 3])), "-q",
+                "--samples", "1", "--threads", "1", "--mode", rng.choice(["mc", "analytic"])]
+        return Case(index, "tiny", "refine", args, {"target.png": buf.getvalue(), "init.svg": tiny_shapes_svg(rng)},
+                    timeout=60, outputs=["out.svg", "out.report.json", "out.compare.png"])
+    if roll < 0.22:  # one very long path at 64 px (a hang: 20 s)
+        mode = rng.choice(["mc", "analytic"])
+        return Case(index, "longpath", "render", ["render", "in.svg", "-o", "out.png", "--width", "64", "--mode", mode,
+                                                  "--samples", "1", "--threads", "1"],
+                    {"in.svg": long_path_svg(rng)}, timeout=20, outputs=["out.png"])
     kind = "mutation" if roll < 0.6 else "grammar"
     svg = mutated_svg(rng, seeds) if kind == "mutation" else grammar_svg(rng)
     if rng.random() < 0.2:
         return Case(index, kind, "info", ["info", "in.svg"], {"in.svg": svg})
-    size = rng.choice([["--width", "64"], ["--height", "48"], ["--width", "64", "--height", "1"], []])
+    size = rng.choice([["--width", "64"], ["--height", "48"], ["--width", "64", "--height", "1"], [],
+                       ["--width", str(rng.randint(1, 6))], ["--width", "3", "--height", "2"],
+                       ["--width", "200", "--height", str(rng.randint(1, 6))]])
     mode = rng.choice(["mc", "mc", "analytic"])
     return Case(index, kind, "render", ["render", "in.svg", "-o", "out.png", *size, "--mode", mode,
                                         "--samples", "1", "--threads", "1"], {"in.svg": svg},

@@ -2,10 +2,13 @@
 resource limits (vecfit/limits.py): each refusal is one line with the limit in it.
 
 The cases run in the fuzzer's worker process, so that a crash or a hang fails a test
-instead of ending the run. About 25 s in all, most of it the 10^5-segment renders."""
+instead of ending the run. About 50 s in all, most of it the 10^5-segment renders and the
+second campaign's cases (issue 28: wide short targets, scenes that barely touch the
+target, long paths in both modes; the pydiffvg scripts are in test_pydiffvg_scripts.py)."""
 from __future__ import annotations
 
 import math
+import tempfile
 import time
 from pathlib import Path
 
@@ -14,7 +17,7 @@ import pytest
 import torch
 
 import vecfit
-from fuzzing import NS, Case, Runner, run_case
+from fuzzing import NS, Case, Runner, run_case, verdict
 from helpers import quiet_load, run
 from vecfit import limits
 
@@ -158,3 +161,118 @@ def test_root_in_another_namespace_says_so(tmp_path):
     svg.write_text('<svg xmlns="999http://www.w3.org/2000/svg" width="9" height="9"/>')
     r = run("info", svg)
     assert r.exit_code == 1 and "namespace '999http://www.w3.org/2000/svg', not SVG's" in r.stderr
+
+
+# ----------------------------------------------- issue 28: the second fuzzing campaign
+
+def _png(array) -> bytes:
+    import io
+    from PIL import Image
+    buf = io.BytesIO()
+    Image.fromarray(array).save(buf, format="PNG")
+    return buf.getvalue()
+
+
+def _noise_png(width: int, height: int, seed: int = 0) -> bytes:
+    return _png((np.random.default_rng(seed).random((height, width, 3)) * 255).astype(np.uint8))
+
+
+WIDE_SVG = (f'<svg {NS} width="700" height="11"><rect width="700" height="11" fill="#ddd"/>'
+            '<circle cx="100" cy="5" r="4" fill="red"/><path d="M 300 1 L 400 10 L 350 2 Z" fill="blue"/></svg>')
+FIT_OUTPUTS = ["out.svg", "out.report.json", "out.compare.png"]
+QUICK = ["--iterations", "2", "-q", "--threads", "1"]
+
+
+@pytest.mark.parametrize("args", [
+    ["paint", "wide.png", "--paths", "4"],
+    ["refine", "wide.png", "wide.svg"],
+    ["trace", "wide.png", "--paths", "4"],
+    ["edit", "wide.svg", "wide.png", "--max-size", "512"],
+    ["retarget", "wide.svg", "--width", "600"],
+], ids=lambda a: a[0])
+def test_wide_short_images_fit(runner, args):
+    """A 700 x 11 target: paint's 512-px working size made it 8 px high, under SSIM's
+    11 x 11 window (a traceback); retarget's 512-px working image likewise."""
+    files = {"wide.png": _noise_png(700, 11), "wide.svg": WIDE_SVG.encode()}
+    out = check(runner, [*args, "-o", "out.svg", *QUICK], files, FIT_OUTPUTS)
+    assert out["exit_code"] == 0, out["stderr"]
+
+
+def test_wide_short_images_batch(runner):
+    case = Case(0, "fixed", "batch", ["batch", "in", "-o", "out", "--mode", "paint", "--config", "it.toml", "-q"],
+                {}, 60.0, [])
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        (folder / "in").mkdir()
+        (folder / "in" / "wide.png").write_bytes(_noise_png(700, 11))
+        (folder / "it.toml").write_text("[optimize]\niterations = 2\n")
+        outcome = runner.run(case, folder)
+        assert verdict(case, folder, outcome) is None and outcome["exit_code"] == 0, outcome
+        assert (folder / "out" / "wide.svg").exists() and (folder / "out" / "wide.report.json").exists()
+
+
+def _circles(n: int, size: float, radius: float, offset: float = 0.0, seed: int = 0) -> str:
+    rng = np.random.default_rng(seed)
+    body = "".join(f'<circle cx="{offset + x:.2f}" cy="{offset + y:.2f}" r="{r:.2f}" fill="#{c:06x}"/>'
+                   for x, y, r, c in zip(rng.uniform(0, size, n), rng.uniform(0, size, n),
+                                         rng.uniform(0, radius, n), rng.integers(0, 1 << 24, n)))
+    return f'<svg {NS} width="{size:g}" height="{size:g}">{body}</svg>'
+
+
+BARELY = [
+    # 300 circles of radius 0-5 on 200 px against a 64 px target: radii cross 0 (draws
+    # come and go), so the fit's last, no-grad evaluation packed the scene anew and the
+    # pack's gradient self-check ran without a graph ("does not require grad")
+    ("tiny-circles", _circles(300, 200, 5)),
+    # every shape below a pixel at the target's size
+    ("below-a-pixel", f'<svg {NS} width="20000" height="20000"><rect x="100" y="100" width="20" height="20" '
+                      'fill="red"/><circle cx="5000" cy="5000" r="30" fill="blue"/><path d="M 9000 9000 '
+                      'C 9010 9000 9010 9010 9000 9010 Z" fill="green" stroke="black" stroke-width="3"/></svg>'),
+    # every shape off the canvas
+    ("off-canvas", f'<svg {NS} width="200" height="200"><rect x="300" y="10" width="20" height="20" fill="red"/>'
+                   '<circle cx="-50" cy="50" r="30" fill="blue"/><path d="M 10 -90 C 50 -90 50 -50 10 -50 Z" '
+                   'fill="green" stroke="black" stroke-width="3"/></svg>'),
+    # radii 0 to 0.05 px: few of the parameters reach a pixel, none of them much
+    ("dust", _circles(400, 64, 0.05, seed=1)),
+]
+
+
+@pytest.mark.parametrize("name, svg", BARELY, ids=[n for n, _ in BARELY])
+@pytest.mark.parametrize("mode", ["mc", "analytic"])
+def test_scenes_that_barely_touch_the_target(runner, name, svg, mode):
+    files = {"target.png": _noise_png(64, 64, seed=2), "in.svg": svg.encode()}
+    out = check(runner, ["refine", "target.png", "in.svg", "-o", "out.svg", "--iterations", "3", "--mode", mode,
+                         "-q", "--threads", "1", "--samples", "1"], files, FIT_OUTPUTS)
+    assert out["exit_code"] == 0, out["stderr"]
+
+
+def _long_path(n: int, kinds: str, step: float, seed: int = 0) -> str:
+    rng = np.random.default_rng(seed)
+    counts = {"L": 1, "Q": 2, "C": 3}
+    xy = np.array([100.0, 100.0])
+    out = ["M 100 100"]
+    for i in range(n):
+        k = kinds[i % len(kinds)]
+        pts = []
+        for _ in range(counts[k]):
+            xy = np.clip(xy + rng.uniform(-step, step, 2), 0, 200)
+            pts.append(f"{xy[0]:.1f} {xy[1]:.1f}")
+        out.append(k + " ".join(pts))
+    return " ".join(out) + " Z"
+
+
+@pytest.mark.parametrize("name, body", [
+    # 30,000 cubics: the analytical mode measured each curve at every pixel of its box
+    ("cubics", lambda: f'<path d="{_long_path(30_000, "C", 60.0)}" fill="#3a6"/>'),
+    # mixed segments, a gradient fill and a stroke 10^7 wide: every stroke item was listed
+    # in every tile and measured at every pixel (past 20 s and 2 GB)
+    ("mixed-wide-stroke", lambda: '<defs><linearGradient id="g"><stop offset="0" stop-color="red"/><stop offset="1" '
+     f'stop-color="blue"/></linearGradient></defs><path d="{_long_path(30_000, "LQC", 4.0, 1)}" fill="url(#g)" '
+     'stroke="green" stroke-width="1e7"/>'),
+], ids=["cubics", "mixed-wide-stroke"])
+@pytest.mark.parametrize("mode", ["mc", "analytic"])
+def test_long_paths_render_in_both_modes(runner, name, body, mode):
+    svg = f'<svg {NS} width="200" height="200">{body()}</svg>'.encode()
+    out = check(runner, ["render", "in.svg", "-o", "out.png", "--width", "64", "--mode", mode, "--threads", "1"],
+                {"in.svg": svg}, ["out.png"], timeout=20)
+    assert out["exit_code"] == 0, out["stderr"]

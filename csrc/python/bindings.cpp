@@ -16,6 +16,7 @@
 #include <utility>
 
 #include "backward/backward.h"
+#include "backward/points.h"
 #include "common/cancel.h"
 #include "common/phase_clock.h"
 #include "common/thread_pool.h"
@@ -269,6 +270,48 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
     return grads_dict(g);
 }
 
+// The scene at n points (pixel space, [n, 2]) in the analytical mode with kernel radius
+// filter_radius: [n, 4] straight RGBA (pydiffvg's eval_positions).
+RenderOptions points_options(double filter_radius, int threads) {
+    return render_options(1, 1, 1, "analytic", "tent", filter_radius, 0, threads, py::none());
+}
+
+const double* points_of(const Array<double>& positions, int& n) {
+    const double* xy = rows(positions, 2, n, "positions");
+    return xy;
+}
+
+py::array_t<float> render_points_py(const py::dict& scene, Array<double> positions, double filter_radius, int threads) {
+    SceneInput in = scene_input(scene);
+    SceneArrays a = in.arrays();
+    RenderOptions o = points_options(filter_radius, threads);
+    int n = 0;
+    const double* xy = points_of(positions, n);
+    py::array_t<float> out({(py::ssize_t)n, (py::ssize_t)4});
+    float* px = out.mutable_data();
+    interruptible([&] { render_points(timed_prepare(a), o, xy, n, px); });
+    return out;
+}
+
+// render_points' adjoint: (dL/d(scene arrays) as render_grad's dict, dL/d(positions) [n, 2]).
+py::tuple render_points_grad_py(const py::dict& scene, Array<double> positions, Array<float> colours,
+                                Array<float> d_colours, double filter_radius, int threads) {
+    SceneInput in = scene_input(scene);
+    SceneArrays a = in.arrays();
+    RenderOptions o = points_options(filter_radius, threads);
+    int n = 0;
+    const double* xy = points_of(positions, n);
+    if (colours.size() != (py::ssize_t)n * 4 || d_colours.size() != colours.size())
+        throw std::invalid_argument("colours and their gradient must be n x 4");
+    SceneGrads g;
+    py::array_t<double> d_xy({(py::ssize_t)n, (py::ssize_t)2});
+    double* dp = d_xy.mutable_data();
+    interruptible([&] {
+        render_points_backward(timed_prepare(a), a, o, xy, n, colours.data(), d_colours.data(), g, dp);
+    });
+    return py::make_tuple(grads_dict(g), d_xy);
+}
+
 // Runs task(b) for every scene of a batch on up to `threads` threads, one scene per
 // thread at a time; the first error (in scene order) is raised after all have run.
 template <class Task>
@@ -407,6 +450,13 @@ PYBIND11_MODULE(_core, m) {
           py::arg("scenes"), py::arg("images"), py::arg("d_images"), py::arg("width"), py::arg("height"),
           py::arg("samples"), py::arg("mode"), py::arg("filter"), py::arg("filter_radius"), py::arg("seeds"),
           py::arg("threads"), py::arg("background"), py::arg("boundary_density"), py::arg("interior_samples") = 0);
+    m.def("render_points", &render_points_py,
+          "The scene at points [n, 2] (pixel space), analytical mode with kernel radius filter_radius: [n, 4] "
+          "straight RGBA", py::arg("scene"), py::arg("positions"), py::arg("filter_radius"), py::arg("threads"));
+    m.def("render_points_grad", &render_points_grad_py,
+          "render_points' gradients: (dict of the scene arrays' gradients, dL/d(positions) [n, 2])",
+          py::arg("scene"), py::arg("positions"), py::arg("colours"), py::arg("d_colours"),
+          py::arg("filter_radius"), py::arg("threads"));
     m.def("filter_radius_grad", &filter_radius_grad,
           "dL/d(filter radius) in Monte Carlo mode, given dL/d(premultiplied colour) per pixel",
           py::arg("scene"), py::arg("g"), py::arg("width"), py::arg("height"), py::arg("samples"),

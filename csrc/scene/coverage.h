@@ -399,7 +399,24 @@ VF_HD int draw_winding_all(const SceneView& sc, const PreparedDraw& d, Vec2 p) {
     return w;
 }
 
+// A lower bound on the squared distance from p to the segment, from the boxes of its
+// sub-pieces (see PreparedSegment::sub_y): a long curve's own box holds most of the canvas,
+// where each sub-piece's holds a strip of it; stops once under `enough`.
+VF_HD double sub_box_distance2(const PreparedSegment& s, Vec2 p, double enough) {
+    double best = 1e300;
+    for (int k = 0; k + 1 < s.n_split; ++k)
+        for (int j = 0; j < s.n_sub; ++j) {
+            double ya = s.sub_y[k][j], yb = s.sub_y[k][j + 1];
+            best = vmin(best, distance2(Box{s.sub_x0[k][j], vmin(ya, yb), s.sub_x1[k][j], vmax(ya, yb)}, p));
+            if (best < enough) return best;
+        }
+    return best;
+}
+
 // Distance from p to the closest fill segment among items, or `limit` if none is closer.
+// (The closest point of a curve costs a quintic's roots: a curve is measured only where a
+// sub-piece's box comes within the distance so far, so that a long path's cost follows the
+// pixels near each segment, not those in its box.)
 template <class Items>
 VF_HD double fill_distance(const SceneView& sc, const PreparedDraw& d, const Items& items, Vec2 p, double limit,
                      SdfArg* arg = nullptr) {
@@ -408,7 +425,12 @@ VF_HD double fill_distance(const SceneView& sc, const PreparedDraw& d, const Ite
     for (int i = 0; i < items.size(); ++i) {
         const PreparedSegment& s = segs[items[i]];
         double d2 = distance2(s.box, p);  // (on an edge, with arg: look for a second one)
-        if (d2 >= best * best && !(arg && best < ON_EDGE && d2 < ON_EDGE * ON_EDGE)) continue;
+        auto far = [&] { return d2 >= best * best && !(arg && best < ON_EDGE && d2 < ON_EDGE * ON_EDGE); };
+        if (far()) continue;
+        if (s.seg.degree > 1) {
+            d2 = sub_box_distance2(s, p, vmin(best * best, ON_EDGE * ON_EDGE));
+            if (far()) continue;
+        }
         Closest c;
         if (s.seg.degree == 1) {
             Vec2 a = s.seg.p[0], e = s.seg.p[1] - a;
@@ -491,6 +513,9 @@ VF_HD double stroke_sdf(const SceneView& sc, const PreparedDraw& d, const Items&
                     arg->item = d.first_item + items[i];
                 }
             }
+            // As deep as the clamp below: whatever else is near, the answer is -limit (and
+            // its kernel slope 0). A stroke 10^7 px wide measured all its items per pixel.
+            if (sd * d.metric_scale <= -limit) break;
         }
     }
     return vclamp(sd * d.metric_scale, -limit, limit);

@@ -65,9 +65,37 @@ struct Pending {
     TileEntry entry;
 };
 
+// Whether the tile's region lies inside one piece of a uniform-width stroke item: its
+// sweep, when the item is a line (a rectangle in stroke space), or a round join or cap (a
+// disk). The region maps to a parallelogram in stroke space, inside a convex piece when
+// its four corners are.
+bool region_inside_piece(const PreparedDraw& d, const StrokeSegment& s, const Box& region) {
+    Vec2 corners[4] = {{region.x0, region.y0}, {region.x1, region.y0}, {region.x0, region.y1}, {region.x1, region.y1}};
+    for (Vec2& c : corners) c = to_stroke_space(d, c);
+    auto all = [&](auto inside) {
+        for (const Vec2& c : corners)
+            if (!inside(c)) return false;
+        return true;
+    };
+    const double hw = d.half_width;
+    for (const StrokeEnd* e : {&s.start, &s.end})
+        if (e->kind == StrokeEnd::DISK && all([&](Vec2 q) { return distance(q, e->center) <= e->hw; })) return true;
+    if (s.seg.degree != 1) return false;
+    Vec2 a = s.seg.p[0], u = s.seg.p[1] - a;
+    double len = length(u);
+    if (!(len > 0)) return false;
+    u = (1 / len) * u;
+    return all([&](Vec2 q) {
+        double along = dot(q - a, u);
+        return along >= 0 && along <= len && std::fabs(cross(u, q - a)) <= hw;
+    });
+}
+
 // A worker's buffers for bin_path_draw, reused from draw to draw.
 struct DrawScratch {
     std::vector<int> counts, start, local, cursor;
+    std::vector<char> full;
+    std::vector<int> stamp;
     std::vector<TileRange> item_tiles;
     std::vector<std::vector<std::pair<double, int>>> row_crossings;
 };
@@ -86,12 +114,59 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
     counts.assign(w * h + 1, 0);
     std::vector<TileRange>& item_tiles = scratch.item_tiles;
     item_tiles.resize(d.n_items);
-    for (int k = 0; k < d.n_items; ++k) {
-        item_tiles[k] = tiles_of(item_box(k), bins.margin, range);
-        const TileRange& r = item_tiles[k];
-        for (int ty = r.y0; ty <= r.y1; ++ty)
-            for (int tx = r.x0; tx <= r.x1; ++tx) ++counts[(ty - range.y0) * w + (tx - range.x0)];
+    for (int k = 0; k < d.n_items; ++k) item_tiles[k] = tiles_of(item_box(k), bins.margin, range);
+    // Strokes wide against a tile: the tiles inside one of their pieces are covered there,
+    // whatever the other items do; they list no items (a stroke 10^7 px wide listed every
+    // item in every tile: gigabytes, and the analytical mode measured each one per pixel).
+    std::vector<char>& full = scratch.full;
+    full.assign(w * h, 0);
+    int n_full = 0;
+    if (!fill && !d.varying && d.half_width * d.metric_scale >= 0.5 * TILE + bins.margin) {
+        for (int k = 0; k < d.n_items && n_full < w * h; ++k) {
+            const StrokeSegment& s = sc.stroke_items[d.first_item + k];
+            if (s.seg.degree != 1 && s.start.kind != StrokeEnd::DISK && s.end.kind != StrokeEnd::DISK) continue;
+            const TileRange& r = item_tiles[k];
+            for (int ty = r.y0; ty <= r.y1; ++ty)
+                for (int tx = r.x0; tx <= r.x1; ++tx) {
+                    int cell = (ty - range.y0) * w + (tx - range.x0);
+                    if (!full[cell] && region_inside_piece(d, s, bins.region(ty * bins.nx + tx))) {
+                        full[cell] = 1;
+                        ++n_full;
+                    }
+                }
+        }
     }
+    // The tiles an item is listed in: those its box reaches, but for a curve of a fill only
+    // those one of its sub-pieces' boxes reach (a curve across the canvas was listed in
+    // every tile of its box). A curve that reaches no part of a region crosses neither leg
+    // of the winding path there (the corner rays count every segment, see above).
+    std::vector<int>& stamp = scratch.stamp;
+    stamp.assign(w * h, -1);
+    auto for_each_tile = [&](int k, auto visit) {
+        const TileRange& r = item_tiles[k];
+        const PreparedSegment* seg = fill ? &sc.fill_items[d.first_item + k] : nullptr;
+        if (!seg || seg->seg.degree == 1 || r.width() * (r.y1 - r.y0 + 1) <= 4) {
+            for (int ty = r.y0; ty <= r.y1; ++ty)
+                for (int tx = r.x0; tx <= r.x1; ++tx) visit((ty - range.y0) * w + (tx - range.x0));
+            return;
+        }
+        for (int i = 0; i + 1 < seg->n_split; ++i)
+            for (int j = 0; j < seg->n_sub; ++j) {
+                double ya = seg->sub_y[i][j], yb = seg->sub_y[i][j + 1];
+                TileRange sr = tiles_of(Box{seg->sub_x0[i][j], std::min(ya, yb), seg->sub_x1[i][j], std::max(ya, yb)},
+                                        bins.margin, r);
+                for (int ty = sr.y0; ty <= sr.y1; ++ty)
+                    for (int tx = sr.x0; tx <= sr.x1; ++tx) {
+                        int cell = (ty - range.y0) * w + (tx - range.x0);
+                        if (stamp[cell] != k) {
+                            stamp[cell] = k;
+                            visit(cell);
+                        }
+                    }
+            }
+    };
+    for (int k = 0; k < d.n_items; ++k)
+        for_each_tile(k, [&](int cell) { counts[cell] += !full[cell]; });
     std::vector<int>& start = scratch.start;
     start.assign(w * h + 1, 0);
     for (int i = 0; i < w * h; ++i) start[i + 1] = start[i] + counts[i];
@@ -99,11 +174,11 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
     local.resize(start[w * h]);
     std::vector<int>& cursor = scratch.cursor;
     cursor.assign(start.begin(), start.end() - 1);
-    for (int k = 0; k < d.n_items; ++k) {
-        const TileRange& r = item_tiles[k];
-        for (int ty = r.y0; ty <= r.y1; ++ty)
-            for (int tx = r.x0; tx <= r.x1; ++tx) local[cursor[(ty - range.y0) * w + (tx - range.x0)]++] = k;
-    }
+    stamp.assign(w * h, -1);
+    for (int k = 0; k < d.n_items; ++k)
+        for_each_tile(k, [&](int cell) {
+            if (!full[cell]) local[cursor[cell]++] = k;
+        });
 
     // Fills: crossings of each tile row's top line, to count the corner rays.
     std::vector<std::vector<std::pair<double, int>>>& row_crossings = scratch.row_crossings;
@@ -144,10 +219,11 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
             }
             int cell = (ty - range.y0) * w + (tx - range.x0);
             int n_local = start[cell + 1] - start[cell];
-            if (n_local == 0 && !every_tile && !(fill && winding_inside(winding, d.fill_rule))) continue;
+            if (n_local == 0 && !every_tile && !full[cell] && !(fill && winding_inside(winding, d.fill_rule)))
+                continue;
             TileEntry e;
             e.draw = draw_index;
-            e.winding = fill ? winding : 0;
+            e.winding = fill ? winding : full[cell];
             e.first = (int)items.size();
             e.count = n_local;
             for (int i = start[cell]; i < start[cell + 1]; ++i) {

@@ -35,7 +35,9 @@ struct LocalItem {
 
 struct TileEntry {
     int32_t draw = 0;
-    int32_t winding = 0;          // crossings of the corner ray (fills)
+    int32_t winding = 0;          // fills: crossings of the corner ray; strokes: 1 where the
+                                  // tile's region lies inside one piece of the stroke (then
+                                  // it is covered there, and no items are listed)
     int32_t first = 0, count = 0; // local items
 };
 
@@ -99,7 +101,7 @@ struct LocalItems {
 // Whether the entry's draw covers p (a point of the tile region): the Monte Carlo test.
 VF_HD bool entry_covers(const SceneView& sc, const TileView& bins, const TileEntry& e, const Box& region, Vec2 p) {
     const PreparedDraw& d = sc.draws[e.draw];
-    if (d.kind == DRAW_STROKE) return stroke_contains(sc, d, LocalItems(bins, e), p);
+    if (d.kind == DRAW_STROKE) return e.winding != 0 || stroke_contains(sc, d, LocalItems(bins, e), p);
     if (d.is_ellipse) return ellipse_contains(d.ellipse, p);
     return winding_inside(tile_winding(sc, bins, e, region, p), d.fill_rule);
 }
@@ -110,7 +112,13 @@ VF_HD bool entry_covers(const SceneView& sc, const TileView& bins, const TileEnt
 VF_HD double entry_sdf(const SceneView& sc, const TileView& bins, const TileEntry& e, const Box& region, Vec2 p,
                        double r, SdfArg* arg = nullptr) {
     const PreparedDraw& d = sc.draws[e.draw];
-    if (d.kind == DRAW_STROKE) return stroke_sdf(sc, d, LocalItems(bins, e), p, r, arg);
+    if (d.kind == DRAW_STROKE) {
+        if (e.winding != 0) {  // inside by at least the region's margin, which is >= r
+            if (arg) arg->kind = SdfArg::NONE;
+            return -r;
+        }
+        return stroke_sdf(sc, d, LocalItems(bins, e), p, r, arg);
+    }
     if (d.is_ellipse) return ellipse_fill_sdf(d, p, r, arg);
     double dist = fill_distance(sc, d, LocalItems(bins, e), p, r, arg);
     return winding_inside(tile_winding(sc, bins, e, region, p), d.fill_rule) ? -dist : dist;

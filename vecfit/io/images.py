@@ -78,12 +78,26 @@ def load_rgba(path: str | os.PathLike) -> np.ndarray:
     return np.asarray(rgba, dtype=np.float32) / 255.0
 
 
+# The shortest side a working image is scaled to (unless the image is shorter itself): the
+# jobs' minimum, SSIM's 11 x 11 window. A 700 x 11 target at 512 px would be 8 px high.
+MIN_WORKING_SIDE = 11
+
+
+def working_scale(width: float, height: float, max_size: float, min_side: float = MIN_WORKING_SIDE) -> float:
+    """The scale (at most 1) that brings the longest side to max_size (<= 0: no limit),
+    but keeps the shortest side at min_side or more: a very wide image keeps its aspect
+    ratio and stays longer than max_size."""
+    scale = max_size / max(width, height) if max_size > 0 else 1.0
+    return min(1.0, max(scale, min_side / min(width, height)))
+
+
 def downscaled(image: np.ndarray, max_size: int) -> np.ndarray:
-    """The image with its longest side at most max_size (area-averaged, premultiplied)."""
+    """The image with its longest side at most max_size (area-averaged, premultiplied), its
+    shortest at least MIN_WORKING_SIDE (see working_scale)."""
     h, w = image.shape[:2]
-    if max_size <= 0 or max(h, w) <= max_size:
+    scale = working_scale(w, h, max_size)
+    if scale >= 1:
         return image
-    scale = max_size / max(h, w)
     size = (max(1, round(w * scale)), max(1, round(h * scale)))
     pre = np.concatenate([image[..., :3] * image[..., 3:], image[..., 3:]], axis=2)
     small = cv2.resize(pre, size, interpolation=cv2.INTER_AREA)

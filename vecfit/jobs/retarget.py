@@ -99,6 +99,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
 
     # Work at one scale s (pixels of the working image per pixel of the canvas).
     s = retarget.work_size / max(w0, h0) if retarget.work_size > 0 else 1.0
+    s = max(s, MIN_SIDE / min(new_w, new_h))  # (a wide SVG: its new short side stays >= 11 px)
     ww, wh = max(1, round(w0 * s)), max(1, round(h0 * s))
     s_x, s_y = ww / w0, wh / h0
 

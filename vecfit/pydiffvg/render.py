@@ -104,6 +104,20 @@ class _FilterRadius(torch.autograd.Function):
         return d_r, grad, None
 
 
+class _Blank(torch.autograd.Function):
+    """diffvg's image for a filter radius <= 0: transparent black, with zero gradients for
+    the tensors given (so that a loss of it still has a graph to go back through)."""
+
+    @staticmethod
+    def forward(ctx, shape, *tensors):
+        ctx.likes = [(t.shape, t.dtype) for t in tensors]
+        return torch.zeros(shape)
+
+    @staticmethod
+    def backward(ctx, grad):
+        return (None, *(torch.zeros(shape, dtype=dtype) for shape, dtype in ctx.likes))
+
+
 def _premultiplied_adjoint(image, grad):
     """dL/d(premultiplied RGBA) from dL/d(straight RGBA) of a straight image (no
     background: the adapter composites background images after the render)."""
@@ -216,6 +230,12 @@ class RenderFunction:
         ftype = FilterType(int(parsed.filter_type))
         radius = parsed.filter_radius
         r = float(radius.detach()) if isinstance(radius, torch.Tensor) else float(radius)
+        if r <= 0:
+            # diffvg goes on: no pixel centre is within a radius <= 0 of a sample (its weight
+            # test is |dx| > r), so no sample is splatted, the background image neither
+            tensors = [a for a in args if isinstance(a, torch.Tensor) and a.is_floating_point()
+                       and a.requires_grad] if torch.is_grad_enabled() else []
+            return _Blank.apply((int(height), int(width), 4), *tensors).to(device.get_device())
         if parsed.use_prefiltering:
             options = dict(samples=1, mode="analytic")
         else:

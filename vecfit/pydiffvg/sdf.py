@@ -19,6 +19,7 @@ import torch
 from vecfit.renderer.raster import render
 
 from .convert import Parsed, to_scene
+from .points import at_points
 from .enums import ColorType
 
 WHITE = torch.tensor([1.0, 1.0, 1.0, 1.0])
@@ -44,6 +45,8 @@ def _distance(coverage: torch.Tensor, r: float) -> torch.Tensor:
 
 
 def _combine(distances: list[torch.Tensor]) -> torch.Tensor:
+    if len(distances) == 1:
+        return distances[0]
     d = torch.stack(distances)
     nearest = d.abs().min(dim=0).values
     inside = (d < 0).any(dim=0)
@@ -65,24 +68,12 @@ def sdf_image(parsed: Parsed, width: int, height: int, device: str) -> torch.Ten
 
 
 def sdf_at(parsed: Parsed, positions: torch.Tensor, device: str) -> torch.Tensor:
-    """[N, 1] signed distances at canvas positions [N, 2] (one 1 x 1 render per position
-    and region: meant for hundreds of points, not millions). Differentiable with respect to
-    the scene and the positions."""
+    """[N, 1] signed distances at canvas positions [N, 2], all the points of a region in one
+    call of the core (points.at_points). Differentiable with respect to the scene and the
+    positions. (On the CPU: the device is not used.)"""
     positions = positions.reshape(-1, 2).cpu().float()
     r = 2 * math.hypot(float(parsed.canvas_width), float(parsed.canvas_height))
-    out = []
-    for region in _regions(parsed):
-        scene = to_scene(region)
-        scene.width = scene.height = 1.0
-        column = []
-        for p in positions:
-            # the position at the centre of a 1 x 1 image
-            scene.view = torch.cat([torch.cat([torch.eye(2), (0.5 - p)[:, None]], dim=1),
-                                    torch.tensor([[0.0, 0.0, 1.0]])])
-            alpha = render(scene, 1, 1, samples=1, mode="analytic", filter="tent", filter_radius=r,
-                           device=device)[0, 0, 3]
-            column.append(_distance(alpha, r))
-        out.append(torch.stack(column) if column else torch.zeros(0))
+    out = [_distance(at_points(to_scene(region), positions, 1.0, r)[:, 3], r) for region in _regions(parsed)]
     if not out:
         return torch.full((positions.shape[0], 1), float("inf"))
     return _combine(out)[:, None]

@@ -202,7 +202,10 @@ class PersistentPack:
                    base, as_index(dst), as_index(src),
                    torch.from_numpy(np.concatenate(coef)).float() if coef else torch.zeros(0),
                    _conditions(provenance.presence, provenance.differences, at))
-        return pack if pack._agrees(kinds, packed) else None
+        # (the check differentiates: a pack first built in a no-grad evaluation, the loop's
+        # last, had no graph to check and raised)
+        with torch.enable_grad():
+            return pack if pack._agrees(kinds, packed) else None
 
     def arrays(self, leaves: list[torch.Tensor]) -> tuple[dict, list[torch.Tensor]]:
         """(integer tables, float arrays in FLOAT_INPUTS order), differentiable w.r.t. leaves."""

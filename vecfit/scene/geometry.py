@@ -52,23 +52,34 @@ def local_bbox(geometry) -> tuple[torch.Tensor, torch.Tensor] | None:
         return geometry.center - r, geometry.center + r
     if isinstance(geometry, Rect):
         return geometry.p_min, geometry.p_max
-    samples = []
+    # Curves sampled at 33 parameters, all the segments of a degree at once (segment by
+    # segment, a 30,000-segment path took a second here).
     t = torch.linspace(0, 1, 33, dtype=torch.float32)[:, None]
-    for pts, degrees in path_segments(geometry):
-        for deg, ctrl in zip(degrees, pts):
-            if deg == 1:
-                samples.append(ctrl)
-            elif deg == 2:
-                u = 1 - t
-                samples.append(u * u * ctrl[0] + 2 * u * t * ctrl[1] + t * t * ctrl[2])
-            else:
-                u = 1 - t
-                samples.append(u ** 3 * ctrl[0] + 3 * u * u * t * ctrl[1] + 3 * u * t * t * ctrl[2]
-                               + t ** 3 * ctrl[3])
+    u = 1 - t
+    bernstein = {1: torch.tensor([[1.0, 0.0], [0.0, 1.0]]), 2: torch.cat([u * u, 2 * u * t, t * t], dim=1),
+                 3: torch.cat([u ** 3, 3 * u * u * t, 3 * u * t * t, t ** 3], dim=1)}
+    samples = []
+    for d, index in _control_indices(geometry).items():
+        ctrl = geometry.points[torch.from_numpy(index)]  # [m, d + 1, 2]
+        samples.append(torch.einsum("sk,mkc->msc", bernstein[d].to(ctrl.dtype), ctrl).reshape(-1, 2))
     if not samples:
         return None
     allp = torch.cat(samples)
     return allp.min(dim=0).values, allp.max(dim=0).values
+
+
+def _control_indices(path: Path) -> dict[int, np.ndarray]:
+    """Degree -> [m, degree + 1] indices into path.points of each such segment's control points."""
+    out: dict[int, list] = {}
+    for (first, count, closed), (p0, n) in zip(path.subpaths, path.subpath_point_ranges()):
+        degrees = np.asarray(path.degrees[first:first + count], dtype=np.int64)
+        starts = np.concatenate([[0], np.cumsum(degrees)[:-1]]) if len(degrees) else degrees
+        for d in (1, 2, 3):
+            k = starts[degrees == d]
+            if len(k):
+                idx = k[:, None] + np.arange(d + 1)
+                out.setdefault(d, []).append(p0 + (idx % n if closed else idx))
+    return {d: np.concatenate(v) for d, v in out.items()}
 
 
 def path_segments(path: Path):
