@@ -51,8 +51,7 @@ def empty_scene() -> dict:
 
 
 def render(scene: dict) -> np.ndarray:
-    return _core.render(scene, width=4, height=3, samples=1, mode="mc", filter="box", filter_radius=0.5, seed=0,
-                        threads=1, background=None)
+    return _core.render(scene, _core.RenderOptions(width=4, height=3, samples=1, threads=1))
 
 
 def test_the_listed_tables_make_a_scene():

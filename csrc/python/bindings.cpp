@@ -1,27 +1,26 @@
-// Python bindings of the core's API: numpy buffers in and out, the GIL released while
-// the core works. The hooks only the tests call are in test_hooks.cpp.
+// Python bindings of the core's API: checks and calls. numpy buffers in and out, the
+// options as one typed RenderOptions, the passes of api/passes.h run while Python can
+// still take a Ctrl-C (python/interrupt.h). The hooks only the tests call are in
+// test_hooks.cpp.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <atomic>
-#include <chrono>
-#include <exception>
-#include <future>
-#include <memory>
-#include <vector>
 #include <initializer_list>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
+#include "api/passes.h"
 #include "backward/backward.h"
 #include "backward/points.h"
-#include "common/cancel.h"
 #include "common/phase_clock.h"
 #include "common/thread_pool.h"
 #include "forward/forward.h"
 #include "gpu/gpu.h"
+#include "python/interrupt.h"
 #include "python/test_hooks.h"
 #include "scene/scene.h"
 
@@ -116,10 +115,20 @@ SceneInput scene_input(const py::dict& s) {
     return in;
 }
 
-RenderOptions render_options(int width, int height, int samples, const std::string& mode, const std::string& filter,
-                             double filter_radius, uint64_t seed, int threads, py::object background) {
+const char* mode_name(int mode) { return mode == MODE_ANALYTIC ? "analytic" : "mc"; }
+
+const char* filter_name(int filter) {
+    static const char* names[] = {"box", "tent", "gaussian", "parabolic", "hann"};
+    return filter >= 0 && filter < 5 ? names[filter] : "box";
+}
+
+// vecfit._core.RenderOptions(...): the options of every pass, checked once here.
+RenderOptions make_options(int width, int height, int samples, const std::string& mode, const std::string& filter,
+                           double filter_radius, uint64_t seed, int threads, py::object background,
+                           int interior_samples, bool brute_force) {
     if (width <= 0 || height <= 0) throw std::invalid_argument("width and height must be positive");
     if (samples <= 0) throw std::invalid_argument("samples must be positive");
+    if (interior_samples < 0) throw std::invalid_argument("interior_samples must be >= 0");
     RenderOptions o;
     o.width = width;
     o.height = height;
@@ -129,6 +138,8 @@ RenderOptions render_options(int width, int height, int samples, const std::stri
     o.filter_radius = filter_radius;
     o.seed = seed;
     o.threads = threads;
+    o.interior_samples = interior_samples;
+    o.brute_force = brute_force;
     if (!background.is_none()) {
         auto bg = background.cast<std::vector<double>>();
         if (bg.size() != 4) throw std::invalid_argument("background must be 4 numbers (RGBA)");
@@ -138,29 +149,10 @@ RenderOptions render_options(int width, int height, int samples, const std::stri
     return o;
 }
 
-// Runs the core's work on another thread and, every 50 ms, lets Python run its signal
-// handlers: a Ctrl-C cancels the work (the thread pool skips the tasks not started, see
-// common/cancel.h) and raises KeyboardInterrupt here, instead of waiting, deaf, for a
-// render that may take minutes. Called with the GIL held; releases it while waiting.
-template <class Work>
-void interruptible(Work&& work) {
-    std::future<void> done = std::async(std::launch::async, std::forward<Work>(work));
-    py::gil_scoped_release release;
-    while (done.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
-        py::gil_scoped_acquire gil;
-        if (PyErr_CheckSignals() != 0) {
-            cancel_requested().store(true);
-            done.wait();
-            cancel_requested().store(false);
-            throw py::error_already_set();
-        }
-    }
-    done.get();  // the core's exceptions, rethrown here
-}
-
-PreparedScene timed_prepare(const SceneArrays& a) {
-    PhaseTimer timer(PHASE_PREPARE);
-    return prepare_scene(a);
+void check_image(const Array<float>& image, const RenderOptions& o, py::ssize_t count, const char* what) {
+    if (image.size() != count * o.width * o.height * 4)
+        throw std::invalid_argument(std::string(what) + " must be " + (count > 1 ? "batch x " : "") +
+                                    "height x width x 4 of the options' size");
 }
 
 // A scene prepared by a forward pass, handed to Python (render_keeping) so that the
@@ -169,37 +161,26 @@ struct KeptScene {
     std::shared_ptr<const PreparedScene> scene;
 };
 
-py::array_t<float> render_into(const py::dict& scene, int width, int height, int samples, const std::string& mode,
-                               const std::string& filter, double filter_radius, uint64_t seed, int threads,
-                               py::object background, bool brute_force, int device, KeptScene* keep) {
+py::array_t<float> render_into(const py::dict& scene, const RenderOptions& o, int device, KeptScene* keep) {
     SceneInput in = scene_input(scene);
     SceneArrays a = in.arrays();
-    RenderOptions o = render_options(width, height, samples, mode, filter, filter_radius, seed, threads, background);
-    o.brute_force = brute_force;
-    py::array_t<float> image({height, width, 4});
+    py::array_t<float> image({o.height, o.width, 4});
     float* out = image.mutable_data();
     interruptible([&] {
-        auto prepared = std::make_shared<const PreparedScene>(timed_prepare(a));
-        if (device >= 0) gpu::render_forward(*prepared, o, device, out);
-        else render_forward(*prepared, o, out);
+        std::shared_ptr<const PreparedScene> prepared = prepare_timed(a);
+        forward_on(*prepared, o, device, out);
         if (keep) keep->scene = prepared;
     });
     return image;
 }
 
-py::array_t<float> render(const py::dict& scene, int width, int height, int samples, const std::string& mode,
-                          const std::string& filter, double filter_radius, uint64_t seed, int threads,
-                          py::object background, bool brute_force, int device) {
-    return render_into(scene, width, height, samples, mode, filter, filter_radius, seed, threads, background,
-                       brute_force, device, nullptr);
+py::array_t<float> render(const py::dict& scene, const RenderOptions& options, int device) {
+    return render_into(scene, options, device, nullptr);
 }
 
-py::tuple render_keeping(const py::dict& scene, int width, int height, int samples, const std::string& mode,
-                         const std::string& filter, double filter_radius, uint64_t seed, int threads,
-                         py::object background, int device) {
+py::tuple render_keeping(const py::dict& scene, const RenderOptions& options, int device) {
     KeptScene keep;
-    py::array_t<float> image = render_into(scene, width, height, samples, mode, filter, filter_radius, seed,
-                                           threads, background, false, device, &keep);
+    py::array_t<float> image = render_into(scene, options, device, &keep);
     return py::make_tuple(image, keep);
 }
 
@@ -225,47 +206,27 @@ py::dict grads_dict(const SceneGrads& g) {
 
 // dL/d(filter radius), Monte Carlo mode: g is dL/d(the filtered premultiplied colour of
 // each pixel, background excluded), height x width x 4. On the CPU.
-double filter_radius_grad(const py::dict& scene, Array<float> g, int width, int height, int samples,
-                          const std::string& filter, double filter_radius, uint64_t seed, int threads) {
+double filter_radius_grad(const py::dict& scene, Array<float> g, const RenderOptions& options) {
     SceneInput in = scene_input(scene);
     SceneArrays a = in.arrays();
-    RenderOptions o = render_options(width, height, samples, "mc", filter, filter_radius, seed, threads, py::none());
-    if (g.size() != (py::ssize_t)width * height * 4) throw std::invalid_argument("g must be height x width x 4");
+    if (options.mode != MODE_MC) throw std::invalid_argument("the filter radius's gradient is Monte Carlo's");
+    check_image(g, options, 1, "g");
     py::gil_scoped_release release;
-    PreparedScene prepared = timed_prepare(a);
-    return filter_radius_gradient(prepared, o, g.data());
+    return filter_radius_gradient(*prepare_timed(a), options, g.data());
 }
 
-// Backward passes redone on the CPU because a sample overflowed a GPU thread's lists.
-std::atomic<long> backward_fallbacks{0};
-
-py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_image, int width, int height,
-                     int samples, const std::string& mode, const std::string& filter, double filter_radius,
-                     uint64_t seed, int threads, py::object background, double boundary_density, int device,
-                     bool emulate_gpu_lists, int interior_samples, const KeptScene* kept) {
+py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_image, const RenderOptions& options,
+                     double boundary_density, int device, bool emulate_gpu_lists, const KeptScene* kept) {
     SceneInput in = scene_input(scene);
     SceneArrays a = in.arrays();
-    RenderOptions o = render_options(width, height, samples, mode, filter, filter_radius, seed, threads, background);
-    if (interior_samples < 0) throw std::invalid_argument("interior_samples must be >= 0");
-    o.interior_samples = interior_samples;
-    if (image.size() != (py::ssize_t)width * height * 4 || d_image.size() != image.size())
-        throw std::invalid_argument("image and its gradient must be height x width x 4");
+    check_image(image, options, 1, "image");
+    check_image(d_image, options, 1, "its gradient");
     SceneGrads g;
     interruptible([&] {
         // (kept: the forward pass's preparation of these same arrays)
-        std::shared_ptr<const PreparedScene> own;
-        if (!kept || !kept->scene) own = std::make_shared<const PreparedScene>(timed_prepare(a));
-        const PreparedScene& prepared = own ? *own : *kept->scene;
-        // On the GPU when asked, unless a sample there needs longer lists than a thread
-        // holds: then on the CPU. emulate_gpu_lists runs the CPU lanes with a GPU thread's
-        // lists first, to see on the CPU what a GPU run would do.
-        bool fixed = device >= 0 || emulate_gpu_lists, done = false;
-        if (device >= 0)
-            done = gpu::render_backward(prepared, a, o, image.data(), d_image.data(), boundary_density, device, g);
-        else if (emulate_gpu_lists)
-            done = render_backward(prepared, a, o, image.data(), d_image.data(), boundary_density, g, &GPU_LISTS);
-        if (fixed && !done) ++backward_fallbacks;
-        if (!done) render_backward(prepared, a, o, image.data(), d_image.data(), boundary_density, g);
+        std::shared_ptr<const PreparedScene> prepared = kept && kept->scene ? kept->scene : prepare_timed(a);
+        backward_on(*prepared, a, options, image.data(), d_image.data(), boundary_density, device, emulate_gpu_lists,
+                    g);
     });
     return grads_dict(g);
 }
@@ -273,7 +234,7 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
 // The scene at n points (pixel space, [n, 2]) in the analytical mode with kernel radius
 // filter_radius: [n, 4] straight RGBA (pydiffvg's eval_positions).
 RenderOptions points_options(double filter_radius, int threads) {
-    return render_options(1, 1, 1, "analytic", "tent", filter_radius, 0, threads, py::none());
+    return make_options(1, 1, 1, "analytic", "tent", filter_radius, 0, threads, py::none(), 0, false);
 }
 
 const double* points_of(const Array<double>& positions, int& n) {
@@ -289,7 +250,7 @@ py::array_t<float> render_points_py(const py::dict& scene, Array<double> positio
     const double* xy = points_of(positions, n);
     py::array_t<float> out({(py::ssize_t)n, (py::ssize_t)4});
     float* px = out.mutable_data();
-    interruptible([&] { render_points(timed_prepare(a), o, xy, n, px); });
+    interruptible([&] { render_points(*prepare_timed(a), o, xy, n, px); });
     return out;
 }
 
@@ -307,25 +268,9 @@ py::tuple render_points_grad_py(const py::dict& scene, Array<double> positions, 
     py::array_t<double> d_xy({(py::ssize_t)n, (py::ssize_t)2});
     double* dp = d_xy.mutable_data();
     interruptible([&] {
-        render_points_backward(timed_prepare(a), a, o, xy, n, colours.data(), d_colours.data(), g, dp);
+        render_points_backward(*prepare_timed(a), a, o, xy, n, colours.data(), d_colours.data(), g, dp);
     });
     return py::make_tuple(grads_dict(g), d_xy);
-}
-
-// Runs task(b) for every scene of a batch on up to `threads` threads, one scene per
-// thread at a time; the first error (in scene order) is raised after all have run.
-template <class Task>
-void for_each_scene(int n, int threads, Task task) {
-    std::vector<std::exception_ptr> errors(n);
-    ThreadPool::instance().parallel_for(n, threads, [&](int b, int) {
-        try {
-            task(b);
-        } catch (...) {
-            errors[b] = std::current_exception();
-        }
-    });
-    for (auto& e : errors)
-        if (e) std::rethrow_exception(e);
 }
 
 std::vector<SceneInput> batch_inputs(const py::list& scenes, const std::vector<uint64_t>& seeds) {
@@ -336,52 +281,36 @@ std::vector<SceneInput> batch_inputs(const py::list& scenes, const std::vector<u
     return inputs;
 }
 
-// A batch of scenes rendered at one size with one set of options (each its own seed), in
-// one call: parallel over the scenes, each scene on one thread. For training loops that
-// render many small scenes a step, where one call per scene would cost more than its pixels.
-py::array_t<float> render_batch(const py::list& scenes, int width, int height, int samples, const std::string& mode,
-                                const std::string& filter, double filter_radius, const std::vector<uint64_t>& seeds,
-                                int threads, py::object background) {
+std::vector<SceneArrays> batch_arrays(const std::vector<SceneInput>& inputs) {
+    std::vector<SceneArrays> arrays;
+    arrays.reserve(inputs.size());
+    for (const SceneInput& in : inputs) arrays.push_back(in.arrays());
+    return arrays;
+}
+
+// A batch of scenes at one size and options (each its own seed), parallel over the
+// scenes on options.threads threads (api/passes.h forward_batch).
+py::array_t<float> render_batch(const py::list& scenes, const RenderOptions& options,
+                                const std::vector<uint64_t>& seeds) {
     std::vector<SceneInput> inputs = batch_inputs(scenes, seeds);
-    RenderOptions o = render_options(width, height, samples, mode, filter, filter_radius, 0, 1, background);
-    const int n = (int)inputs.size();
-    const size_t pixels = (size_t)width * height;
-    py::array_t<float> images({(py::ssize_t)n, (py::ssize_t)height, (py::ssize_t)width, (py::ssize_t)4});
+    std::vector<SceneArrays> arrays = batch_arrays(inputs);
+    py::array_t<float> images({(py::ssize_t)inputs.size(), (py::ssize_t)options.height, (py::ssize_t)options.width,
+                               (py::ssize_t)4});
     float* out = images.mutable_data();
-    interruptible([&] {
-        for_each_scene(n, threads, [&](int b) {
-            SceneArrays a = inputs[b].arrays();
-            RenderOptions ob = o;
-            ob.seed = seeds[b];
-            render_forward(timed_prepare(a), ob, out + 4 * pixels * b);
-        });
-    });
+    interruptible([&] { forward_batch(arrays, options, seeds, out); });
     return images;
 }
 
 // Gradients of a batch rendered by render_batch: one dict per scene, as render_grad's.
-py::list render_grad_batch(const py::list& scenes, Array<float> images, Array<float> d_images, int width, int height,
-                           int samples, const std::string& mode, const std::string& filter, double filter_radius,
-                           const std::vector<uint64_t>& seeds, int threads, py::object background,
-                           double boundary_density, int interior_samples) {
+py::list render_grad_batch(const py::list& scenes, Array<float> images, Array<float> d_images,
+                           const RenderOptions& options, const std::vector<uint64_t>& seeds,
+                           double boundary_density) {
     std::vector<SceneInput> inputs = batch_inputs(scenes, seeds);
-    RenderOptions o = render_options(width, height, samples, mode, filter, filter_radius, 0, 1, background);
-    if (interior_samples < 0) throw std::invalid_argument("interior_samples must be >= 0");
-    o.interior_samples = interior_samples;
-    const int n = (int)inputs.size();
-    const size_t pixels = (size_t)width * height;
-    if (images.size() != (py::ssize_t)(4 * pixels * n) || d_images.size() != images.size())
-        throw std::invalid_argument("images and their gradients must be batch x height x width x 4");
-    std::vector<SceneGrads> grads(n);
-    interruptible([&] {
-        for_each_scene(n, threads, [&](int b) {
-            SceneArrays a = inputs[b].arrays();
-            RenderOptions ob = o;
-            ob.seed = seeds[b];
-            render_backward(timed_prepare(a), a, ob, images.data() + 4 * pixels * b, d_images.data() + 4 * pixels * b,
-                            boundary_density, grads[b]);
-        });
-    });
+    std::vector<SceneArrays> arrays = batch_arrays(inputs);
+    check_image(images, options, (py::ssize_t)inputs.size(), "images");
+    check_image(d_images, options, (py::ssize_t)inputs.size(), "their gradients");
+    std::vector<SceneGrads> grads;
+    interruptible([&] { backward_batch(arrays, options, seeds, images.data(), d_images.data(), boundary_density, grads); });
     py::list out;
     for (const SceneGrads& g : grads) out.append(grads_dict(g));
     return out;
@@ -424,32 +353,46 @@ py::dict layout() {
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "vecfit's compiled core: geometry and rendering on flat arrays";
+    py::class_<RenderOptions>(m, "RenderOptions",
+                              "The options of every pass: size, N x N samples, mode ('mc' or 'analytic'), pixel "
+                              "filter and radius, seed, threads (0: all), background (RGBA or None), the interior "
+                              "samples the Monte Carlo backward pass revisits (0: all), brute_force (every draw at "
+                              "every sample: a check of the tiles)")
+        .def(py::init(&make_options), py::kw_only(), py::arg("width"), py::arg("height"), py::arg("samples") = 2,
+             py::arg("mode") = "mc", py::arg("filter") = "box", py::arg("filter_radius") = 0.5, py::arg("seed") = 0,
+             py::arg("threads") = 0, py::arg("background") = py::none(), py::arg("interior_samples") = 0,
+             py::arg("brute_force") = false)
+        .def_readonly("width", &RenderOptions::width)
+        .def_readonly("height", &RenderOptions::height)
+        .def_readonly("samples", &RenderOptions::samples)
+        .def_property_readonly("mode", [](const RenderOptions& o) { return mode_name(o.mode); })
+        .def_property_readonly("filter", [](const RenderOptions& o) { return filter_name(o.filter); })
+        .def_readonly("filter_radius", &RenderOptions::filter_radius)
+        .def_readonly("seed", &RenderOptions::seed)
+        .def_readonly("threads", &RenderOptions::threads)
+        .def_readonly("interior_samples", &RenderOptions::interior_samples)
+        .def_readonly("brute_force", &RenderOptions::brute_force)
+        .def_property_readonly("background", [](const RenderOptions& o) -> py::object {
+            if (!o.has_background) return py::none();
+            return py::make_tuple(o.background[0], o.background[1], o.background[2], o.background[3]);
+        });
     m.def("render", &render, "Render the scene arrays (a dict, see vecfit/renderer/pack.py) into [H, W, 4] straight RGBA",
-          py::arg("scene"), py::arg("width"), py::arg("height"), py::arg("samples"), py::arg("mode"),
-          py::arg("filter"), py::arg("filter_radius"), py::arg("seed"), py::arg("threads"), py::arg("background"),
-          py::arg("brute_force") = false, py::arg("device") = -1);
+          py::arg("scene"), py::arg("options"), py::arg("device") = -1);
     py::class_<KeptScene>(m, "KeptScene", "A scene prepared by render_keeping, for render_grad's `prepared`");
     m.def("render_keeping", &render_keeping,
           "render, returning (image, the prepared scene) for render_grad of the same arrays",
-          py::arg("scene"), py::arg("width"), py::arg("height"), py::arg("samples"), py::arg("mode"),
-          py::arg("filter"), py::arg("filter_radius"), py::arg("seed"), py::arg("threads"), py::arg("background"),
-          py::arg("device") = -1);
+          py::arg("scene"), py::arg("options"), py::arg("device") = -1);
     m.def("render_grad", &render_grad,
           "Gradients of the scene arrays given the forward image and dL/d(image)",
-          py::arg("scene"), py::arg("image"), py::arg("d_image"), py::arg("width"), py::arg("height"),
-          py::arg("samples"), py::arg("mode"), py::arg("filter"), py::arg("filter_radius"), py::arg("seed"),
-          py::arg("threads"), py::arg("background"), py::arg("boundary_density"), py::arg("device") = -1,
-          py::arg("emulate_gpu_lists") = false, py::arg("interior_samples") = 0,
-          py::arg("prepared") = nullptr);
+          py::arg("scene"), py::arg("image"), py::arg("d_image"), py::arg("options"), py::arg("boundary_density"),
+          py::arg("device") = -1, py::arg("emulate_gpu_lists") = false, py::arg("prepared") = nullptr);
     m.def("render_batch", &render_batch,
           "Render a list of scene dicts at one size into [B, H, W, 4] straight RGBA, in parallel over the scenes",
-          py::arg("scenes"), py::arg("width"), py::arg("height"), py::arg("samples"), py::arg("mode"),
-          py::arg("filter"), py::arg("filter_radius"), py::arg("seeds"), py::arg("threads"), py::arg("background"));
+          py::arg("scenes"), py::arg("options"), py::arg("seeds"));
     m.def("render_grad_batch", &render_grad_batch,
           "Gradients of a batch rendered by render_batch: a list of dicts, one per scene, as render_grad's",
-          py::arg("scenes"), py::arg("images"), py::arg("d_images"), py::arg("width"), py::arg("height"),
-          py::arg("samples"), py::arg("mode"), py::arg("filter"), py::arg("filter_radius"), py::arg("seeds"),
-          py::arg("threads"), py::arg("background"), py::arg("boundary_density"), py::arg("interior_samples") = 0);
+          py::arg("scenes"), py::arg("images"), py::arg("d_images"), py::arg("options"), py::arg("seeds"),
+          py::arg("boundary_density"));
     m.def("render_points", &render_points_py,
           "The scene at points [n, 2] (pixel space), analytical mode with kernel radius filter_radius: [n, 4] "
           "straight RGBA", py::arg("scene"), py::arg("positions"), py::arg("filter_radius"), py::arg("threads"));
@@ -459,12 +402,11 @@ PYBIND11_MODULE(_core, m) {
           py::arg("filter_radius"), py::arg("threads"));
     m.def("filter_radius_grad", &filter_radius_grad,
           "dL/d(filter radius) in Monte Carlo mode, given dL/d(premultiplied colour) per pixel",
-          py::arg("scene"), py::arg("g"), py::arg("width"), py::arg("height"), py::arg("samples"),
-          py::arg("filter"), py::arg("filter_radius"), py::arg("seed"), py::arg("threads"));
+          py::arg("scene"), py::arg("g"), py::arg("options"));
     m.def("layout", &layout,
           "The scene arrays' layout: enums (shape_kinds, draw_kinds, fill_rules, caps, joins, brush_kinds) "
           "and each table's row width (columns)");
-    m.def("backward_fallbacks", [] { return backward_fallbacks.load(); },
+    m.def("backward_fallbacks", &backward_fallbacks,
           "Backward passes redone on the CPU so far because a sample needed longer lists than a GPU thread has");
     m.def("phase_seconds", [] {
         py::dict out;

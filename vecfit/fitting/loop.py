@@ -24,7 +24,8 @@ from vecfit.io.configs import defaults
 from vecfit.io.images import downscaled, downscaled_weight
 from vecfit.renderer import device as devices
 from vecfit.renderer.persistent import PersistentPack
-from vecfit.renderer.raster import MODES, render
+from vecfit.renderer.options import MODES
+from vecfit.renderer.raster import render
 from vecfit.renderer.stopwatch import lap, phase
 from vecfit.scene import Scene
 

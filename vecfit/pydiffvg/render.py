@@ -14,6 +14,7 @@ import torch
 
 from vecfit import _core
 from vecfit.errors import VecfitError
+from vecfit.renderer.options import RenderOptions
 from vecfit.renderer.pack import pack_scene
 from vecfit.renderer.raster import render
 
@@ -137,8 +138,9 @@ def _mc_radius_gradient(scene, width, height, settings):
         core_scene = {k: (v.detach().cpu().float().numpy() if isinstance(v, torch.Tensor) else v)
                       for k, v in arrays.items()}
         g = _premultiplied_adjoint(image.cpu(), grad.cpu()).contiguous().numpy()
-        return _core.filter_radius_grad(core_scene, g, width, height, settings["samples"], settings["filter"],
-                                        settings["filter_radius"], settings["seed"], 0)
+        options = RenderOptions(width, height, samples=settings["samples"], filter=settings["filter"],
+                                filter_radius=settings["filter_radius"], seed=settings["seed"])
+        return _core.filter_radius_grad(core_scene, g, options.core())
     return gradient
 
 

@@ -18,9 +18,11 @@ from vecfit import _core
 from vecfit.errors import VecfitError
 from vecfit.limits import MAX_PIXELS
 
-from . import device as devices
-from .raster import FLOAT_INPUTS, background_rgba, check_options, packed_for_core, render
 from vecfit.scene import Scene
+
+from . import device as devices
+from .options import RenderOptions, background_rgba
+from .raster import FLOAT_INPUTS, packed_for_core, render
 from .stopwatch import add_core_phases, phase
 
 
@@ -40,15 +42,15 @@ class _RenderBatch(torch.autograd.Function):
     (autograd carries them on through each scene's packing)."""
 
     @staticmethod
-    def forward(ctx, settings, backward_settings, structures, *floats):
+    def forward(ctx, options, seeds, boundary_density, structures, *floats):
         ctx.scenes = _scene_dicts(structures, floats)
         try:
             with phase("call forward"):
-                ctx.images = _core.render_batch(ctx.scenes, **settings)
+                ctx.images = _core.render_batch(ctx.scenes, options, seeds)
             add_core_phases()
         except ValueError as e:  # the core refused a scene
             raise VecfitError(str(e)) from None
-        ctx.settings, ctx.backward_settings = settings, backward_settings
+        ctx.options, ctx.seeds, ctx.boundary_density = options, seeds, boundary_density
         ctx.shapes = [t.shape for t in floats]
         return torch.from_numpy(ctx.images)
 
@@ -56,11 +58,11 @@ class _RenderBatch(torch.autograd.Function):
     def backward(ctx, grad_images):
         d_images = np.ascontiguousarray(grad_images.detach().cpu().numpy(), dtype=np.float32)
         with phase("call backward"):
-            grads = _core.render_grad_batch(ctx.scenes, ctx.images, d_images, **ctx.settings,
-                                            **ctx.backward_settings)
+            grads = _core.render_grad_batch(ctx.scenes, ctx.images, d_images, ctx.options, ctx.seeds,
+                                            ctx.boundary_density)
         add_core_phases()
         out = [torch.from_numpy(g[name]) for g in grads for name in FLOAT_INPUTS]
-        return (None, None, None, *[g.reshape(shape) for g, shape in zip(out, ctx.shapes)])
+        return (None, None, None, None, *[g.reshape(shape) for g, shape in zip(out, ctx.shapes)])
 
 
 def render_batch(scenes: Sequence[Scene], width: int, height: int, *, samples: int = 2, mode: str = "mc",
@@ -78,11 +80,13 @@ def render_batch(scenes: Sequence[Scene], width: int, height: int, *, samples: i
     seeds = [int(seed)] * len(scenes) if isinstance(seed, (int, np.integer)) else [int(s) for s in seed]
     if len(seeds) != len(scenes):
         raise VecfitError(f"{len(seeds)} seeds for {len(scenes)} scenes")
-    check_options(samples, mode, filter, filter_radius)
     width, height = int(width), int(height)
     if width < 1 or height < 1 or width * height * len(scenes) > MAX_PIXELS:
         raise VecfitError(f"{len(scenes)} images of {width} x {height} pixels cannot be rendered "
                           f"(at most {MAX_PIXELS // 1_000_000} million pixels in all)")
+    options = RenderOptions(width, height, samples=int(samples), mode=mode, filter=filter,
+                            filter_radius=float(filter_radius), threads=int(threads or 0),
+                            background=background_rgba(background), interior_samples=int(interior_samples))
     if devices.resolve(device) >= 0:
         return torch.stack([render(s, width, height, samples=samples, mode=mode, filter=filter,
                                    filter_radius=filter_radius, seed=sd, background=background,
@@ -94,8 +98,5 @@ def render_batch(scenes: Sequence[Scene], width: int, height: int, *, samples: i
         structure, f = packed_for_core(scene, width, height)
         structures.append(structure)
         floats.extend(f)
-    settings = dict(width=width, height=height, samples=int(samples), mode=mode, filter=filter,
-                    filter_radius=float(filter_radius), seeds=seeds, threads=int(threads or 0),
-                    background=background_rgba(background))
-    backward_settings = dict(boundary_density=float(boundary_samples), interior_samples=int(interior_samples))
-    return _RenderBatch.apply(settings, backward_settings, structures, *floats)  # (no graph without grads)
+    return _RenderBatch.apply(options.core(), seeds, float(boundary_samples), structures,
+                              *floats)  # (no graph without grads)

@@ -13,13 +13,13 @@ from vecfit import _core
 from vecfit.errors import NonFiniteScene, VecfitError
 from vecfit.limits import MAX_PIXELS
 
-from . import device as devices
-from .pack import pack_scene
 from vecfit.scene import Scene
+
+from . import device as devices
+from .options import RenderOptions, background_rgba
+from .pack import pack_scene
 from .stopwatch import add_core_phases, phase
 
-MODES = ("mc", "analytic")
-FILTERS = ("box", "tent", "gaussian", "parabolic", "hann")
 
 
 def output_size(scene: Scene, width: int | None, height: int | None) -> tuple[int, int]:
@@ -43,47 +43,25 @@ FLOAT_INPUTS = ("points", "point_widths", "ellipses", "draw_params", "brush_para
                 "stop_colors", "layer_opacity")
 
 
-def _core_render(settings: dict, structure: dict, floats, brute_force: bool = False, keep: bool = False):
-    """The core's forward pass on the packed arrays: (the arrays it saw, image), and with
-    ``keep`` the scene as the core prepared it, for the backward pass of these arrays."""
+def _core_render(options, device: int, structure: dict, floats, keep: bool = False):
+    """The core's forward pass on the packed arrays (``options``: the core's
+    RenderOptions): (the arrays it saw, image), and with ``keep`` the scene as the core
+    prepared it, for the backward pass of these arrays."""
     scene = dict(structure)
     for name, t in zip(FLOAT_INPUTS, floats):
         scene[name] = t.detach().cpu().numpy()
     try:
         with phase("call forward"):
             if keep:
-                image, prepared = _core.render_keeping(scene, **settings)
+                image, prepared = _core.render_keeping(scene, options, device)
             else:
-                image = _core.render(scene, **settings, brute_force=brute_force)
+                image = _core.render(scene, options, device)
         add_core_phases()
         return (scene, image, prepared) if keep else (scene, image)
     except ValueError as e:  # the core refused the scene (e.g. layers nested too deeply)
         raise VecfitError(str(e)) from None
     except RuntimeError as e:  # the GPU failed (out of memory, driver)
-        raise VecfitError(f"rendering on {devices.device_name(settings['device'])} failed: {e}") from None
-
-
-def check_options(samples, mode: str, filter: str, filter_radius: float) -> None:
-    if mode not in MODES:
-        raise VecfitError(f"mode must be one of {', '.join(MODES)}, not {mode!r}")
-    if filter not in FILTERS:
-        raise VecfitError(f"filter must be one of {', '.join(FILTERS)}, not {filter!r}")
-    if int(samples) < 1:
-        raise VecfitError("samples must be at least 1")
-    if not (filter_radius > 0 and math.isfinite(filter_radius)):
-        raise VecfitError("filter radius must be a positive number")
-
-
-def background_rgba(background) -> list[float] | None:
-    """None, or the background as 4 floats (RGB gets alpha 1)."""
-    if background is None:
-        return None
-    bg = [float(v) for v in background]
-    if len(bg) == 3:
-        bg.append(1.0)
-    if len(bg) != 4:
-        raise VecfitError("background must have 3 or 4 components")
-    return bg
+        raise VecfitError(f"rendering on {devices.device_name(device)} failed: {e}") from None
 
 
 def packed_for_core(scene: Scene, width: int, height: int) -> tuple[dict, list]:
@@ -108,28 +86,24 @@ class _Render(torch.autograd.Function):
     (the autograd graph of vecfit.renderer.pack carries them on to the Scene's tensors)."""
 
     @staticmethod
-    def forward(ctx, settings, boundary_density, interior_samples, emulate_gpu_lists, structure, *floats):
-        ctx.scene, ctx.image, ctx.prepared = _core_render(settings, structure, floats, keep=True)
-        ctx.settings, ctx.boundary_density = settings, boundary_density
-        ctx.interior_samples = interior_samples
+    def forward(ctx, options, device, boundary_density, emulate_gpu_lists, structure, *floats):
+        ctx.scene, ctx.image, ctx.prepared = _core_render(options, device, structure, floats, keep=True)
+        ctx.options, ctx.device, ctx.boundary_density = options, device, boundary_density
         ctx.emulate_gpu_lists = emulate_gpu_lists
         ctx.shapes = [t.shape for t in floats]
         return torch.from_numpy(ctx.image)
 
     @staticmethod
     def backward(ctx, grad_image):
-        s = ctx.settings
         try:
             with phase("call backward"):
                 grads = _core.render_grad(ctx.scene, ctx.image, grad_image.detach().cpu().contiguous().numpy(),
-                                          s["width"], s["height"], s["samples"], s["mode"], s["filter"],
-                                          s["filter_radius"], s["seed"], s["threads"], s["background"],
-                                          ctx.boundary_density, s["device"], ctx.emulate_gpu_lists,
-                                          ctx.interior_samples, ctx.prepared)
+                                          ctx.options, ctx.boundary_density, ctx.device, ctx.emulate_gpu_lists,
+                                          ctx.prepared)
             ctx.prepared = None  # (its memory, before the next forward pass)
             add_core_phases()
         except RuntimeError as e:  # the GPU failed (out of memory, driver)
-            raise VecfitError(f"gradients on {devices.device_name(s['device'])} failed: {e}") from None
+            raise VecfitError(f"gradients on {devices.device_name(ctx.device)} failed: {e}") from None
         out = [torch.from_numpy(grads[name]).reshape(shape) for name, shape in zip(FLOAT_INPUTS, ctx.shapes)]
         return (None, None, None, None, None, *out)
 
@@ -165,22 +139,20 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     (_brute_force and _gpu_lists are for tests: every draw tested at every sample, and the
     CPU backward pass run first with a GPU thread's list sizes, see backward_fallbacks.)
     """
-    check_options(samples, mode, filter, filter_radius)
     width, height = output_size(scene, width, height)
-    background = background_rgba(background)
+    options = RenderOptions(width, height, samples=int(samples), mode=mode, filter=filter,
+                            filter_radius=float(filter_radius), seed=int(seed), threads=int(threads or 0),
+                            background=background_rgba(background), interior_samples=int(interior_samples),
+                            brute_force=bool(_brute_force))
     if packed is None:
         structure, floats = packed_for_core(scene, width, height)
     else:
         structure, floats = packed
         check_finite(floats)
-    settings = dict(width=width, height=height, samples=int(samples), mode=mode, filter=filter,
-                    filter_radius=float(filter_radius), seed=int(seed), threads=int(threads or 0),
-                    background=background, device=devices.resolve(device))
+    core, where = options.core(), devices.resolve(device)
     if torch.is_grad_enabled() and any(t.requires_grad for t in floats) and not _brute_force:
-        return _Render.apply(settings, float(boundary_samples), int(interior_samples), bool(_gpu_lists),
-                             structure, *floats)
-    image = _core_render(settings, structure, floats, brute_force=_brute_force)[1]
-    return torch.from_numpy(image)
+        return _Render.apply(core, where, float(boundary_samples), bool(_gpu_lists), structure, *floats)
+    return torch.from_numpy(_core_render(core, where, structure, floats)[1])
 
 
 def backward_fallbacks() -> int:

@@ -1,0 +1,72 @@
+"""RenderOptions: how the core renders, as one typed value (the core's struct of the same
+name, csrc/forward/forward.h), checked here with messages for the user and passed to the
+core's entry points whole instead of as a row of positional arguments."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from vecfit import _core
+from vecfit.errors import VecfitError
+
+MODES = ("mc", "analytic")
+FILTERS = ("box", "tent", "gaussian", "parabolic", "hann")
+
+
+@dataclass(frozen=True)
+class RenderOptions:
+    """width x height pixels; samples: N for N x N per pixel; mode: "mc" or "analytic";
+    filter and filter_radius: the pixel filter (box always covers exactly the pixel);
+    seed; threads (0: all cores); background: None or straight RGBA; interior_samples:
+    of the N x N, those the Monte Carlo backward pass revisits (0: all); brute_force:
+    every draw tested at every sample (a check of the tiles, for tests)."""
+    width: int
+    height: int
+    samples: int = 2
+    mode: str = "mc"
+    filter: str = "box"
+    filter_radius: float = 0.5
+    seed: int = 0
+    threads: int = 0
+    background: tuple | None = None
+    interior_samples: int = 0
+    brute_force: bool = False
+
+    def __post_init__(self):
+        check_options(self.samples, self.mode, self.filter, self.filter_radius)
+        if self.interior_samples < 0:
+            raise VecfitError("interior_samples must be 0 or more")
+
+    def core(self, **changes) -> "_core.RenderOptions":
+        """The core's struct (with ``changes``, e.g. another seed)."""
+        values = {**self.__dict__, **changes}
+        bg = values["background"]
+        return _core.RenderOptions(
+            width=int(values["width"]), height=int(values["height"]), samples=int(values["samples"]),
+            mode=values["mode"], filter=values["filter"], filter_radius=float(values["filter_radius"]),
+            seed=int(values["seed"]), threads=int(values["threads"] or 0),
+            background=None if bg is None else [float(v) for v in bg],
+            interior_samples=int(values["interior_samples"]), brute_force=bool(values["brute_force"]))
+
+
+def check_options(samples, mode: str, filter: str, filter_radius: float) -> None:
+    if mode not in MODES:
+        raise VecfitError(f"mode must be one of {', '.join(MODES)}, not {mode!r}")
+    if filter not in FILTERS:
+        raise VecfitError(f"filter must be one of {', '.join(FILTERS)}, not {filter!r}")
+    if int(samples) < 1:
+        raise VecfitError("samples must be at least 1")
+    if not (filter_radius > 0 and math.isfinite(filter_radius)):
+        raise VecfitError("filter radius must be a positive number")
+
+
+def background_rgba(background) -> tuple | None:
+    """None, or the background as 4 floats (RGB gets alpha 1)."""
+    if background is None:
+        return None
+    bg = [float(v) for v in background]
+    if len(bg) == 3:
+        bg.append(1.0)
+    if len(bg) != 4:
+        raise VecfitError("background must have 3 or 4 components")
+    return tuple(bg)
