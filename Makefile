@@ -6,7 +6,7 @@ STAMP := $(VENV)/.vecfit-installed
 # A CPU build of torch: an unpinned torch would pull gigabytes of CUDA packages.
 TORCH := torch==2.13.0
 
-.PHONY: install demo test fuzz sanitize bench gpu-carry clean
+.PHONY: install demo test test-fast fuzz sanitize bench gpu-carry clean
 
 install: $(STAMP)
 
@@ -27,21 +27,28 @@ demo: install
 test: install
 	$(PY) -m pytest -q
 
-# A long fuzzing campaign (tests/fuzzing.py): N cases from SEED, a summary table; failures
+# The suites marked slow (over 30 s each: the wheel, interruptions, the fuzzer's quick run,
+# the conformance corpus, ...) left out: under a minute.
+test-fast: install
+	$(PY) -m pytest -q -m "not slow"
+
+# A long fuzzing campaign (tests/fuzz/fuzzing.py): N cases from SEED, a summary table; failures
 # are kept under tests/failures/fuzz/.
 N ?= 2000
 SEED ?= 1
 fuzz: install
-	$(PY) tests/fuzzing.py -n $(N) --seed $(SEED)
+	$(PY) tests/fuzz/fuzzing.py -n $(N) --seed $(SEED)
 
 # The core built with AddressSanitizer and UndefinedBehaviorSanitizer in its own folder,
 # then the core's tests, the conformance corpus and the fuzzer's quick run through it
 # (tests/sanitize/sitecustomize.py loads that build in place of the installed one; ASan
 # must be preloaded into Python, and leak checking is off: Python itself "leaks").
 SANITIZE_BUILD := build/sanitize
-SANITIZE_TESTS := tests/test_render_basics.py tests/test_degenerate.py tests/test_render_vs_reference.py \
-	tests/test_gradients.py tests/test_point_widths.py tests/test_golden.py tests/test_conformance.py \
-	tests/test_hostile.py tests/test_fuzz.py tests/test_long_paths.py tests/test_pydiffvg_scripts.py
+SANITIZE_TESTS := tests/unit/renderer/test_render_basics.py tests/unit/renderer/test_degenerate.py \
+	tests/oracles/test_render_vs_reference.py tests/oracles/test_gradients.py \
+	tests/unit/renderer/test_point_widths.py tests/oracles/test_golden.py tests/oracles/test_conformance.py \
+	tests/fuzz/test_hostile.py tests/fuzz/test_fuzz.py tests/unit/renderer/test_long_paths.py \
+	tests/unit/pydiffvg/test_pydiffvg_scripts.py
 sanitize: install
 	$(PY) -m pip install -q pybind11
 	cmake -S . -B $(SANITIZE_BUILD) -DVECFIT_SANITIZE=ON -DCMAKE_BUILD_TYPE=Release \

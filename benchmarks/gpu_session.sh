@@ -28,7 +28,7 @@ status=0
 if [ "$phase" = all ] || [ "$phase" = test ]; then
     # GPU against CPU: images over the conformance corpus, gradients on the tiger, and the
     # GPU list sizes. (The nvcc compile checks run in CI; they are skipped here.)
-    python3 -m pytest -q -p no:cacheprovider tests/test_cuda.py -rs -k "not compiles" || status=1
+    python3 -m pytest -q -p no:cacheprovider tests/oracles/test_cuda.py -rs -k "not compiles" || status=1
 fi
 if [ "$phase" = all ] || [ "$phase" = bench ]; then
     python3 benchmarks/gpu.py --threads 16 || status=1

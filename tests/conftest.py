@@ -8,8 +8,10 @@ from pathlib import Path
 # (spinning, they starve the core's threads on a busy machine; see vecfit/__init__.py).
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
-# Test helpers (reference renderer, conformance harness) live next to the tests.
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+# Test helpers are imported by name from any folder: the shared ones here, the reference
+# renderer and conformance harness in oracles/, the fuzzer in fuzz/.
+for _folder in ("fuzz", "oracles", "."):
+    sys.path.insert(0, str((Path(__file__).resolve().parent / _folder).resolve()))
 
 
 import time

@@ -6,7 +6,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+TESTS = Path(__file__).resolve().parent
+ROOT = TESTS.parent
+FAILURES = TESTS / "failures"  # what failing checks leave to look at (not in git)
 SHARED = Path(os.environ.get("VECFIT_SHARED") or ROOT.parent / "shared")
 CONFORMANCE = SHARED / "conformance"
 PHOTOS = SHARED / "data" / "photos"

@@ -2,7 +2,7 @@
 derivative of its own image? Every geometry point of the scene moves right by delta;
 L(delta) = sum(W * image) with W a smooth random weighting that vanishes near the canvas
 border; dL/d delta by autograd against central differences of the same renderer, same
-seed both sides. Used by benchmarks/fig9.py and tests/test_fig9.py.
+seed both sides. Used by benchmarks/fig9.py and tests/oracles/test_fig9.py.
 """
 from __future__ import annotations
 

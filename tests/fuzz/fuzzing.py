@@ -1,0 +1,625 @@
+"""vecfit's own fuzzer: hostile SVGs and images through the command line, each checked
+against what every input must get: exit 0, 1 or 2 with a clear line, and never a
+traceback, a signal, a hang, NaN or inf written into an SVG, or a partial or .tmp file
+left behind.
+
+Cases are deterministic from (seed, index). SVGs are mutated from tests/oracles/golden/ (and the
+conformance corpus in ../shared when it is there) or built from a grammar of hostile
+values; images are broken in the ways image files break. Families added after the second
+campaign (issue 28): images with a side of 1 to 12 px through refine, trace, paint, edit
+and retarget, and renders under 7 px on a side; hundreds to thousands of tiny shapes
+(below a pixel, off the canvas, radii near 0) refined against small targets; one path of
+3,000 to 60,000 segments rendered at 64 px in either mode (20 s: a hang). Clip paths,
+masks, filters and dashes are not drawn yet: their families come when they are. The cases run in a worker
+process that imports vecfit once and calls the command line's main in-process (click's
+runner): starting a Python that imports torch costs 1-2 s a case. The worker is killed
+and restarted after a signal or a time-out, which are recorded as failures.
+
+    python tests/fuzz/fuzzing.py -n 2000 --seed 1      # `make fuzz N=2000`: a summary table
+    python tests/fuzz/fuzzing.py --worker              # (what the runner starts)
+
+Failures are saved under tests/failures/fuzz/ (the case's files and what happened);
+each one fixed becomes a fixed input in tests/fuzz/hostile/ (tests/fuzz/test_hostile.py).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import random
+import re
+import shutil
+import signal
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+import zlib
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+
+TESTS = Path(__file__).resolve().parents[1]
+ROOT = TESTS.parent
+SHARED = Path(os.environ.get("VECFIT_SHARED") or ROOT.parent / "shared")
+NS = 'xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink"'
+RESULT = "@@fuzz-result "
+
+# ------------------------------------------------------------------------- the grammar
+
+HOSTILE_NUMBERS = ["NaN", "nan", "inf", "-inf", "Infinity", "1e308", "-1e308", "1e39", "1e400",
+                   "4.9e-324", "1e-310", "-0", "0", "-1", "-5", "1e-30", "1e30", "3.4e38",
+                   "99999999999999999999", ".", "-", "1e", "0x10", "1,5", "", " ", "1e7",
+                   "2147483648", "-2147483649", "1.5.5"]
+LENGTH_SUFFIXES = ["", "", "px", "%", "em", "mm", "in", "pt", "xx"]
+PATH_GARBAGE = ["M", "Z", "L", "A", "C 1 2", "M 0 0 L", "Q", "0 0 0", "nan", "e", "-", ",,",
+                "M1 1 A 0 0 0 1 1 5 5", "M 0 0 A 1e308 1e-308 90 1 1 1 1",
+                "M0 0 a -5 -5 0 0 0 10 0", "M0 0 A 1 1 1e308 0 1 5 5", "m 1e308 1e308 l 1e308 1e308",
+                "M 0 0 C 1e39 0 0 1e39 1 1", "M0,0L10,10Z" * 3, "\x00", "M 0 0 H 1e-320 V 1e-320"]
+TRANSFORMS = ["scale(0)", "scale(1e308)", "scale(1e-308)", "matrix(0 0 0 0 0 0)",
+              "matrix(1 2 2 4 0 0)", "matrix(nan 0 0 1 0 0)", "rotate(inf)", "translate(1e308)",
+              "skewX(90)", "scale(2)", "scale(-1 1)", "rotate(45 1e308 0)", "matrix(1 0 0 1)",
+              "scale(", "translate(1e7 1e7)"]
+COLORS = ["red", "#f00", "#ff000080", "rgb(300,-5,nan)", "url(#missing)", "url(#g)", "none",
+          "currentColor", "hsl(inf, 50%, 50%)", "#zzzzzz", "rgba(0,0,0,1e308)", "transparent"]
+
+
+def _num(rng: random.Random) -> str:
+    if rng.random() < 0.6:
+        return rng.choice(HOSTILE_NUMBERS) + rng.choice(LENGTH_SUFFIXES)
+    return f"{rng.uniform(-200, 200):.3g}"
+
+
+def _path_data(rng: random.Random) -> str:
+    kind = rng.randrange(5)
+    if kind == 0:  # garbage stitched together
+        return " ".join(rng.choice(PATH_GARBAGE) for _ in range(rng.randint(1, 6)))
+    if kind == 1:  # a long path: 10^4 to 10^5 segments
+        n = rng.choice([10_000, 30_000, 150_000])  # (over the limit of 100,000: refused)
+        xs = (f"{(i * 7919) % 64} {(i * 104729) % 64}" for i in range(n))
+        return "M 0 0 L " + " ".join(xs) + " Z"
+    if kind == 2:  # arcs with zero, negative, huge or tiny radii
+        return "M 10 10 " + " ".join(
+            f"A {_num(rng)} {_num(rng)} {_num(rng)} {rng.randint(0, 1)} {rng.randint(0, 1)} {_num(rng)} {_num(rng)}"
+            for _ in range(rng.randint(1, 4)))
+    if kind == 3:  # commands with hostile numbers
+        cmds = ["L", "C", "Q", "S", "T", "H", "V", "l", "c", "a"]
+        counts = {"L": 2, "C": 6, "Q": 4, "S": 4, "T": 2, "H": 1, "V": 1, "l": 2, "c": 6, "a": 7}
+        out = [f"M {_num(rng)} {_num(rng)}"]
+        for _ in range(rng.randint(1, 8)):
+            c = rng.choice(cmds)
+            out.append(c + " " + " ".join(_num(rng) for _ in range(counts[c])))
+        return " ".join(out)
+    return "M 0 0 " + "L 1 1 " * rng.randint(0, 3) + rng.choice(["Z", "z", "", "Z Z", "M 5 5"])
+
+
+def _shape(rng: random.Random) -> str:
+    attrs = []
+    if rng.random() < 0.3:
+        attrs.append(f'transform="{rng.choice(TRANSFORMS)}"')
+    if rng.random() < 0.4:
+        attrs.append(f'fill="{rng.choice(COLORS)}"')
+    if rng.random() < 0.4:
+        attrs.append(f'stroke="{rng.choice(COLORS)}" stroke-width="{_num(rng)}"')
+    if rng.random() < 0.2:
+        attrs.append(f'stroke-linejoin="{rng.choice(["round", "miter", "bevel", "x"])}" '
+                     f'stroke-miterlimit="{_num(rng)}"')
+    if rng.random() < 0.2:
+        attrs.append(f'opacity="{_num(rng)}"')
+    a = " ".join(attrs)
+    kind = rng.randrange(6)
+    if kind == 0:
+        return f'<rect x="{_num(rng)}" y="{_num(rng)}" width="{_num(rng)}" height="{_num(rng)}" rx="{_num(rng)}" {a}/>'
+    if kind == 1:
+        return f'<circle cx="{_num(rng)}" cy="{_num(rng)}" r="{_num(rng)}" {a}/>'
+    if kind == 2:
+        return f'<ellipse cx="5" cy="5" rx="{_num(rng)}" ry="{_num(rng)}" {a}/>'
+    if kind == 3:
+        return f'<polygon points="{" ".join(_num(rng) for _ in range(rng.randint(0, 9)))}" {a}/>'
+    if kind == 4:
+        return f'<line x1="{_num(rng)}" y1="0" x2="10" y2="{_num(rng)}" {a}/>'
+    return f'<path d="{_path_data(rng)}" {a}/>'
+
+
+def _gradient(rng: random.Random) -> str:
+    n = rng.choice([0, 1, 2, 10_000])
+    stops = "".join(f'<stop offset="{i / max(n, 1) if rng.random() < 0.9 else _num(rng)}" '
+                    f'stop-color="{rng.choice(COLORS)}" stop-opacity="{_num(rng) if i % 7 == 0 else 1}"/>'
+                    for i in range(n))
+    tag = rng.choice(["linearGradient", "radialGradient"])
+    geo = (f'x1="{_num(rng)}" x2="{_num(rng)}"' if tag == "linearGradient"
+           else f'r="{_num(rng)}" fx="{_num(rng)}" cx="{_num(rng)}"')
+    units = rng.choice(["", 'gradientUnits="userSpaceOnUse"', 'gradientUnits="objectBoundingBox"'])
+    extra = f'gradientTransform="{rng.choice(TRANSFORMS)}"' if rng.random() < 0.3 else ""
+    href = 'xlink:href="#g"' if rng.random() < 0.1 else ""  # a cycle
+    return f'<{tag} id="g" {geo} {units} {extra} {href}>{stops}</{tag}>'
+
+
+def _structure(rng: random.Random, body: str) -> str:
+    kind = rng.randrange(7)
+    if kind == 0:  # deep nesting
+        depth = rng.choice([10, 50, 64, 65, 150, 300, 5000])
+        g = rng.choice(['<g>', '<g opacity="0.9">', '<g transform="scale(2)">', '<g transform="scale(0.5)">'])
+        return g * depth + body + "</g>" * depth
+    if kind == 1:  # a <use> chain or cycle
+        n = rng.randint(1, 12)
+        defs = f'<defs><g id="u0">{body}</g>' + "".join(
+            f'<g id="u{i}"><use href="#u{i - 1}"/><use href="#u{i - 1}" x="3"/></g>' for i in range(1, n)) + "</defs>"
+        cyc = '<g id="c1"><use href="#c2"/></g><g id="c2"><use href="#c1"/></g>' if rng.random() < 0.3 else ""
+        return defs + cyc + f'<use href="#u{n - 1}"/><use href="#{rng.choice(["u0", "missing", "", "c1"])}"/>'
+    if kind == 2:  # gradients
+        return f"<defs>{_gradient(rng)}</defs>" + body.replace('fill="red"', 'fill="url(#g)"')
+    if kind == 3:  # broken CSS
+        css = rng.choice(["rect { fill: url(#nothing) }", "* { stroke-width: 1e308 }", "{{{{", ".a { fill: }",
+                          "@import url(x.css); path { opacity: nan }", "svg|rect { fill: red", "\x00"])
+        return f"<style>{css}</style>" + body
+    if kind == 4:  # missing references
+        return (body + '<use href="#nowhere"/><rect width="3" height="3" fill="url(#nowhere) red" '
+                'stroke="url(#g)" clip-path="url(#none)" filter="url(#f)"/>')
+    if kind == 5:  # nested svg and symbols
+        return (f'<svg x="{_num(rng)}" width="{_num(rng)}" height="{_num(rng)}" viewBox="{_viewbox(rng)}">{body}</svg>'
+                f'<symbol id="s" viewBox="{_viewbox(rng)}">{body}</symbol><use href="#s" width="{_num(rng)}"/>')
+    return body
+
+
+def _viewbox(rng: random.Random) -> str:
+    return " ".join(rng.choice(["0", "0", "1", "-10", "1e-30", "3", "1e300", "1e308", "1e-300", "nan",
+                                "inf", "1e400", "-5", "64", _num(rng)]) for _ in range(4))
+
+
+def _root(rng: random.Random) -> str:
+    parts = []
+    if rng.random() < 0.6:
+        parts.append(f'width="{rng.choice(["64", "1e308", "inf", "nan", "0", "-5", "1e9", "1e-30", "50%", _num(rng)])}"')
+    if rng.random() < 0.6:
+        parts.append(f'height="{rng.choice(["64", "1e308", "0", "1e-300", "50%", "1", _num(rng)])}"')
+    if rng.random() < 0.6:
+        parts.append(f'viewBox="{_viewbox(rng) if rng.random() < 0.7 else "0 0 64 64"}"')
+    if rng.random() < 0.1:
+        parts.append(f'preserveAspectRatio="{rng.choice(["none", "xMaxYMax slice", "bogus"])}"')
+    return " ".join(parts)
+
+
+def grammar_svg(rng: random.Random) -> bytes:
+    body = "".join(_shape(rng) for _ in range(rng.randint(1, 4))) + '<rect width="5" height="5" fill="red"/>'
+    if rng.random() < 0.08:
+        return _entities(rng)
+    return f'<svg {NS} {_root(rng)}>{_structure(rng, body)}</svg>'.encode()
+
+
+def _entities(rng: random.Random) -> bytes:
+    """An entity bomb: nested entities expanding to many elements (or a billion laughs)."""
+    k = rng.choice([3, 4, 5, 9])
+    ents = '<!ENTITY e0 "<rect width=\'1\' height=\'1\'/>">' + "".join(
+        f'<!ENTITY e{i} "{f"&e{i - 1};" * 10}">' for i in range(1, k + 1))
+    return f'<?xml version="1.0"?><!DOCTYPE svg [{ents}]><svg {NS} width="64" height="64">&e{k};</svg>'.encode()
+
+
+def _seed_files() -> list[Path]:
+    files = sorted((TESTS / "oracles" / "golden").glob("*.svg")) + sorted((TESTS / "fuzz" / "hostile").glob("*.svg"))
+    conformance = SHARED / "conformance" / "cases"
+    if conformance.is_dir():
+        files += sorted(conformance.glob("*.svg"))
+    return files
+
+
+_NUMBER_RE = re.compile(rb"-?\d+(?:\.\d+)?(?:e-?\d+)?")
+
+
+def mutated_svg(rng: random.Random, seeds: list[Path]) -> bytes:
+    data = seeds[rng.randrange(len(seeds))].read_bytes()
+    for _ in range(rng.randint(1, 4)):
+        # (truncation, byte flips and encodings mostly end at the XML parser: rarer)
+        kind = rng.choice([0, 0, 0, 3, 3, 5, 6, 6, 7, 1, 2, 4])
+        if kind == 0:  # a number replaced by a hostile one
+            matches = list(_NUMBER_RE.finditer(data))
+            if matches:
+                m = rng.choice(matches)
+                data = data[:m.start()] + rng.choice(HOSTILE_NUMBERS).encode() + data[m.end():]
+        elif kind == 1:  # truncation
+            data = data[:rng.randrange(len(data) + 1)]
+        elif kind == 2:  # bytes flipped
+            b = bytearray(data)
+            for _ in range(rng.randint(1, 5)):
+                if b:
+                    b[rng.randrange(len(b))] = rng.randrange(256)
+            data = bytes(b)
+        elif kind == 3:  # a hostile shape or structure inserted before </svg>
+            i = data.rfind(b"</svg>")
+            if i >= 0:
+                data = data[:i] + _structure(rng, _shape(rng)).encode() + data[i:]
+        elif kind == 4:  # a bad encoding
+            data = rng.choice([b'<?xml version="1.0" encoding="bogus"?>', b'<?xml version="1.0" encoding="UTF-16"?>',
+                               b"\xff\xfe", b"\xef\xbb\xbf"]) + data.split(b"?>", 1)[-1]
+        elif kind == 5:  # a transform on the root
+            data = data.replace(b"<svg ", f'<svg transform="{rng.choice(TRANSFORMS)}" '.encode(), 1)
+        elif kind == 6:  # the root's size
+            data = re.sub(rb'viewBox="[^"]*"', f'viewBox="{_viewbox(rng)}"'.encode(), data, count=1)
+        else:  # an attribute value made huge
+            data = data.replace(b'="', b'="' + b"9" * rng.choice([40, 400, 4000]), 1)
+    return data
+
+
+# ----------------------------------------------------------------------------- images
+
+def _png_chunk(kind: bytes, payload: bytes) -> bytes:
+    return struct.pack(">I", len(payload)) + kind + payload + struct.pack(">I", zlib.crc32(kind + payload))
+
+
+def image_case(rng: random.Random) -> tuple[str, bytes]:
+    """(file name, bytes) of an image that is broken, odd, or fine."""
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    def encoded(im, fmt="PNG"):
+        buf = io.BytesIO()
+        im.save(buf, format=fmt)
+        return buf.getvalue()
+
+    photo = np.array(Image.open(ROOT / "examples" / "chelsea.png").convert("RGB").resize((48, 32)))
+    kind = rng.randrange(11)
+    if kind == 0:
+        data = encoded(Image.fromarray(photo))
+        return "truncated.png", data[:rng.randrange(8, len(data))]
+    if kind == 1:
+        return "empty.png", b""
+    if kind == 2:
+        return "one.png", encoded(Image.new("RGB", (1, 1), (255, 0, 0)))
+    if kind == 3:
+        return "deep.png", encoded(Image.fromarray(photo[..., 0].astype(np.uint16) * 257))
+    if kind == 4:
+        return "grey.png", encoded(Image.fromarray(photo).convert("L"))
+    if kind == 5:
+        return "palette.png", encoded(Image.fromarray(photo).convert("P"))
+    if kind == 6:
+        return "clear.png", encoded(Image.new("RGBA", (40, 30), (0, 0, 0, 0)))
+    if kind == 7:  # a header declaring 100,000 x 100,000 pixels, and little data
+        ihdr = struct.pack(">IIBBBBB", 100_000, 100_000, 8, 2, 0, 0, 0)
+        idat = zlib.compress(b"\x00" * 1000)
+        return "huge.png", b"\x89PNG\r\n\x1a\n" + _png_chunk(b"IHDR", ihdr) + _png_chunk(b"IDAT", idat) + _png_chunk(b"IEND", b"")
+    if kind == 8:
+        return "photo.png", encoded(Image.fromarray(photo), "JPEG")  # a JPEG named .png
+    if kind == 9:
+        return "tiny.png", encoded(Image.fromarray(photo[:rng.randint(1, 12), :rng.randint(1, 12)]))
+    return "photo.png", encoded(Image.fromarray(photo))
+
+
+# ------------------------------------------------- families from the second campaign
+
+def thin_image(rng: random.Random) -> tuple[str, bytes, int, int]:
+    """A photo-like image with one side of 1 to 12 pixels and the other 100 to 700: the
+    jobs' working sizes shrink the long side and must not take the short one below 11."""
+    import io
+
+    import numpy as np
+    from PIL import Image
+    short, long_ = rng.choice([1, 3, 6, 11, 11, 12, 12]), rng.choice([100, 300, 700])
+    w, h = (long_, short) if rng.random() < 0.5 else (short, long_)
+    pixels = (np.random.default_rng(rng.randrange(1 << 30)).random((h, w, 3)) * 255).astype(np.uint8)
+    buf = io.BytesIO()
+    Image.fromarray(pixels).save(buf, format="PNG")
+    return "thin.png", buf.getvalue(), w, h
+
+
+def tiny_shapes_svg(rng: random.Random) -> bytes:
+    """Hundreds to thousands of small shapes (radii 0 to 5, some below a pixel or off the
+    canvas) on a 200-unit canvas: against a small target most parameters barely touch a
+    pixel, and radii crossing 0 make draws come and go."""
+    n = rng.choice([200, 800, 2000])
+    off = rng.random() < 0.2   # every shape off the canvas
+    scale = rng.choice([1.0, 1.0, 0.01])  # 0.01: every shape below a pixel
+    parts = []
+    for _ in range(n):
+        x, y = rng.uniform(0, 200), rng.uniform(0, 200)
+        if off:
+            x += 400
+        r = rng.uniform(0, 5) * scale
+        color = f"#{rng.randrange(1 << 24):06x}"
+        kind = rng.randrange(3)
+        if kind == 0:
+            parts.append(f'<circle cx="{x:.2f}" cy="{y:.2f}" r="{r:.3f}" fill="{color}"/>')
+        elif kind == 1:
+            parts.append(f'<rect x="{x:.2f}" y="{y:.2f}" width="{2 * r:.3f}" height="{r:.3f}" fill="{color}"/>')
+        else:
+            parts.append(f'<path d="M {x:.2f} {y:.2f} q {r:.2f} {-r:.2f} {2 * r:.2f} 0" stroke="{color}" '
+                         f'stroke-width="{r / 2:.3f}" fill="none"/>')
+    return f'<svg {NS} width="200" height="200">{"".join(parts)}</svg>'.encode()
+
+
+def long_path_svg(rng: random.Random) -> bytes:
+    """One path of 3,000 to 60,000 segments (lines, quadratics, cubics or all three), a walk
+    of short or canvas-wide steps, filled with a colour or a gradient, sometimes stroked
+    up to 10^7 wide."""
+    n = rng.choice([3000, 10_000, 30_000, 60_000])
+    kinds = rng.choice(["L", "C", "LQC", "QC"])
+    step = rng.choice([1.0, 4.0, 15.0])
+    counts = {"L": 1, "Q": 2, "C": 3}
+    x = y = 100.0
+    out = [f"M {x:.1f} {y:.1f}"]
+    for i in range(n):
+        k = kinds[i % len(kinds)]
+        pts = []
+        for _ in range(counts[k]):
+            x = min(max(x + rng.uniform(-step, step), 0.0), 200.0)
+            y = min(max(y + rng.uniform(-step, step), 0.0), 200.0)
+            pts.append(f"{x:.1f} {y:.1f}")
+        out.append(k + " ".join(pts))
+    fill = rng.choice(['fill="#3a6"', 'fill="url(#g)"', 'fill="none"'])
+    stroke = rng.choice(["", 'stroke="#000" stroke-width="1"', 'stroke="#000" stroke-width="30"',
+                         'stroke="green" stroke-width="1e7"'])
+    defs = ('<defs><linearGradient id="g"><stop offset="0" stop-color="red"/><stop offset="1" '
+            'stop-color="blue"/></linearGradient></defs>')
+    return (f'<svg {NS} width="200" height="200">{defs}<path d="{" ".join(out)} Z" {fill} {stroke}/></svg>').encode()
+
+
+# ------------------------------------------------------------------------------ cases
+
+@dataclass
+class Case:
+    index: int
+    kind: str                     # what made it (grammar, mutation, image, ...)
+    command: str                  # render, info, refine, trace, paint
+    args: list[str]               # the command line; files named relative to the case folder
+    files: dict[str, bytes] = field(default_factory=dict)
+    timeout: float = 30.0
+    outputs: list[str] = field(default_factory=list)  # files the command may write
+
+
+def make_case(seed: int, index: int, seeds: list[Path] | None = None) -> Case:
+    rng = random.Random(f"{seed}:{index}")
+    seeds = seeds if seeds is not None else _seed_files()
+    roll = rng.random()
+    if roll < 0.12:  # an image through refine / trace / paint, a few iterations
+        name, data = image_case(rng)
+        command = rng.choice(["refine", "trace", "paint"])
+        files = {name: data}
+        args = [command, name]
+        if command == "refine":
+            svg = mutated_svg(rng, seeds) if rng.random() < 0.5 else (
+                f'<svg {NS} viewBox="0 0 48 32"><rect width="48" height="32" fill="#888"/>'
+                f'<circle cx="20" cy="16" r="9" fill="red"/></svg>').encode()
+            files["init.svg"] = svg
+            args.append("init.svg")
+        elif command == "paint":
+            args += ["--paths", "4"]
+        else:
+            args += ["--paths", "6"]
+        args += ["-o", "out.svg", "--iterations", str(rng.choice([0, 2, 3])), "--max-size", "48", "-q",
+                 "--samples", "1", "--threads", "1"]
+        return Case(index, "image", command, args, files, timeout=60,
+                    outputs=["out.svg", "out.report.json", "out.compare.png"])
+    if roll < 0.16:  # an image with a side under 12 px through every fitting command
+        name, data, w, h = thin_image(rng)
+        command = rng.choice(["refine", "trace", "paint", "edit", "retarget"])
+        svg = (f'<svg {NS} viewBox="0 0 {w} {h}"><rect width="{w}" height="{h}" fill="#888"/>'
+               f'<circle cx="{w / 3:g}" cy="{h / 2:g}" r="{min(w, h) / 3:g}" fill="red"/></svg>').encode()
+        files = {name: data, "init.svg": svg}
+        args = {"refine": ["refine", name, "init.svg"], "trace": ["trace", name, "--paths", "4"],
+                "paint": ["paint", name, "--paths", "4"], "edit": ["edit", "init.svg", name],
+                "retarget": ["retarget", "init.svg", "--width", "80%"] if w > h else
+                            ["retarget", "init.svg", "--width", "100%", "--height", "80%"]}[command]
+        args += ["-o", "out.svg", "--iterations", str(rng.choice([0, 2])), "-q", "--samples", "1", "--threads", "1"]
+        if command != "retarget":
+            args += ["--max-size", str(rng.choice([48, 512]))]
+        return Case(index, "thin", command, args, files, timeout=60,
+                    outputs=["out.svg", "out.report.json", "out.compare.png"])
+    if roll < 0.19:  # many tiny shapes refined against a small target
+        import io
+
+        import numpy as np
+        from PIL import Image
+        buf = io.BytesIO()
+        side = rng.choice([11, 16, 64])
+        Image.fromarray((np.random.default_rng(index).random((side, side, 3)) * 255).astype(np.uint8)).save(buf, "PNG")
+        args = ["refine", "target.png", "init.svg", "-o", "out.svg", "--iterations", str(rng.choice([1, 3])), "-q",
+                "--samples", "1", "--threads", "1", "--mode", rng.choice(["mc", "analytic"])]
+        return Case(index, "tiny", "refine", args, {"target.png": buf.getvalue(), "init.svg": tiny_shapes_svg(rng)},
+                    timeout=60, outputs=["out.svg", "out.report.json", "out.compare.png"])
+    if roll < 0.22:  # one very long path at 64 px (a hang: 20 s)
+        mode = rng.choice(["mc", "analytic"])
+        return Case(index, "longpath", "render", ["render", "in.svg", "-o", "out.png", "--width", "64", "--mode", mode,
+                                                  "--samples", "1", "--threads", "1"],
+                    {"in.svg": long_path_svg(rng)}, timeout=20, outputs=["out.png"])
+    kind = "mutation" if roll < 0.6 else "grammar"
+    svg = mutated_svg(rng, seeds) if kind == "mutation" else grammar_svg(rng)
+    if rng.random() < 0.2:
+        return Case(index, kind, "info", ["info", "in.svg"], {"in.svg": svg})
+    size = rng.choice([["--width", "64"], ["--height", "48"], ["--width", "64", "--height", "1"], [],
+                       ["--width", str(rng.randint(1, 6))], ["--width", "3", "--height", "2"],
+                       ["--width", "200", "--height", str(rng.randint(1, 6))]])
+    mode = rng.choice(["mc", "mc", "analytic"])
+    return Case(index, kind, "render", ["render", "in.svg", "-o", "out.png", *size, "--mode", mode,
+                                        "--samples", "1", "--threads", "1"], {"in.svg": svg},
+                outputs=["out.png"])
+
+
+# ----------------------------------------------------------------------------- oracle
+
+def verdict(case: Case, folder: Path, outcome: dict) -> str | None:
+    """What is wrong with how the case ended (None: nothing)."""
+    if outcome.get("signal"):
+        return f"killed by signal {outcome['signal']}"
+    if outcome.get("timeout"):
+        return f"no answer within {case.timeout:g} s"
+    if outcome.get("exception"):
+        return "traceback: " + outcome["exception"].strip().splitlines()[-1]
+    text = outcome["stdout"] + outcome["stderr"]
+    if "Traceback" in text:
+        return "traceback in the output"
+    code = outcome["exit_code"]
+    if code not in (0, 1, 2):
+        return f"exit code {code}"
+    if code != 0 and not re.search(r"^(error|Error|Usage):?", outcome["stderr"], re.M):
+        return "failed without an error line"
+    names = {p.name for p in folder.iterdir()}
+    stray = [n for n in names if n.endswith(".tmp") or n.startswith(".")]
+    if stray:
+        return f"left behind: {', '.join(sorted(stray))}"
+    for name in case.outputs:
+        path = folder / name
+        if not path.exists():
+            if code == 0 and name in ("out.png", "out.svg"):
+                return f"exit 0 but no {name}"
+            continue
+        if name.endswith(".svg"):
+            text = path.read_text(encoding="utf-8", errors="replace")
+            if not text.rstrip().endswith("</svg>"):
+                return f"{name} is not a complete SVG"
+            if re.search(r"\b(nan|inf|infinity)\b", text, re.I):
+                return f"{name} has nan or inf in it"
+        elif name.endswith(".png"):
+            from PIL import Image
+            try:
+                with Image.open(path) as im:
+                    im.load()
+            except Exception as e:  # a partial PNG
+                return f"{name} cannot be read back ({e})"
+    return None
+
+
+# ----------------------------------------------------------------------------- worker
+
+def _worker() -> None:
+    """Reads case folders and command lines (JSON, one a line) from stdin; runs each with
+    click's runner in this process; writes the outcome as a RESULT line."""
+    import traceback
+    import warnings
+
+    from click.testing import CliRunner
+
+    from vecfit.cli.commands import main
+
+    def timed_out(signum, frame):
+        raise TimeoutError("the case ran past its time limit")
+
+    signal.signal(signal.SIGALRM, timed_out)
+    out = sys.stdout
+    for line in sys.stdin:
+        job = json.loads(line)
+        os.chdir(job["folder"])
+        start = time.perf_counter()
+        signal.alarm(max(1, int(job["timeout"])))
+        outcome = {"exception": None, "timeout": False}
+        try:
+            with warnings.catch_warnings():
+                result = CliRunner().invoke(main, job["args"], catch_exceptions=True)
+            outcome.update(exit_code=result.exit_code, stdout=result.stdout, stderr=result.stderr)
+            if result.exception is not None and not isinstance(result.exception, SystemExit):
+                if isinstance(result.exception, TimeoutError):
+                    outcome["timeout"] = True
+                else:
+                    outcome["exception"] = "".join(traceback.format_exception(result.exception))
+        finally:
+            signal.alarm(0)
+        outcome["seconds"] = time.perf_counter() - start
+        out.write(RESULT + json.dumps(outcome) + "\n")
+        out.flush()
+
+
+class Runner:
+    """The worker process: started on demand, restarted after it dies or hangs."""
+
+    def __init__(self, env: dict | None = None):
+        self.env = env
+        self.proc = None
+
+    def _start(self):
+        self.proc = subprocess.Popen([sys.executable, str(Path(__file__).resolve()), "--worker"],
+                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                                     text=True, env=self.env, cwd=str(ROOT))
+
+    def run(self, case: Case, folder: Path) -> dict:
+        if self.proc is None or self.proc.poll() is not None:
+            self._start()
+        self.proc.stdin.write(json.dumps({"folder": str(folder), "args": case.args, "timeout": case.timeout}) + "\n")
+        self.proc.stdin.flush()
+        deadline = time.monotonic() + case.timeout + 20  # (the worker's own alarm comes first)
+        import selectors
+        sel = selectors.DefaultSelector()
+        sel.register(self.proc.stdout, selectors.EVENT_READ)
+        try:
+            while True:
+                left = deadline - time.monotonic()
+                if left <= 0 or not sel.select(timeout=left):
+                    self.close()
+                    return {"timeout": True}
+                line = self.proc.stdout.readline()
+                if not line:  # the worker died
+                    code = self.proc.wait()
+                    self.proc = None
+                    return {"signal": -code if code < 0 else None, "exception": f"worker exited with {code}"}
+                if line.startswith(RESULT):
+                    return json.loads(line[len(RESULT):])
+        finally:
+            sel.close()
+
+    def close(self):
+        if self.proc is not None:
+            self.proc.kill()
+            self.proc.wait()
+            self.proc = None
+
+
+def run_case(runner: Runner, case: Case, keep_failures: Path | None = None) -> tuple[str | None, dict]:
+    with tempfile.TemporaryDirectory(prefix="vecfit-fuzz-") as tmp:
+        folder = Path(tmp)
+        for name, data in case.files.items():
+            (folder / name).write_bytes(data)
+        outcome = runner.run(case, folder)
+        problem = verdict(case, folder, outcome)
+        if problem and keep_failures is not None:
+            dest = keep_failures / f"case-{case.index}"
+            shutil.rmtree(dest, ignore_errors=True)
+            dest.mkdir(parents=True)
+            for name, data in case.files.items():
+                (dest / name).write_bytes(data)
+            (dest / "what.json").write_text(json.dumps({"problem": problem, "args": case.args,
+                                                        "outcome": outcome}, indent=1))
+    return problem, outcome
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("-n", type=int, default=300, help="number of cases")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--start", type=int, default=0, help="first case index")
+    parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.worker:
+        _worker()
+        return 0
+    failures_dir = TESTS / "failures" / "fuzz"
+    seeds = _seed_files()
+    runner = Runner()
+    table: dict[tuple[str, str], Counter] = {}
+    failures = []
+    started = time.perf_counter()
+    try:
+        for i in range(args.start, args.start + args.n):
+            case = make_case(args.seed, i, seeds)
+            problem, outcome = run_case(runner, case, failures_dir)
+            row = table.setdefault((case.command, case.kind), Counter())
+            row["cases"] += 1
+            row["seconds"] += outcome.get("seconds", 0.0)
+            if problem:
+                row["failed"] += 1
+                failures.append((case.index, case.command, problem))
+            else:
+                row[f"exit {outcome['exit_code']}"] += 1
+    finally:
+        runner.close()
+    print(f"{'command':8} {'made by':9} {'cases':>6} {'exit 0':>7} {'exit 1':>7} {'exit 2':>7} {'failed':>7} {'s/case':>7}")
+    for (command, kind), c in sorted(table.items()):
+        print(f"{command:8} {kind:9} {c['cases']:6} {c['exit 0']:7} {c['exit 1']:7} {c['exit 2']:7} "
+              f"{c['failed']:7} {c['seconds'] / c['cases']:7.2f}")
+    print(f"{args.n} cases (seed {args.seed}) in {time.perf_counter() - started:.0f} s; {len(failures)} failed")
+    for index, command, problem in failures:
+        print(f"  case {index} ({command}): {problem}  -> {failures_dir / f'case-{index}'}")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

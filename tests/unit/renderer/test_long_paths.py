@@ -1,0 +1,88 @@
+"""Long paths (issue 28): the tile lists follow the pixels a segment reaches (a curve of a
+fill is listed only in the tiles its sub-pieces' boxes reach; a stroke wide against a tile
+lists no items in the tiles that lie inside one of its pieces), and the analytical
+distance measures a curve only near its sub-pieces. None of it may change an image: each
+scene here is rendered through the tiles and brute force (every item of every draw at
+every sample), in both modes. Timings are in benchmarks/long_paths.py."""
+from __future__ import annotations
+
+import random
+
+import pytest
+import torch
+
+import vecfit
+from helpers import quiet_load
+
+NS = 'xmlns="http://www.w3.org/2000/svg"'
+
+
+def walk(n: int, size: float, step: float, kinds: str, seed: int = 0) -> str:
+    """Path data: n segments (L, Q, C in turn from `kinds`) of a random walk."""
+    r = random.Random(seed)
+    x = y = size / 2
+    out = [f"M {x:.2f} {y:.2f}"]
+    for i in range(n):
+        k = kinds[i % len(kinds)]
+        pts = []
+        for _ in range({"L": 1, "Q": 2, "C": 3}[k]):
+            x = min(max(x + r.uniform(-step, step), 0), size)
+            y = min(max(y + r.uniform(-step, step), 0), size)
+            pts.append(f"{x:.2f} {y:.2f}")
+        out.append(k + " " + " ".join(pts))
+    return " ".join(out)
+
+
+GRADIENT = ('<defs><linearGradient id="g"><stop offset="0" stop-color="red"/><stop offset="1" stop-color="blue"/>'
+            '</linearGradient></defs>')
+
+SCENES = {
+    # curves across the whole canvas: each was listed in every tile of its box
+    "cubics-across": f'<path d="{walk(300, 64, 64, "C", 1)} Z" fill="url(#g)" fill-rule="evenodd"/>',
+    "walk-mixed": f'<path d="{walk(1500, 64, 6, "LQC", 2)} Z" fill="#3a6"/>',
+    # strokes 10^7 px wide (every tile inside the first line's rectangle) and wide against
+    # a tile: round joins (disks), miter joins, butt and square caps, curves among lines
+    "stroke-1e7": f'<path d="{walk(600, 64, 10, "LQC", 3)}" fill="url(#g)" stroke="green" stroke-width="1e7"/>',
+    "stroke-wide-round": f'<path d="{walk(40, 64, 20, "LC", 4)}" fill="none" stroke="#800" stroke-width="30" '
+                         'stroke-linejoin="round" stroke-linecap="round" opacity="0.7"/>',
+    "stroke-wide-miter": f'<path d="{walk(30, 64, 25, "LLQ", 5)}" fill="none" stroke="#008" stroke-width="40" '
+                         'stroke-linejoin="miter" stroke-linecap="square"/>'
+                         f'<path d="M 5 60 L 60 5" stroke="#080" stroke-width="26" stroke-linecap="butt"/>',
+    "stroke-wide-transformed": f'<g transform="matrix(1.5 0.4 -0.2 0.7 3 2)"><path d="{walk(30, 40, 15, "LC", 6)}" '
+                               'fill="none" stroke="#088" stroke-width="33" stroke-linejoin="bevel"/></g>',
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(SCENES))
+@pytest.mark.parametrize("mode", ["mc", "analytic"])
+def test_tiles_match_brute_force(tmp_path, name, mode):
+    svg = tmp_path / f"{name}.svg"
+    svg.write_text(f'<svg {NS} width="64" height="64">{GRADIENT}{SCENES[name]}</svg>')
+    scene = quiet_load(svg)
+    for size in (40, 64):
+        fast = vecfit.render(scene, size, size, samples=2, mode=mode, threads=2)
+        brute = vecfit.render(scene, size, size, samples=2, mode=mode, _brute_force=True)
+        assert fast[..., 3].sum() > 0
+        assert torch.allclose(fast, brute, atol=1e-6, rtol=0), float((fast - brute).abs().max())
+
+
+@pytest.mark.parametrize("mode", ["mc", "analytic"])
+def test_wide_stroke_gradients_unchanged_inside(tmp_path, mode):
+    """A tile inside a wide stroke lists none of its items: the stroke's gradients there
+    are 0 as they were (inside by more than the kernel, or a boundary piece covered by
+    another piece), and they stay finite and equal across thread counts."""
+    svg = tmp_path / "s.svg"
+    svg.write_text(f'<svg {NS} width="64" height="64"><path d="M 4 30 L 60 34 L 30 60" fill="none" '
+                   'stroke="#800" stroke-width="40" stroke-linejoin="round"/></svg>')
+    grads = []
+    for threads in (1, 2):
+        scene = quiet_load(svg)
+        pts = scene.parameters()["points"]
+        for t in pts:
+            t.requires_grad_(True)
+        image = vecfit.render(scene, 64, 64, samples=2, mode=mode, threads=threads, seed=3)
+        (image * torch.linspace(0, 1, 64)[:, None, None]).sum().backward()
+        grads.append(torch.cat([t.grad.reshape(-1) for t in pts]))
+    assert torch.isfinite(grads[0]).all() and grads[0].abs().sum() > 0
+    assert torch.allclose(grads[0], grads[1], rtol=1e-5, atol=1e-5)

@@ -1,0 +1,189 @@
+"""The fitting loop's persistent pack (vecfit/renderer/persistent.py): the same image and
+the same gradients as packing the Scene on every call, where it applies, and no pack
+(None) where it does not."""
+from __future__ import annotations
+
+import pytest
+import torch
+
+from vecfit.fitting import loop
+from vecfit.fitting.loop import Settings, Target, optimize
+from vecfit.fitting.rates import parameter_kinds
+from vecfit.renderer.persistent import PersistentPack
+from vecfit.renderer.raster import render
+from vecfit.svg.read import load_svg
+
+from shared_data import SHARED
+
+# Every kind of float the core reads that an affine route serves: path points under a
+# group's scale and a shape's rotation, per-point and uniform stroke widths, circles and
+# ellipses, solid colours under fixed opacities (one a layer), user-space and bounding-box
+# gradients (the latter on a shape whose geometry stays put: see RATES), a viewBox.
+MIXED = """<svg xmlns="http://www.w3.org/2000/svg" width="64" height="48" viewBox="0 0 128 96">
+  <defs>
+    <linearGradient id="lin" gradientUnits="userSpaceOnUse" x1="10" y1="10" x2="100" y2="80">
+      <stop offset="0.1" stop-color="#f00"/><stop offset="0.9" stop-color="#00f" stop-opacity="0.6"/>
+    </linearGradient>
+    <radialGradient id="rad" gradientUnits="userSpaceOnUse" cx="90" cy="30" r="30" fx="80" fy="25">
+      <stop offset="0" stop-color="#ff0"/><stop offset="1" stop-color="#0a0"/>
+    </radialGradient>
+  </defs>
+  <path d="M0 0 H128 V96 H0 Z" fill="#eee"/>
+  <g transform="translate(4 6) scale(1.2)" opacity="0.7">
+    <path d="M10 10 C40 0 60 40 90 20 L80 70 Q40 90 12 60 Z" fill="url(#lin)" stroke="#123"
+          stroke-width="3" stroke-opacity="0.5"/>
+    <path d="M20 20 L50 25 L40 60 Z" fill="#c84" fill-opacity="0.8"/>
+  </g>
+  <circle cx="90" cy="30" r="20" fill="url(#rad)" stroke="#345" stroke-width="2"/>
+  <ellipse cx="40" cy="70" rx="20" ry="9" fill="#48c" transform="rotate(25 40 70)" opacity="0.6"
+           stroke="#000" stroke-width="1.5"/>
+  <path d="M5 90 C30 60 60 95 120 70" fill="none" stroke="#a0a" stroke-width="4" stroke-linecap="round"/>
+</svg>"""
+
+RATES = {"points": 1.0, "colors": 0.01, "stroke_widths": 0.1, "radii": 0.5, "gradient_points": 1.0,
+         "gradient_radii": 0.5, "stop_offsets": 0.01}
+
+
+def _scene(tmp_path, text=MIXED):
+    path = tmp_path / "scene.svg"
+    path.write_text(text)
+    return load_svg(path)
+
+
+def _image_and_gradients(scene, kinds, w, h, pack):
+    """The image and each kind's gradient for a fixed image adjoint: through the Scene's
+    tensors (pack None) or through the persistent pack's leaves."""
+    for k in kinds:
+        k.zero_grad()
+    leaves = [k.flat.detach().requires_grad_() for k in kinds]
+    image = render(scene, w, h, seed=5, threads=2, interior_samples=1,
+                   packed=pack.arrays(leaves) if pack is not None else None)
+    weights = torch.linspace(-1, 1, image.numel()).reshape(image.shape)
+    (image * weights).sum().backward()
+    return image.detach(), {k.name: k.gradient(leaf if pack is not None else None) for k, leaf in zip(kinds, leaves)}
+
+
+def _assert_same(scene, kinds, w, h):
+    pack = PersistentPack.build(scene, w, h, kinds)
+    assert pack is not None
+    image, grads = _image_and_gradients(scene, kinds, w, h, None)
+    image2, grads2 = _image_and_gradients(scene, kinds, w, h, pack)
+    assert torch.allclose(image, image2, atol=1e-6)
+    for name, g in grads.items():
+        assert g.abs().max() > 0, name  # (the scene exercises every kind)
+        assert torch.allclose(grads2[name], g, rtol=1e-5, atol=1e-6 * float(g.abs().max())), name
+
+
+def test_mixed_scene_same_image_and_gradients(tmp_path):
+    scene = _scene(tmp_path)
+    kinds = parameter_kinds(scene, RATES, 64, 48)
+    assert {k.name for k in kinds} == set(RATES)
+    _assert_same(scene, kinds, 64, 48)
+    _assert_same(scene, kinds, 37, 29)  # another size: other matrices
+
+
+def test_square_rect(tmp_path):
+    scene = _scene(tmp_path, MIXED.replace('<path d="M0 0 H128 V96 H0 Z" fill="#eee"/>',
+                                           '<rect x="3" y="4" width="100" height="80" fill="#eee" stroke="#f00"/>'))
+    kinds = parameter_kinds(scene, RATES, 64, 48)
+    _assert_same(scene, kinds, 64, 48)
+    pack = PersistentPack.build(scene, 64, 48, kinds)
+    flats = [k.flat for k in kinds]
+    rect = scene.shapes[0].geometry
+    with torch.no_grad():
+        rect.p_max[0] = 2.0  # narrower than nothing: no longer drawn
+        assert not pack.still_valid(flats)
+        rect.p_max[0] = 103.0
+        assert pack.still_valid(flats)
+        rect.corner_radii.fill_(2.0)  # rounded: another path
+        assert not pack.still_valid(flats)
+
+
+def test_per_point_widths(tmp_path):
+    scene = _scene(tmp_path)
+    path = scene.shapes[-1].geometry
+    path.widths = torch.linspace(1.0, 6.0, len(path.points))
+    kinds = parameter_kinds(scene, {"points": 1.0, "stroke_widths": 0.1}, 64, 48)
+    _assert_same(scene, kinds, 64, 48)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["peppers", "kitty"])
+def test_adobe_trace_bit_identical(name):
+    svg = SHARED / "data" / "photos" / f"{name}.svg"
+    if not svg.exists():
+        pytest.skip("shared data not here")
+    scene = load_svg(svg)
+    w, h = int(scene.width) // 2, int(scene.height) // 2
+    kinds = parameter_kinds(scene, loop.Settings.defaults().lr, w, h)
+    pack = PersistentPack.build(scene, w, h, kinds)
+    image, grads = _image_and_gradients(scene, kinds, w, h, None)
+    image2, grads2 = _image_and_gradients(scene, kinds, w, h, pack)
+    assert torch.equal(image, image2)
+    for name in grads:
+        assert torch.equal(grads[name], grads2[name])
+
+
+def test_no_pack_where_values_enter_non_linearly(tmp_path):
+    scene = _scene(tmp_path)
+    assert PersistentPack.build(scene, 64, 48, parameter_kinds(scene, {"transforms": 0.01}, 64, 48)) is None
+    assert PersistentPack.build(scene, 64, 48, parameter_kinds(scene, {"opacities": 0.01}, 64, 48)) is None
+    # a rect's corners (points kind) become path points through rect_as_path
+    rect = MIXED.replace('<path d="M0 0 H128 V96 H0 Z" fill="#eee"/>', '<rect width="128" height="96" rx="9" fill="#eee"/>')
+    scene = _scene(tmp_path, rect)
+    assert PersistentPack.build(scene, 64, 48, parameter_kinds(scene, {"points": 1.0}, 64, 48)) is None
+    assert PersistentPack.build(scene, 64, 48, parameter_kinds(scene, {"colors": 0.01}, 64, 48)) is not None
+    # a bounding-box gradient's geometry: its bounds enter the paint's matrix
+    bbox = MIXED.replace('id="lin" gradientUnits="userSpaceOnUse"', 'id="lin"')
+    scene = _scene(tmp_path, bbox)
+    assert PersistentPack.build(scene, 64, 48, parameter_kinds(scene, {"points": 1.0}, 64, 48)) is None
+    # ... but the colours alone are affine there too
+    assert PersistentPack.build(scene, 64, 48, parameter_kinds(scene, {"colors": 0.01}, 64, 48)) is not None
+
+
+def test_draws_that_come_and_go_make_it_stale(tmp_path):
+    scene = _scene(tmp_path)
+    kinds = parameter_kinds(scene, {"stroke_widths": 0.1, "radii": 0.5}, 64, 48)
+    pack = PersistentPack.build(scene, 64, 48, kinds)
+    flats = [k.flat for k in kinds]
+    assert pack.still_valid(flats)
+    with torch.no_grad():
+        scene.shapes[-1].stroke_width.fill_(0.0)  # the open path's stroke disappears
+    assert not pack.still_valid(flats)
+    with torch.no_grad():
+        scene.shapes[-1].stroke_width.fill_(2.0)
+        scene.shapes[3].geometry.radius.fill_(0.0)  # the circle disappears
+    assert not pack.still_valid(flats)
+
+
+def test_loop_same_fit_either_way(tmp_path, monkeypatch):
+    """Same seed, same fit, whether the loop packs once or on every iteration."""
+    target = Target(torch.rand(48, 64, 4, generator=torch.Generator().manual_seed(1)), background=(1, 1, 1))
+    target.image[..., 3] = 1
+    results = []
+    for persistent in (True, False):
+        monkeypatch.setattr(loop, "PERSISTENT_PACK", persistent)
+        scene = _scene(tmp_path)
+        lr = dict(RATES)
+        result = optimize(scene, target, Settings.defaults(iterations=12, threads=2, lr=lr, coarse=0.0))
+        results.append((result.losses, scene.shapes[1].geometry.points.detach().clone()))
+    (losses_a, points_a), (losses_b, points_b) = results
+    assert losses_a == pytest.approx(losses_b, rel=1e-5)
+    assert torch.allclose(points_a, points_b, atol=1e-4)
+
+
+def test_loop_same_seed_same_result(tmp_path):
+    """The same seed gives the same fit: bit for bit on the same thread count, and to
+    rounding on another (the core's gradients are summed per thread, DESIGN.md)."""
+    target = Target(torch.rand(48, 64, 4, generator=torch.Generator().manual_seed(2)), background=(1, 1, 1))
+    target.image[..., 3] = 1
+    runs = []
+    for threads in (2, 2, 1, 3):
+        scene = _scene(tmp_path)
+        result = optimize(scene, target, Settings.defaults(iterations=10, threads=threads, lr=dict(RATES), coarse=0.0))
+        runs.append((result.losses, torch.cat([t.detach().reshape(-1) for ts in scene.parameters().values()
+                                               for t in ts])))
+    assert runs[0][0] == runs[1][0] and torch.equal(runs[0][1], runs[1][1])
+    for losses, values in runs[2:]:
+        assert losses == pytest.approx(runs[0][0], rel=1e-4)
+        assert torch.allclose(values, runs[0][1], atol=1e-3)
