@@ -11,7 +11,7 @@
 #include "backward/hits.h"
 #include "common/portable.h"
 #include "scene/layers.h"
-#include "scene/brush.h"
+#include "scene/paint.h"
 #include "scene/scene.h"
 #include "scene/tiles.h"
 
@@ -128,19 +128,19 @@ VF_HD void jump_without_layers(const SceneView& sc, const TileView& bins, Vec2 p
         if (draw == forced) continue;
         if (draw > forced) {  // in front
             if (!covers(sc, bins, es[k], region, p)) continue;
-            brush_color(sc, sc.brushes[sc.draws[draw].brush], p, c);
+            paint_color(sc, sc.paints[sc.draws[draw].paint], p, c);
             T *= 1 - c[3];
             if (T <= 0) return;
         } else {  // behind
             if (!covers(sc, bins, es[k], region, p)) continue;
-            brush_color(sc, sc.brushes[sc.draws[draw].brush], p, c);
+            paint_color(sc, sc.paints[sc.draws[draw].paint], p, c);
             double k2 = 1 - B[3];
             for (int i = 0; i < 4; ++i) B[i] += k2 * c[i];
             if (B[3] >= 1) break;
         }
     }
     double cd[4];
-    brush_color(sc, sc.brushes[sc.draws[forced].brush], p, cd);
+    paint_color(sc, sc.paints[sc.draws[forced].paint], p, cd);
     for (int i = 0; i < 4; ++i) delta[i] = T * (cd[i] - cd[3] * B[i]);
 }
 

@@ -30,19 +30,19 @@ struct GradPtr {
 };
 
 struct GradView {
-    GradPtr points, point_widths, ellipses, draw_params, brush_params, stop_offsets, stop_colors, layer_opacity;
+    GradPtr points, point_widths, ellipses, draw_params, paint_params, stop_offsets, stop_colors, layer_opacity;
 };
 
 // Host gradient arrays (one lane's, or the result).
 struct SceneGrads {
-    std::vector<double> points, point_widths, ellipses, draw_params, brush_params, stop_offsets, stop_colors,
+    std::vector<double> points, point_widths, ellipses, draw_params, paint_params, stop_offsets, stop_colors,
         layer_opacity;
     void resize_like(const SceneArrays& a) {
         points.assign(2 * a.n_points, 0);
         point_widths.assign(a.n_point_widths, 0);
         ellipses.assign(ELLIPSE_COLS * a.n_ellipses, 0);
         draw_params.assign(DRAW_FCOLS * a.n_draws, 0);
-        brush_params.assign(BRUSH_FCOLS * a.n_brushes, 0);
+        paint_params.assign(PAINT_FCOLS * a.n_paints, 0);
         stop_offsets.assign(a.n_stops, 0);
         stop_colors.assign(4 * a.n_stops, 0);
         layer_opacity.assign(a.n_layers, 0);
@@ -52,12 +52,12 @@ struct SceneGrads {
             for (size_t i = 0; i < x.size(); ++i) x[i] += y[i];
         };
         acc(points, o.points); acc(point_widths, o.point_widths); acc(ellipses, o.ellipses); acc(draw_params, o.draw_params);
-        acc(brush_params, o.brush_params); acc(stop_offsets, o.stop_offsets);
+        acc(paint_params, o.paint_params); acc(stop_offsets, o.stop_offsets);
         acc(stop_colors, o.stop_colors); acc(layer_opacity, o.layer_opacity);
     }
     GradView view() {
         return {{points.data()},       {point_widths.data()}, {ellipses.data()},     {draw_params.data()},
-                {brush_params.data()}, {stop_offsets.data()}, {stop_colors.data()}, {layer_opacity.data()}};
+                {paint_params.data()}, {stop_offsets.data()}, {stop_colors.data()}, {layer_opacity.data()}};
     }
 };
 

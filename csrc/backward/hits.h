@@ -8,7 +8,7 @@
 #include "common/portable.h"
 #include "forward/forward.h"
 #include "scene/coverage.h"
-#include "scene/brush.h"
+#include "scene/paint.h"
 #include "scene/scene.h"
 #include "scene/tiles.h"
 
@@ -17,9 +17,9 @@ namespace vf {
 struct Hit {
     int draw;
     double c[4];  // premultiplied colour of the draw at the point (times its coverage)
-    // analytical prefilter only: coverage K(sd / r), the signed distance, the brush colour
+    // analytical prefilter only: coverage K(sd / r), the signed distance, the paint colour
     // (premultiplied) and the piece the distance came from
-    double cov = 1, sd = 0, brush[4] = {0, 0, 0, 0};
+    double cov = 1, sd = 0, paint[4] = {0, 0, 0, 0};
     SdfArg arg;
 };
 
@@ -113,7 +113,7 @@ VF_HD int collect_hits(const SceneView& sc, const TileView& bins, Vec2 p, int fo
     auto add = [&](int draw) {
         Hit h;
         h.draw = draw;
-        brush_color(sc, sc.brushes[sc.draws[draw].brush], p, h.c);
+        paint_color(sc, sc.paints[sc.draws[draw].paint], p, h.c);
         hits.push_back(h);
         if (h.c[3] >= 1) ++opaque;
     };
@@ -167,8 +167,8 @@ VF_HD void collect_hits_analytic(const SceneView& sc, const TileView& bins, Vec2
         }
         h.cov = kernel_coverage(h.sd / r);
         if (h.cov <= 0) continue;
-        brush_color(sc, sc.brushes[d.brush], p, h.brush);
-        for (int i = 0; i < 4; ++i) h.c[i] = h.cov * h.brush[i];
+        paint_color(sc, sc.paints[d.paint], p, h.paint);
+        for (int i = 0; i < 4; ++i) h.c[i] = h.cov * h.paint[i];
         hits.push_back(h);
     }
 }

@@ -2,9 +2,9 @@
 // CUDA kernels (cuda/backward.cu), after Li et al. 2020, section 5: here the drivers, one
 // pixel (pixel_backward, the adjoint of forward/pixel.h's pixel_forward, by way of
 // sample_backward) and one boundary sample (boundary_sample); the parts they run are in
-// hits.h, composite.h, brush.h, boundary.h and prefilter.h. Monte Carlo mode:
+// hits.h, composite.h, paint.h, boundary.h and prefilter.h. Monte Carlo mode:
 //   * interior term: per pixel sample, reverse-mode through front-to-back compositing
-//     (with layers) into brush parameters, stop offsets / colours and layer opacities;
+//     (with layers) into paint parameters, stop offsets / colours and layer opacities;
 //   * boundary term (Reynolds transport): stratified samples on every boundary of every
 //     draw (fill segments, ellipses, stroke offset curves, caps, joins, butt ends), each
 //     weighted by its length element; at p+ = p + eps n (just outside) the scene is
@@ -28,7 +28,7 @@
 #include "backward/composite.h"
 #include "backward/grads.h"
 #include "backward/hits.h"
-#include "backward/brush.h"
+#include "backward/paint.h"
 #include "backward/prefilter.h"
 #include "common/portable.h"
 #include "common/sampling.h"
@@ -48,7 +48,7 @@ struct SampleScratch {
 };
 
 // Adjoint of sample_forward (forward/pixel.h), the premultiplied colour of the scene at
-// p: g_c is dL/d(that colour); adds dL/d(brush parameters, stops, layer opacities) and,
+// p: g_c is dL/d(that colour); adds dL/d(paint parameters, stops, layer opacities) and,
 // for the analytical prefilter, dL/d(geometry) through the signed distances. Returns
 // false where a list overflowed (a GPU thread's fixed lists): past a list's end the tape
 // may have lost the POP of a PUSH it kept, which composite_backward cannot walk back, so
@@ -66,12 +66,12 @@ VF_HD bool sample_backward(const SceneView& sc, const TileView& bins, Vec2 p, co
     composite_backward(sc, w.hits, w.tape, g_c, w.g_hits, g);
     for (int k = 0; k < w.hits.size(); ++k) {
         const Hit& h = w.hits[k];
-        double gbrush[4];
-        for (int i = 0; i < 4; ++i) gbrush[i] = h.cov * w.g_hits[k][i];
-        brush_color_backward(sc, sc.draws[h.draw].brush, p, gbrush, g);
+        double gpaint[4];
+        for (int i = 0; i < 4; ++i) gpaint[i] = h.cov * w.g_hits[k][i];
+        paint_color_backward(sc, sc.draws[h.draw].paint, p, gpaint, g);
         if (!analytic) continue;
         double g_cov = 0;
-        for (int i = 0; i < 4; ++i) g_cov += w.g_hits[k][i] * h.brush[i];
+        for (int i = 0; i < 4; ++i) g_cov += w.g_hits[k][i] * h.paint[i];
         double g_sd = g_cov * kernel_slope(h.sd / R) / R;
         if (g_sd != 0) entry_sdf_backward(sc, h, p, g_sd, g);
     }

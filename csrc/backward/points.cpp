@@ -95,7 +95,7 @@ void render_points_backward(const PreparedScene& prepared, const SceneArrays& a,
                 if (view.count(0) == 0 || (gc[0] == 0 && gc[1] == 0 && gc[2] == 0 && gc[3] == 0)) continue;
                 sample_backward(sc, view, {xy[2 * i], xy[2 * i + 1]}, o, gc, w, g);
                 // The point moving by t is the geometry moving by -t (points, ellipse
-                // centres); a brush sees it through its affine map q = M p + m.
+                // centres); a paint sees it through its affine map q = M p + m.
                 double dx = 0, dy = 0;
                 for (size_t k = 0; k < one.points.size(); k += 2) {
                     dx -= one.points[k];
@@ -105,9 +105,9 @@ void render_points_backward(const PreparedScene& prepared, const SceneArrays& a,
                     dx -= one.ellipses[k];
                     dy -= one.ellipses[k + 1];
                 }
-                for (int q = 0; q < (int)sc.brushes.size(); ++q) {
-                    const Affine& m = sc.brushes[q].to_brush;
-                    double gx = one.brush_params[BRUSH_FCOLS * q + 2], gy = one.brush_params[BRUSH_FCOLS * q + 5];
+                for (int q = 0; q < (int)sc.paints.size(); ++q) {
+                    const Affine& m = sc.paints[q].to_paint;
+                    double gx = one.paint_params[PAINT_FCOLS * q + 2], gy = one.paint_params[PAINT_FCOLS * q + 5];
                     dx += m.m00 * gx + m.m10 * gy;
                     dy += m.m01 * gx + m.m11 * gy;
                 }

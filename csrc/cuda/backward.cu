@@ -66,7 +66,7 @@ struct DeviceGrads {
     }
     explicit DeviceGrads(const SceneGrads& host) {
         view = {zeroed(host.points),       zeroed(host.point_widths), zeroed(host.ellipses),
-                zeroed(host.draw_params),  zeroed(host.brush_params), zeroed(host.stop_offsets),
+                zeroed(host.draw_params),  zeroed(host.paint_params), zeroed(host.stop_offsets),
                 zeroed(host.stop_colors),  zeroed(host.layer_opacity)};
     }
     static void fetch(GradPtr from, std::vector<double>& to) {
@@ -79,7 +79,7 @@ struct DeviceGrads {
         fetch(view.point_widths, out.point_widths);
         fetch(view.ellipses, out.ellipses);
         fetch(view.draw_params, out.draw_params);
-        fetch(view.brush_params, out.brush_params);
+        fetch(view.paint_params, out.paint_params);
         fetch(view.stop_offsets, out.stop_offsets);
         fetch(view.stop_colors, out.stop_colors);
         fetch(view.layer_opacity, out.layer_opacity);

@@ -56,7 +56,7 @@ inline SceneView upload_scene(Uploads& up, const PreparedScene& sc) {
     v.fill_items = up.put(sc.fill_items);
     v.stroke_items = up.put(sc.stroke_items);
     v.draws = up.put(sc.draws);
-    v.brushes = up.put(sc.brushes);
+    v.paints = up.put(sc.paints);
     v.stop_offsets = up.put(sc.stop_offsets);
     v.stop_colors = up.put(sc.stop_colors);
     v.layer_parent = up.put(sc.layer_parent);

@@ -100,11 +100,11 @@ void tile_forward(const SceneView& sc, const TileView& bins, const RenderOptions
     for (int k = bins.count(tile) - 1; k >= 0 && !ts.active.empty(); --k) {
         const TileEntry& e = entries[k];
         const PreparedDraw& d = sc.draws[e.draw];
-        const PreparedBrush& brush = sc.brushes[d.brush];
-        const bool solid = brush.kind == BRUSH_SOLID;
+        const PreparedPaint& paint = sc.paints[d.paint];
+        const bool solid = paint.kind == PAINT_SOLID;
         double c[4];
         if (solid) {
-            brush_color(sc, brush, {0, 0}, c);
+            paint_color(sc, paint, {0, 0}, c);
             if (c[3] <= 0) continue;
         }
         const Box near = grown(d.box, R);
@@ -137,7 +137,7 @@ void tile_forward(const SceneView& sc, const TileView& bins, const RenderOptions
             bool opaque = false;
             if (q.x >= near.x0 && q.x <= near.x1 && q.y >= near.y0 && q.y <= near.y1 &&
                 (counted ? winding_inside(ts.winding[a], d.fill_rule) : entry_covers(sc, bins, e, region, q))) {
-                if (!solid) brush_color(sc, brush, q, c);
+                if (!solid) paint_color(sc, paint, q, c);
                 if (c[3] > 0) {
                     std::array<double, 4>& f = ts.colour[si];
                     double under = (1 - f[3]) * 1.0;  // FrontToBackCompositor::under, coverage 1

@@ -10,7 +10,7 @@
 #include "forward/forward.h"
 #include "scene/coverage.h"
 #include "scene/layers.h"
-#include "scene/brush.h"
+#include "scene/paint.h"
 #include "scene/tiles.h"
 
 namespace vf {
@@ -56,7 +56,7 @@ VF_HD void sample_forward(const SceneView& sc, const TileView& bins, int tile, V
         double coverage = entry_coverage(sc, bins, e, region, p, o);
         if (coverage <= 0) continue;
         double c[4];
-        brush_color(sc, sc.brushes[d.brush], p, c);
+        paint_color(sc, sc.paints[d.paint], p, c);
         if (c[3] <= 0) continue;
         comp.enter(d.layer);
         comp.under(c, coverage);

@@ -67,8 +67,8 @@ int parse_filter(const std::string& f) {
 
 // The scene's arrays, kept alive for the duration of a call.
 struct SceneInput {
-    Array<float> points, point_widths, ellipses, draw_params, brush_params, stop_offsets, stop_colors, layer_opacity;
-    Array<int32_t> segments, subpaths, shapes, draws, brushes, layer_parents;
+    Array<float> points, point_widths, ellipses, draw_params, paint_params, stop_offsets, stop_colors, layer_opacity;
+    Array<int32_t> segments, subpaths, shapes, draws, paints, layer_parents;
 
     SceneArrays arrays() const {
         SceneArrays a;
@@ -82,9 +82,9 @@ struct SceneInput {
         int n;
         a.draw_params = rows(draw_params, DRAW_FCOLS, n, "draw_params");
         if (n != a.n_draws) throw std::invalid_argument("vecfit core: draw_params does not match draws");
-        a.brushes = rows(brushes, BRUSH_COLS, a.n_brushes, "brushes");
-        a.brush_params = rows(brush_params, BRUSH_FCOLS, n, "brush_params");
-        if (n != a.n_brushes) throw std::invalid_argument("vecfit core: brush_params does not match brushes");
+        a.paints = rows(paints, PAINT_COLS, a.n_paints, "paints");
+        a.paint_params = rows(paint_params, PAINT_FCOLS, n, "paint_params");
+        if (n != a.n_paints) throw std::invalid_argument("vecfit core: paint_params does not match paints");
         a.stop_offsets = rows(stop_offsets, 1, a.n_stops, "stop_offsets");
         a.stop_colors = rows(stop_colors, STOP_COLOR_COLS, n, "stop_colors");
         if (n != a.n_stops) throw std::invalid_argument("vecfit core: stop_colors does not match stop_offsets");
@@ -106,8 +106,8 @@ SceneInput scene_input(const py::dict& s) {
     in.ellipses = s["ellipses"].cast<Array<float>>();
     in.draws = s["draws"].cast<Array<int32_t>>();
     in.draw_params = s["draw_params"].cast<Array<float>>();
-    in.brushes = s["brushes"].cast<Array<int32_t>>();
-    in.brush_params = s["brush_params"].cast<Array<float>>();
+    in.paints = s["paints"].cast<Array<int32_t>>();
+    in.paint_params = s["paint_params"].cast<Array<float>>();
     in.stop_offsets = s["stop_offsets"].cast<Array<float>>();
     in.stop_colors = s["stop_colors"].cast<Array<float>>();
     in.layer_parents = s["layer_parents"].cast<Array<int32_t>>();
@@ -197,7 +197,7 @@ py::dict grads_dict(const SceneGrads& g) {
     r["point_widths"] = out(g.point_widths, 1);
     r["ellipses"] = out(g.ellipses, ELLIPSE_COLS);
     r["draw_params"] = out(g.draw_params, DRAW_FCOLS);
-    r["brush_params"] = out(g.brush_params, BRUSH_FCOLS);
+    r["paint_params"] = out(g.paint_params, PAINT_FCOLS);
     r["stop_offsets"] = out(g.stop_offsets, 1);
     r["stop_colors"] = out(g.stop_colors, STOP_COLOR_COLS);
     r["layer_opacity"] = out(g.layer_opacity, 1);
@@ -331,7 +331,7 @@ py::dict layout() {
     l["fill_rules"] = named({{"nonzero", NONZERO}, {"evenodd", EVENODD}});
     l["caps"] = named({{"butt", CAP_BUTT}, {"round", CAP_ROUND}, {"square", CAP_SQUARE}});
     l["joins"] = named({{"miter", JOIN_MITER}, {"round", JOIN_ROUND}, {"bevel", JOIN_BEVEL}});
-    l["brush_kinds"] = named({{"solid", BRUSH_SOLID}, {"linear", BRUSH_LINEAR}, {"radial", BRUSH_RADIAL}});
+    l["paint_kinds"] = named({{"solid", PAINT_SOLID}, {"linear", PAINT_LINEAR}, {"radial", PAINT_RADIAL}});
     l["columns"] = named({{"points", POINT_COLS},
                           {"point_widths", 1},
                           {"segments", SEGMENT_COLS},
@@ -340,8 +340,8 @@ py::dict layout() {
                           {"ellipses", ELLIPSE_COLS},
                           {"draws", DRAW_COLS},
                           {"draw_params", DRAW_FCOLS},
-                          {"brushes", BRUSH_COLS},
-                          {"brush_params", BRUSH_FCOLS},
+                          {"paints", PAINT_COLS},
+                          {"paint_params", PAINT_FCOLS},
                           {"stop_offsets", 1},
                           {"stop_colors", STOP_COLOR_COLS},
                           {"layer_parents", 1},
@@ -404,7 +404,7 @@ PYBIND11_MODULE(_core, m) {
           "dL/d(filter radius) in Monte Carlo mode, given dL/d(premultiplied colour) per pixel",
           py::arg("scene"), py::arg("g"), py::arg("options"));
     m.def("layout", &layout,
-          "The scene arrays' layout: enums (shape_kinds, draw_kinds, fill_rules, caps, joins, brush_kinds) "
+          "The scene arrays' layout: enums (shape_kinds, draw_kinds, fill_rules, caps, joins, paint_kinds) "
           "and each table's row width (columns)");
     m.def("backward_fallbacks", &backward_fallbacks,
           "Backward passes redone on the CPU so far because a sample needed longer lists than a GPU thread has");

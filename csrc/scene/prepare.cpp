@@ -1,6 +1,6 @@
 // Builds the PreparedScene from the flat arrays: control points per segment, bounds,
-// y-monotone pieces for ray crossings, stroke pieces (joins and caps), brushes (from the
-// brushes table), layers.
+// y-monotone pieces for ray crossings, stroke pieces (joins and caps), paints (from the
+// paints table), layers.
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -285,21 +285,21 @@ PreparedScene prepare_scene(const SceneArrays& a) {
 
     sc.stop_offsets.assign(a.stop_offsets, a.stop_offsets + a.n_stops);
     sc.stop_colors.assign(a.stop_colors, a.stop_colors + 4 * a.n_stops);
-    for (int q = 0; q < a.n_brushes; ++q) {
-        const int32_t* row = a.brushes + BRUSH_COLS * q;
-        const float* f = a.brush_params + BRUSH_FCOLS * q;
-        PreparedBrush p;  // a row of the brushes table
+    for (int q = 0; q < a.n_paints; ++q) {
+        const int32_t* row = a.paints + PAINT_COLS * q;
+        const float* f = a.paint_params + PAINT_FCOLS * q;
+        PreparedPaint p;  // a row of the paints table
         p.kind = row[0];
         p.first_stop = row[1];
         p.n_stops = row[2];
-        check(p.kind >= BRUSH_SOLID && p.kind <= BRUSH_RADIAL, "unknown paint kind");
-        check(p.kind == BRUSH_SOLID || (p.first_stop >= 0 && p.n_stops >= 1 &&
+        check(p.kind >= PAINT_SOLID && p.kind <= PAINT_RADIAL, "unknown paint kind");
+        check(p.kind == PAINT_SOLID || (p.first_stop >= 0 && p.n_stops >= 1 &&
                                         p.first_stop + p.n_stops <= a.n_stops),
               "gradient stops out of range");
-        p.to_brush = {f[0], f[1], f[2], f[3], f[4], f[5]};
+        p.to_paint = {f[0], f[1], f[2], f[3], f[4], f[5]};
         for (int i = 0; i < 4; ++i) p.rgba[i] = f[6 + i];
         for (int i = 0; i < 5; ++i) p.g[i] = f[6 + i];
-        sc.brushes.push_back(p);
+        sc.paints.push_back(p);
     }
 
     check(a.n_layers >= 1, "at least the root layer is needed");
@@ -321,13 +321,13 @@ PreparedScene prepare_scene(const SceneArrays& a) {
         d.shape = row[0];
         d.kind = row[1];
         d.fill_rule = row[2];
-        d.brush = row[3];
+        d.paint = row[3];
         d.layer = row[4];
         d.cap = row[5];
         d.join = row[6];
         d.varying = row[7] != 0;
         check(d.shape >= 0 && d.shape < a.n_shapes, "draw shape out of range");
-        check(d.brush >= 0 && d.brush < a.n_brushes, "draw paint out of range");
+        check(d.paint >= 0 && d.paint < a.n_paints, "draw paint out of range");
         check(d.layer >= 0 && d.layer < a.n_layers, "draw layer out of range");
         d.half_width = 0.5 * std::max(0.0f, f[0]);
         d.miter_limit = std::max(1.0f, f[1]);

@@ -1,9 +1,9 @@
 // The scene as the core sees it: flat arrays in (structure of arrays, filled by the
 // Python side, all geometry already in pixel space), and the prepared form the samplers
-// read (segments with their control points, bounds, joins, brushes).
+// read (segments with their control points, bounds, joins, paints).
 //
-// Names: a fill or stroke's colour source (solid, linear or radial gradient) is a brush
-// in the core and in the arrays Python hands it (the "brushes" and "brush_params" tables,
+// Names: a fill or stroke's colour source (solid, linear or radial gradient) is a paint
+// in the core and in the arrays Python hands it (the "paints" and "paint_params" tables,
 // as vello calls them): "paint" is the painterly command elsewhere in vecfit, and the
 // SVG's word for a fill or stroke value in the Scene and the SVG reader.
 #pragma once
@@ -22,7 +22,7 @@ enum DrawKind : int32_t { DRAW_FILL = 0, DRAW_STROKE = 1 };
 enum FillRule : int32_t { NONZERO = 0, EVENODD = 1 };
 enum Cap : int32_t { CAP_BUTT = 0, CAP_ROUND = 1, CAP_SQUARE = 2 };
 enum Join : int32_t { JOIN_MITER = 0, JOIN_ROUND = 1, JOIN_BEVEL = 2 };
-enum BrushKind : int32_t { BRUSH_SOLID = 0, BRUSH_LINEAR = 1, BRUSH_RADIAL = 2 };
+enum PaintKind : int32_t { PAINT_SOLID = 0, PAINT_LINEAR = 1, PAINT_RADIAL = 2 };
 
 // Column layouts of the input tables (row-major, one row per item). These, the enums above
 // and the tables' keys are what _core.layout() exports to Python (python/bindings.cpp).
@@ -31,10 +31,10 @@ constexpr int SEGMENT_COLS = 5;   // degree, point index of each control point (
 constexpr int SUBPATH_COLS = 3;   // first segment, segment count, closed (0/1)
 constexpr int SHAPE_COLS = 4;     // kind, first subpath, subpath count, ellipse index
 constexpr int ELLIPSE_COLS = 6;   // cx, cy, a, b, c, d: ellipse {c + (a b; c d)(cos, sin)}
-constexpr int DRAW_COLS = 8;      // shape, kind, fill rule, brush, layer, cap, join, per-point widths (0/1)
+constexpr int DRAW_COLS = 8;      // shape, kind, fill rule, paint, layer, cap, join, per-point widths (0/1)
 constexpr int DRAW_FCOLS = 6;     // stroke width (unused with per-point widths), miter limit, metric (a b c d)
-constexpr int BRUSH_COLS = 3;     // kind, first stop, stop count
-constexpr int BRUSH_FCOLS = 11;   // pixel->brush affine (6), then solid rgba | x1 y1 x2 y2 | cx cy r fx fy
+constexpr int PAINT_COLS = 3;     // kind, first stop, stop count
+constexpr int PAINT_FCOLS = 11;   // pixel->paint affine (6), then solid rgba | x1 y1 x2 y2 | cx cy r fx fy
 constexpr int STOP_COLOR_COLS = 4;  // straight RGBA
 // point_widths, stop_offsets, layer_parents and layer_opacity: one value per row.
 
@@ -49,8 +49,8 @@ struct SceneArrays {
     const float* ellipses = nullptr;     int n_ellipses = 0;   // [E, ELLIPSE_COLS]
     const int32_t* draws = nullptr;      int n_draws = 0;      // [D, DRAW_COLS]
     const float* draw_params = nullptr;                        // [D, DRAW_FCOLS]
-    const int32_t* brushes = nullptr;    int n_brushes = 0;    // [Q, BRUSH_COLS]
-    const float* brush_params = nullptr;                       // [Q, BRUSH_FCOLS]
+    const int32_t* paints = nullptr;    int n_paints = 0;    // [Q, PAINT_COLS]
+    const float* paint_params = nullptr;                       // [Q, PAINT_FCOLS]
     const float* stop_offsets = nullptr; int n_stops = 0;      // [T]
     const float* stop_colors = nullptr;                        // [T, 4] straight RGBA
     const int32_t* layer_parents = nullptr; int n_layers = 0;  // [L]; layer 0 is the root
@@ -124,7 +124,7 @@ struct StrokeSegment {
 };
 
 struct PreparedDraw {
-    int32_t shape = 0, kind = DRAW_FILL, fill_rule = NONZERO, brush = 0, layer = 0;
+    int32_t shape = 0, kind = DRAW_FILL, fill_rule = NONZERO, paint = 0, layer = 0;
     int32_t cap = CAP_BUTT, join = JOIN_MITER;
     double half_width = 0, miter_limit = 4;  // per-point widths: the largest half width
     bool varying = false;       // stroke with per-point widths (StrokeSegment::hw, StrokeEnd::hw)
@@ -141,9 +141,9 @@ struct PreparedDraw {
     Box box;                            // pixel-space bounds of what the draw can cover
 };
 
-struct PreparedBrush {
-    int32_t kind = BRUSH_SOLID;
-    Affine to_brush;            // pixel -> brush space
+struct PreparedPaint {
+    int32_t kind = PAINT_SOLID;
+    Affine to_paint;            // pixel -> paint space
     double rgba[4] = {0, 0, 0, 0};
     double g[5] = {0, 0, 0, 0, 0};
     int first_stop = 0, n_stops = 0;
@@ -155,7 +155,7 @@ struct PreparedScene {
     std::vector<PreparedSegment> fill_items; // per fill draw: its segments and closing lines
     std::vector<StrokeSegment> stroke_items; // per stroke draw
     std::vector<PreparedDraw> draws;
-    std::vector<PreparedBrush> brushes;
+    std::vector<PreparedPaint> paints;
     std::vector<double> stop_offsets;
     std::vector<double> stop_colors;          // straight RGBA
     std::vector<int32_t> layer_parent;
@@ -172,7 +172,7 @@ struct SceneView {
     Span<PreparedSegment> fill_items;
     Span<StrokeSegment> stroke_items;
     Span<PreparedDraw> draws;
-    Span<PreparedBrush> brushes;
+    Span<PreparedPaint> paints;
     Span<double> stop_offsets, stop_colors;
     Span<int32_t> layer_parent;
     Span<double> layer_opacity;
@@ -181,7 +181,7 @@ struct SceneView {
 
 inline SceneView PreparedScene::view() const {
     return {span_of(segments),     span_of(point_hw),     span_of(fill_items),   span_of(stroke_items),
-            span_of(draws),        span_of(brushes),       span_of(stop_offsets), span_of(stop_colors),
+            span_of(draws),        span_of(paints),       span_of(stop_offsets), span_of(stop_colors),
             span_of(layer_parent), span_of(layer_opacity), span_of(layer_depth)};
 }
 

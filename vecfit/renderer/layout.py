@@ -17,10 +17,10 @@ DRAW_STROKE: int = _LAYOUT["draw_kinds"]["stroke"]
 FILL_RULES: dict[str, int] = dict(_LAYOUT["fill_rules"])
 CAPS: dict[str, int] = dict(_LAYOUT["caps"])
 JOINS: dict[str, int] = dict(_LAYOUT["joins"])
-BRUSH_SOLID: int = _LAYOUT["brush_kinds"]["solid"]
-BRUSH_LINEAR: int = _LAYOUT["brush_kinds"]["linear"]
-BRUSH_RADIAL: int = _LAYOUT["brush_kinds"]["radial"]
+PAINT_SOLID: int = _LAYOUT["paint_kinds"]["solid"]
+PAINT_LINEAR: int = _LAYOUT["paint_kinds"]["linear"]
+PAINT_RADIAL: int = _LAYOUT["paint_kinds"]["radial"]
 COLUMNS: dict[str, int] = dict(_LAYOUT["columns"])
 
 __all__ = ["SHAPE_PATH", "SHAPE_ELLIPSE", "DRAW_FILL", "DRAW_STROKE", "FILL_RULES", "CAPS", "JOINS",
-           "BRUSH_SOLID", "BRUSH_LINEAR", "BRUSH_RADIAL", "COLUMNS"]
+           "PAINT_SOLID", "PAINT_LINEAR", "PAINT_RADIAL", "COLUMNS"]

@@ -19,8 +19,8 @@ from vecfit.scene import Circle, Ellipse, LinearGradient, Path, RadialGradient, 
 from vecfit.scene.geometry import affine_apply, local_bbox, rect_as_path, value
 from vecfit.scene.placement import canvas_matrix, group_matrices, stacked_shape_matrices
 
-from .layout import (CAPS, COLUMNS, DRAW_FILL, DRAW_STROKE, FILL_RULES, JOINS, BRUSH_LINEAR,
-                     BRUSH_RADIAL, BRUSH_SOLID, SHAPE_ELLIPSE, SHAPE_PATH)
+from .layout import (CAPS, COLUMNS, DRAW_FILL, DRAW_STROKE, FILL_RULES, JOINS, PAINT_LINEAR,
+                     PAINT_RADIAL, PAINT_SOLID, SHAPE_ELLIPSE, SHAPE_PATH)
 
 
 @dataclass
@@ -34,8 +34,8 @@ class Packed:
     ellipses: list = field(default_factory=list)      # torch [6]
     draws: list = field(default_factory=list)         # rows of 8 ints
     draw_params: list = field(default_factory=list)   # torch [6]
-    brushes: list = field(default_factory=list)       # rows of 3 ints
-    brush_params: list = field(default_factory=list)  # torch [11]
+    paints: list = field(default_factory=list)       # rows of 3 ints
+    paint_params: list = field(default_factory=list)  # torch [11]
     stop_offsets: list = field(default_factory=list)  # torch [k]
     stop_colors: list = field(default_factory=list)   # torch [k, 4]
     layer_parents: list = field(default_factory=lambda: [-1])
@@ -63,8 +63,8 @@ class Packed:
             "ellipses": cat(self.ellipses, COLUMNS["ellipses"]),
             "draws": ints(self.draws, COLUMNS["draws"]),
             "draw_params": cat(self.draw_params, COLUMNS["draw_params"]),
-            "brushes": ints(self.brushes, COLUMNS["brushes"]),
-            "brush_params": cat(self.brush_params, COLUMNS["brush_params"]),
+            "paints": ints(self.paints, COLUMNS["paints"]),
+            "paint_params": cat(self.paint_params, COLUMNS["paint_params"]),
             "stop_offsets": cat(self.stop_offsets, COLUMNS["stop_offsets"]).reshape(-1),
             "stop_colors": cat(self.stop_colors, COLUMNS["stop_colors"]),
             "layer_parents": np.asarray(self.layer_parents, dtype=np.int32),
@@ -153,24 +153,24 @@ class Packer:
         if abs(value(torch.linalg.det(g[:2, :2]))) < 1e-30:
             return None
         to_paint = torch.linalg.inv(g)[:2].reshape(6)
-        # its row: after the solids and the gradients before it (see _finish_brushes)
-        first = (self._n_solid + getattr(self, "_n_gradients", 0)) * COLUMNS["brush_params"]
+        # its row: after the solids and the gradients before it (see _finish_paints)
+        first = (self._n_solid + getattr(self, "_n_gradients", 0)) * COLUMNS["paint_params"]
         if isinstance(paint, LinearGradient):
             params = torch.cat([to_paint, paint.start.float(), paint.end.float(), torch.zeros(1)])
-            kind = BRUSH_LINEAR
+            kind = PAINT_LINEAR
             if self.provenance:
-                self.provenance.copy("brush_params", first + 6, paint.start)
-                self.provenance.copy("brush_params", first + 8, paint.end)
+                self.provenance.copy("paint_params", first + 6, paint.start)
+                self.provenance.copy("paint_params", first + 8, paint.end)
         elif isinstance(paint, RadialGradient):
             # SVG 2 semantics, as resvg and browsers draw it: a focal point outside the
             # circle makes a cone, and the area outside the cone is not painted.
             c, f, r = paint.center.float(), paint.focal.float(), paint.radius.float().reshape(1)
             params = torch.cat([to_paint, c, r, f])
-            kind = BRUSH_RADIAL
+            kind = PAINT_RADIAL
             if self.provenance:
-                self.provenance.copy("brush_params", first + 6, paint.center)
-                self.provenance.copy("brush_params", first + 8, paint.radius)
-                self.provenance.copy("brush_params", first + 9, paint.focal)
+                self.provenance.copy("paint_params", first + 6, paint.center)
+                self.provenance.copy("paint_params", first + 8, paint.radius)
+                self.provenance.copy("paint_params", first + 9, paint.focal)
         else:
             raise VecfitError(f"unknown paint {type(paint).__name__}")
         colors = paint.colors.float()
@@ -178,8 +178,8 @@ class Packer:
         if self.provenance:
             self.provenance.copy("stop_offsets", out.n_stops, paint.offsets)
             self.provenance.colors("stop_colors", out.n_stops * 4, paint.colors, torch.full((len(paint.offsets),), value(alpha)))
-        out.brushes.append([kind, out.n_stops, len(paint.offsets)])
-        out.brush_params.append(params)
+        out.paints.append([kind, out.n_stops, len(paint.offsets)])
+        out.paint_params.append(params)
         out.stop_offsets.append(paint.offsets.float())
         out.stop_colors.append(colors)
         out.n_stops += len(paint.offsets)
@@ -207,7 +207,7 @@ class Packer:
         gradient_rows = []                    # (paint, alpha, matrix, geometry)
         stroke_rows = []                      # (draw index, shape index)
 
-        def brush_index(paint, factors, shape_index, geometry):
+        def paint_index(paint, factors, shape_index, geometry):
             if isinstance(paint, Solid):
                 solid_colors.append(paint.color)
                 solid_alphas.append(factors)
@@ -253,17 +253,17 @@ class Packer:
                 if index is None:
                     continue
             if has_fill:
-                paint = brush_index(shape.fill, factors + [shape.fill_opacity], i, shape.geometry)
+                paint = paint_index(shape.fill, factors + [shape.fill_opacity], i, shape.geometry)
                 out.draws.append([index, DRAW_FILL, FILL_RULES[shape.fill_rule], paint, layer, 0, 0, 0])
             if has_stroke:
-                paint = brush_index(shape.stroke, factors + [shape.stroke_opacity], i, shape.geometry)
+                paint = paint_index(shape.stroke, factors + [shape.stroke_opacity], i, shape.geometry)
                 stroke_rows.append((len(out.draws), i))
                 per_point = int(isinstance(geometry, Path) and geometry.widths is not None)
                 out.draws.append([index, DRAW_STROKE, 0, paint, layer,
                                   CAPS[shape.linecap], JOINS[shape.linejoin], per_point])
 
         paths.finish(out, matrices, scale, self.provenance)
-        self._finish_brushes(solid_colors, solid_alphas, gradient_rows)
+        self._finish_paints(solid_colors, solid_alphas, gradient_rows)
         self._finish_draw_params(stroke_rows, matrices, scale, similar)
         return out
 
@@ -291,7 +291,7 @@ class Packer:
         self.out.shapes.append([SHAPE_ELLIPSE, 0, 0, len(self.out.ellipses) - 1])
         return len(self.out.shapes) - 1
 
-    def _finish_brushes(self, solid_colors, solid_alphas, gradient_rows) -> None:
+    def _finish_paints(self, solid_colors, solid_alphas, gradient_rows) -> None:
         """Paint table: the solids (stacked in one go), then the gradients; draws that
         point at a gradient are renumbered."""
         out = self.out
@@ -306,10 +306,10 @@ class Packer:
             colors = torch.cat([colors[:, :3], colors[:, 3:4] * alphas[:, None]], dim=1)
             if self.provenance:
                 for row, (color, a) in enumerate(zip(solid_colors, alphas.detach())):
-                    self.provenance.colors("brush_params", row * COLUMNS["brush_params"] + 6, color, a.reshape(1))
+                    self.provenance.colors("paint_params", row * COLUMNS["paint_params"] + 6, color, a.reshape(1))
             ident = torch.eye(2, 3).reshape(1, 6).expand(n_solid, 6)
-            out.brush_params.append(torch.cat([ident, colors, torch.zeros(n_solid, 1)], dim=1))
-            out.brushes.extend([[BRUSH_SOLID, 0, 0]] * n_solid)
+            out.paint_params.append(torch.cat([ident, colors, torch.zeros(n_solid, 1)], dim=1))
+            out.paints.extend([[PAINT_SOLID, 0, 0]] * n_solid)
         gradient_index = []
         for paint, alpha, m, geometry in gradient_rows:
             gradient_index.append(self._add_gradient(paint, alpha, m, geometry))

@@ -39,7 +39,7 @@ def output_size(scene: Scene, width: int | None, height: int | None) -> tuple[in
     return int(w), int(h)
 
 
-FLOAT_INPUTS = ("points", "point_widths", "ellipses", "draw_params", "brush_params", "stop_offsets",
+FLOAT_INPUTS = ("points", "point_widths", "ellipses", "draw_params", "paint_params", "stop_offsets",
                 "stop_colors", "layer_opacity")
 
 

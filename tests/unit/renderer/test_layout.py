@@ -18,12 +18,12 @@ PACK_LITERALS = {
     "FILL_RULES": {"nonzero": 0, "evenodd": 1},
     "CAPS": {"butt": 0, "round": 1, "square": 2},
     "JOINS": {"miter": 0, "round": 1, "bevel": 2},
-    "BRUSH_SOLID": 0, "BRUSH_LINEAR": 1, "BRUSH_RADIAL": 2,
+    "PAINT_SOLID": 0, "PAINT_LINEAR": 1, "PAINT_RADIAL": 2,
 }
 PACK_COLUMNS = {"points": 2, "point_widths": 1, "segments": 5, "subpaths": 3, "shapes": 4, "ellipses": 6,
-                "draws": 8, "draw_params": 6, "brushes": 3, "brush_params": 11, "stop_offsets": 1,
+                "draws": 8, "draw_params": 6, "paints": 3, "paint_params": 11, "stop_offsets": 1,
                 "stop_colors": 4, "layer_parents": 1, "layer_opacity": 1}
-INT_TABLES = {"segments", "subpaths", "shapes", "draws", "brushes", "layer_parents"}
+INT_TABLES = {"segments", "subpaths", "shapes", "draws", "paints", "layer_parents"}
 
 
 @pytest.mark.parametrize("name", sorted(PACK_LITERALS))
@@ -36,7 +36,7 @@ def test_columns_are_the_widths_pack_uses():
 
 
 def test_core_layout_keys():
-    assert set(_core.layout()) == {"shape_kinds", "draw_kinds", "fill_rules", "caps", "joins", "brush_kinds",
+    assert set(_core.layout()) == {"shape_kinds", "draw_kinds", "fill_rules", "caps", "joins", "paint_kinds",
                                    "columns"}
 
 

@@ -1,6 +1,6 @@
-// Brushes, the colour sources of fills and strokes: solid colours and linear / radial
+// Paints, the colour sources of fills and strokes: solid colours and linear / radial
 // gradients (pad spread), evaluated at a point, premultiplied. The adjoint is
-// backward/brush.h.
+// backward/paint.h.
 #pragma once
 
 #include "common/vec.h"
@@ -9,7 +9,7 @@
 namespace vf {
 
 // Colour of the stops at t (straight RGBA interpolated, as SVG does), premultiplied.
-VF_HD void stop_color(const SceneView& sc, const PreparedBrush& p, double t, double out[4]) {
+VF_HD void stop_color(const SceneView& sc, const PreparedPaint& p, double t, double out[4]) {
     const double* off = sc.stop_offsets.data() + p.first_stop;
     const double* col = sc.stop_colors.data() + 4 * p.first_stop;
     int n = p.n_stops;
@@ -49,16 +49,16 @@ VF_HD bool radial_t(Vec2 q, Vec2 c, double r, Vec2 f, double& t) {
     return t >= 0;
 }
 
-VF_HD void brush_color(const SceneView& sc, const PreparedBrush& p, Vec2 pixel, double out[4]) {
-    if (p.kind == BRUSH_SOLID) {
+VF_HD void paint_color(const SceneView& sc, const PreparedPaint& p, Vec2 pixel, double out[4]) {
+    if (p.kind == PAINT_SOLID) {
         double a = vclamp(p.rgba[3], 0.0, 1.0);
         for (int i = 0; i < 3; ++i) out[i] = vclamp(p.rgba[i], 0.0, 1.0) * a;
         out[3] = a;
         return;
     }
-    Vec2 q = apply(p.to_brush, pixel);
+    Vec2 q = apply(p.to_paint, pixel);
     double t;
-    if (p.kind == BRUSH_LINEAR) {
+    if (p.kind == PAINT_LINEAR) {
         Vec2 a{p.g[0], p.g[1]}, d = Vec2{p.g[2], p.g[3]} - a;
         double l2 = dot(d, d);
         t = l2 > 0 ? dot(q - a, d) / l2 : 1.0;  // degenerate: the last stop's colour

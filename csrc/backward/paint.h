@@ -1,5 +1,5 @@
-// The adjoint of brush evaluation (scene/brush.h): dL/d(premultiplied colour) at a point
-// to dL/d(brush parameters (the brush_params table), stop offsets, stop colours).
+// The adjoint of paint evaluation (scene/paint.h): dL/d(premultiplied colour) at a point
+// to dL/d(paint parameters (the paint_params table), stop offsets, stop colours).
 #pragma once
 
 #include <cmath>
@@ -7,7 +7,7 @@
 #include "backward/grads.h"
 #include "common/portable.h"
 #include "common/vec.h"
-#include "scene/brush.h"
+#include "scene/paint.h"
 #include "scene/scene.h"
 
 namespace vf {
@@ -23,23 +23,23 @@ VF_HD void premultiply_backward(const double c[4], const double g[4], double gc[
     gc[3] = (c[3] >= 0 && c[3] <= 1) ? ga : 0.0;
 }
 
-// Adjoint of brush_color: g is dL/d(premultiplied colour at `pixel`); adds dL/d(brush
+// Adjoint of paint_color: g is dL/d(premultiplied colour at `pixel`); adds dL/d(paint
 // parameters, stop offsets, stop colours) into grads.
-VF_HD void brush_color_backward(const SceneView& sc, int brush_index, Vec2 pixel, const double g[4],
+VF_HD void paint_color_backward(const SceneView& sc, int paint_index, Vec2 pixel, const double g[4],
                                 const GradView& grads) {
-    const PreparedBrush& p = sc.brushes[brush_index];
-    GradPtr gp = grads.brush_params + BRUSH_FCOLS * brush_index;
-    if (p.kind == BRUSH_SOLID) {
+    const PreparedPaint& p = sc.paints[paint_index];
+    GradPtr gp = grads.paint_params + PAINT_FCOLS * paint_index;
+    if (p.kind == PAINT_SOLID) {
         double gc[4];
         premultiply_backward(p.rgba, g, gc);
         for (int i = 0; i < 4; ++i) gp[6 + i] += gc[i];
         return;
     }
-    Vec2 q = apply(p.to_brush, pixel);
+    Vec2 q = apply(p.to_paint, pixel);
     double t;
     Vec2 dt_dq{0, 0};
     double gg[5] = {0, 0, 0, 0, 0};  // dt / d(gradient geometry g[0..4])
-    if (p.kind == BRUSH_LINEAR) {
+    if (p.kind == PAINT_LINEAR) {
         Vec2 a{p.g[0], p.g[1]}, d = Vec2{p.g[2], p.g[3]} - a, e = q - a;
         double D = dot(d, d);
         if (D <= 0) return;  // constant colour: the last stop
