@@ -34,11 +34,8 @@ VF_HD bool covers(const SceneView& sc, const TileView& bins, const TileEntry& e,
     return p.x >= b.x0 && p.x <= b.x1 && p.y >= b.y0 && p.y <= b.y1 && entry_covers(sc, bins, e, region, p);
 }
 
-// Does draw `draw` cover p? (p inside the tile grid's reach.)
-VF_HD bool draw_covers_at(const SceneView& sc, const TileView& bins, int draw, Vec2 p) {
-    int tile = tile_of(bins, p);
-    Box region = bins.region(tile);
-    if (p.x < region.x0 || p.x > region.x1 || p.y < region.y0 || p.y > region.y1) return false;
+// Draw `draw`'s entry in tile `tile`, or null where the draw reaches nothing there.
+VF_HD const TileEntry* entry_of(const TileView& bins, int tile, int draw) {
     const TileEntry* es = bins.begin(tile);
     int n = bins.count(tile);
     int lo = 0, hi = n;  // entries are sorted by draw index (paint order)
@@ -46,8 +43,16 @@ VF_HD bool draw_covers_at(const SceneView& sc, const TileView& bins, int draw, V
         int mid = (lo + hi) / 2;
         if (es[mid].draw < draw) lo = mid + 1; else hi = mid;
     }
-    if (lo >= n || es[lo].draw != draw) return false;
-    return covers(sc, bins, es[lo], region, p);
+    return lo < n && es[lo].draw == draw ? es + lo : nullptr;
+}
+
+// Does draw `draw` cover p? (p inside the tile grid's reach.)
+VF_HD bool draw_covers_at(const SceneView& sc, const TileView& bins, int draw, Vec2 p) {
+    int tile = tile_of(bins, p);
+    Box region = bins.region(tile);
+    if (p.x < region.x0 || p.x > region.x1 || p.y < region.y0 || p.y > region.y1) return false;
+    const TileEntry* e = entry_of(bins, tile, draw);
+    return e && covers(sc, bins, *e, region, p);
 }
 
 // Whether draw `draw` covers each of two points a hair apart (either side of one of its
@@ -70,15 +75,9 @@ VF_HD void draw_covers_pair(const SceneView& sc, const TileView& bins, int draw,
     };
     bool ra = reached(a), rb = reached(b);
     if (!ra && !rb) return;
-    const TileEntry* es = bins.begin(tile);
-    int n = bins.count(tile);
-    int lo = 0, hi = n;  // entries are sorted by draw index (paint order)
-    while (lo < hi) {
-        int mid = (lo + hi) / 2;
-        if (es[mid].draw < draw) lo = mid + 1; else hi = mid;
-    }
-    if (lo >= n || es[lo].draw != draw) return;
-    const TileEntry& e = es[lo];
+    const TileEntry* found = entry_of(bins, tile, draw);
+    if (!found) return;
+    const TileEntry& e = *found;
     const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
     const LocalItem* items = bins.items.data() + e.first;
     int wa = e.winding, wb = e.winding;
