@@ -163,10 +163,6 @@ def render(inputs, output, out_dir, width, height, samples, mode, filter_, filte
 def info(svg, build):
     """List the shapes, segments and paints of an SVG, and what was skipped; or, with
     --build, what the compiled core has."""
-    import vecfit
-    from vecfit.errors import VecfitError
-    from vecfit.scene.summary import summarize
-
     if build:
         from vecfit.renderer.device import build_summary
         click.echo(build_summary())
@@ -174,6 +170,10 @@ def info(svg, build):
         if not build:
             raise click.UsageError("give an SVG file, or --build")
         return
+    import vecfit  # (the Scene's tensors: torch is imported only from here on)
+    from vecfit.errors import VecfitError
+    from vecfit.scene.summary import summarize
+
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")

@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -83,3 +85,11 @@ def test_info_on_non_svg_is_a_clear_error(tmp_path):
     p.write_text("hello, not xml")
     r = run("info", p)
     assert r.exit_code == 1 and "notes.svg" in r.output and "Traceback" not in r.output
+
+
+def test_version_starts_without_torch():
+    """`vecfit --version` says the core's build without importing torch (a second of start-up)."""
+    code = ("import sys\nfrom vecfit.cli.commands import main\nsys.argv = ['vecfit', '--version']\n"
+            "try:\n    main()\nexcept SystemExit:\n    pass\nprint('torch' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.stdout.split()[-1] == "False" and out.stdout.startswith("vecfit "), out.stdout + out.stderr

@@ -5,7 +5,7 @@ runs there (the same functions as on the CPU, compiled for both).
 """
 from __future__ import annotations
 
-import torch
+import sys
 
 from vecfit import _core
 from vecfit.errors import VecfitError
@@ -28,7 +28,8 @@ def resolve(device) -> int:
     """The core's device index for `device`: "auto" (the first GPU if there is one), "cpu",
     "cuda", "cuda:N" or a torch.device. Raises VecfitError when a GPU is asked for and
     cannot be had."""
-    if isinstance(device, torch.device):
+    torch = sys.modules.get("torch")  # (a torch.device exists only once torch is imported:
+    if torch is not None and isinstance(device, torch.device):  # --version needs no torch)
         device = str(device)
     if not isinstance(device, str):
         raise VecfitError(f"device must be one of {', '.join(CHOICES)} or cuda:N, not {device!r}")
