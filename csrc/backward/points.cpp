@@ -1,3 +1,4 @@
+// The scene at arbitrary points (points.h): forward and adjoint, all points in one call.
 #include "backward/points.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// The persistent thread pool (thread_pool.h): workers started once, tasks skipped on cancel.
 #include "common/thread_pool.h"
 
 #include "common/cancel.h"

@@ -1,4 +1,4 @@
-// Test hooks: the core's geometry called directly from the tests (tests/test_geometry.py),
+// Test hooks: the core's geometry called directly from the tests (tests/unit/scene/test_geometry.py),
 // which check it against brute force and a Python reference renderer. Registered on
 // vecfit._core by the module (bindings.cpp); nothing in vecfit/ calls them.
 #include "python/test_hooks.h"

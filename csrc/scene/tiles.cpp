@@ -1,3 +1,4 @@
+// Tile binning (tiles.h): which draws and which of their pieces reach each tile.
 #include "scene/tiles.h"
 
 #include <algorithm>
