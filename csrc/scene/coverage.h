@@ -399,24 +399,41 @@ VF_HD int draw_winding_all(const SceneView& sc, const PreparedDraw& d, Vec2 p) {
     return w;
 }
 
-// A lower bound on the squared distance from p to the segment, from the boxes of its
-// sub-pieces (see PreparedSegment::sub_y): a long curve's own box holds most of the canvas,
-// where each sub-piece's holds a strip of it; stops once under `enough`.
-VF_HD double sub_box_distance2(const PreparedSegment& s, Vec2 p, double enough) {
-    double best = 1e300;
+// Whether the curve lies `limit` or farther from p, for certain: its sub-pieces' boxes (see
+// PreparedSegment::sub_y; exact ranges), then the halves of those that come closer, by de
+// Casteljau, each bounded by its control points' box, down to DEPTH levels. A curve's
+// closest point costs a quintic's roots; where many long curves pass near a pixel (30,000
+// across a 64 px canvas: hundreds at each), most are set aside in a few splits.
+VF_HD bool curve_farther(const PreparedSegment& s, Vec2 p, double limit) {
+    constexpr int DEPTH = 6;
+    const double l2 = limit * limit;
     for (int k = 0; k + 1 < s.n_split; ++k)
         for (int j = 0; j < s.n_sub; ++j) {
             double ya = s.sub_y[k][j], yb = s.sub_y[k][j + 1];
-            best = vmin(best, distance2(Box{s.sub_x0[k][j], vmin(ya, yb), s.sub_x1[k][j], vmax(ya, yb)}, p));
-            if (best < enough) return best;
+            if (distance2(Box{s.sub_x0[k][j], vmin(ya, yb), s.sub_x1[k][j], vmax(ya, yb)}, p) >= l2) continue;
+            Segment stack[DEPTH + 1];
+            int level[DEPTH + 1], n = 0;
+            stack[n] = seg_part(s.seg, s.sub_t(k, j), s.sub_t(k, j + 1));
+            level[n++] = 0;
+            while (n > 0) {
+                --n;
+                const Segment c = stack[n];
+                const int lv = level[n];
+                Box b;
+                for (int i = 0; i <= c.degree; ++i) expand(b, c.p[i]);
+                if (distance2(b, p) >= l2) continue;
+                if (lv == DEPTH) return false;
+                seg_split(c, 0.5, stack[n], stack[n + 1]);
+                level[n] = level[n + 1] = lv + 1;
+                n += 2;
+            }
         }
-    return best;
+    return true;
 }
 
 // Distance from p to the closest fill segment among items, or `limit` if none is closer.
-// (The closest point of a curve costs a quintic's roots: a curve is measured only where a
-// sub-piece's box comes within the distance so far, so that a long path's cost follows the
-// pixels near each segment, not those in its box.)
+// (A curve is measured only where it may come within the distance so far, curve_farther:
+// a long path's cost follows the pixels near each segment, not those in its box.)
 template <class Items>
 VF_HD double fill_distance(const SceneView& sc, const PreparedDraw& d, const Items& items, Vec2 p, double limit,
                      SdfArg* arg = nullptr) {
@@ -425,12 +442,8 @@ VF_HD double fill_distance(const SceneView& sc, const PreparedDraw& d, const Ite
     for (int i = 0; i < items.size(); ++i) {
         const PreparedSegment& s = segs[items[i]];
         double d2 = distance2(s.box, p);  // (on an edge, with arg: look for a second one)
-        auto far = [&] { return d2 >= best * best && !(arg && best < ON_EDGE && d2 < ON_EDGE * ON_EDGE); };
-        if (far()) continue;
-        if (s.seg.degree > 1) {
-            d2 = sub_box_distance2(s, p, vmin(best * best, ON_EDGE * ON_EDGE));
-            if (far()) continue;
-        }
+        if (d2 >= best * best && !(arg && best < ON_EDGE && d2 < ON_EDGE * ON_EDGE)) continue;
+        if (s.seg.degree > 1 && curve_farther(s, p, arg && best < ON_EDGE ? ON_EDGE : best)) continue;
         Closest c;
         if (s.seg.degree == 1) {
             Vec2 a = s.seg.p[0], e = s.seg.p[1] - a;
