@@ -78,6 +78,42 @@ def load_rgba(path: str | os.PathLike) -> np.ndarray:
     return np.asarray(rgba, dtype=np.float32) / 255.0
 
 
+def image_rgba(source) -> np.ndarray:
+    """An image given as a file path, the bytes of an image file, a PIL image or a NumPy
+    array ([H, W], [H, W, 3] or [H, W, 4]; uint8, or floats in [0, 1]) as float32 straight
+    RGBA in [0, 1]; VecfitError saying what is wrong with it."""
+    if isinstance(source, (str, os.PathLike)):
+        return load_rgba(source)
+    if isinstance(source, (bytes, bytearray, memoryview)):
+        import io
+        try:
+            with Image.open(io.BytesIO(bytes(source))) as im:
+                if im.width * im.height > MAX_IMAGE_PIXELS:
+                    raise VecfitError(f"the image is {im.width}x{im.height} pixels; at most "
+                                      f"{MAX_IMAGE_PIXELS // 1_000_000} million pixels (the limit)")
+                return np.asarray(im.convert("RGBA"), dtype=np.float32) / 255.0
+        except (UnidentifiedImageError, OSError, ValueError, Image.DecompressionBombError) as e:
+            raise VecfitError(f"the image bytes cannot be read as an image ({e})") from None
+    if isinstance(source, Image.Image):
+        return np.asarray(source.convert("RGBA"), dtype=np.float32) / 255.0
+    a = np.asarray(source)
+    if a.ndim == 2:
+        a = a[..., None].repeat(3, axis=2)
+    if a.ndim != 3 or a.shape[2] not in (3, 4) or a.shape[0] * a.shape[1] == 0:
+        raise VecfitError(f"an image array must be [H, W], [H, W, 3] or [H, W, 4], not {list(a.shape)}")
+    if a.dtype == np.uint8:
+        a = a.astype(np.float32) / 255.0
+    elif np.issubdtype(a.dtype, np.floating):
+        a = a.astype(np.float32)
+        if not np.isfinite(a).all() or a.min() < 0 or a.max() > 1:
+            raise VecfitError("an image array of floats must hold finite values in [0, 1]")
+    else:
+        raise VecfitError(f"an image array must be uint8 or floats in [0, 1], not {a.dtype}")
+    if a.shape[2] == 3:
+        a = np.concatenate([a, np.ones_like(a[..., :1])], axis=2)
+    return np.ascontiguousarray(a)
+
+
 # The shortest side a working image is scaled to (unless the image is shorter itself): the
 # jobs' minimum, SSIM's 11 x 11 window. A 700 x 11 target at 512 px would be 8 px high.
 MIN_WORKING_SIDE = 11

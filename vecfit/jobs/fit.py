@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import time
 import warnings
+from pathlib import Path
 
 import numpy as np
 import torch
@@ -15,7 +16,7 @@ from vecfit.errors import VecfitError
 from vecfit.fitting.loop import Settings, Target, optimize
 from vecfit.fitting.metrics import compare, to_rgb
 from vecfit.io.colors import fitting_background
-from vecfit.io.images import downscaled, load_rgba
+from vecfit.io.images import downscaled, image_rgba
 from vecfit.io.report import save_comparison, save_report
 from vecfit.renderer import device as devices
 from vecfit.renderer.raster import render
@@ -23,7 +24,7 @@ from vecfit.scene import Scene
 from vecfit.svg.numbers import hex_color
 from vecfit.svg.document import SvgDocument
 from vecfit.svg.read import read_svg, scene_of
-from vecfit.svg.write import write_svg
+from vecfit.svg.write import svg_bytes, write_bytes
 
 from .protocol import Outputs, listener
 
@@ -34,12 +35,13 @@ MIN_SIDE = 11
 
 # ------------------------------------------------------------------------- target
 
-def load_target(path) -> np.ndarray:
-    """The target image (vecfit.io.images.load_rgba), big enough to be measured: SSIM's
-    Gaussian window is 11 x 11 pixels."""
-    a = load_rgba(path)
+def load_target(source) -> np.ndarray:
+    """The target image (a path, or an image itself: vecfit.io.images.image_rgba), big
+    enough to be measured: SSIM's Gaussian window is 11 x 11 pixels."""
+    a = image_rgba(source)
+    name = str(source) if isinstance(source, (str, Path)) else "the image given"
     if min(a.shape[:2]) < MIN_SIDE:
-        raise VecfitError(f"{path}: the image is too small ({a.shape[1]}x{a.shape[0]} pixels; "
+        raise VecfitError(f"{name}: the image is too small ({a.shape[1]}x{a.shape[0]} pixels; "
                           f"at least {MIN_SIDE}x{MIN_SIDE})")
     return a
 
@@ -60,15 +62,19 @@ def background_for(image: np.ndarray, setting: str) -> tuple | None:
     return fitting_background(setting)
 
 
-def load_scene_to_fit(svg_path) -> tuple[Scene, SvgDocument]:
-    """The user's SVG as a Scene (its warnings shown every time) and its document (to write
-    the result into), refused when it has no shapes: what refine, edit and retarget start
-    from."""
+def load_scene_to_fit(svg) -> tuple[Scene, SvgDocument]:
+    """The user's SVG (a path, or its text) as a Scene (its warnings shown every time) and
+    its document (to write the result into), refused when it has no shapes: what refine,
+    edit and retarget start from."""
     with warnings.catch_warnings():
         warnings.simplefilter("always")
-        scene, document = read_svg(svg_path)
+        if isinstance(svg, str):
+            document = SvgDocument.parse(svg, "the SVG given")
+            scene = scene_of(document)
+        else:
+            scene, document = read_svg(svg)
     if not scene.shapes:
-        raise VecfitError(f"{svg_path}: the SVG has no shapes to optimise")
+        raise VecfitError(f"{document.name}: the SVG has no shapes to optimise")
     return scene, document
 
 
@@ -110,7 +116,8 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     progress = listener(progress)
     # The report marks a finished run: an old one must not sit beside new outputs if this
     # run dies before it writes its own.
-    outputs.report.unlink(missing_ok=True)
+    if outputs.report is not None:
+        outputs.report.unlink(missing_ok=True)
     # "auto" settled once, for the loop, the full-size renders and the report alike
     opt = {**config["optimize"], "device": devices.device_name(devices.resolve(config["optimize"]["device"]))}
     settings = Settings.from_config(opt)
@@ -140,15 +147,19 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     # uncovered, the background is written in as a first rect.
     covered = float(final_image[..., 3].min()) >= OPAQUE
     svg_background = background if background is not None and not covered else None
-    write_svg(scene, document, outputs.svg, background=svg_background)
-    save_comparison(outputs.comparison, target_rgb, initial_rgb, final_rgb)
+    payload = svg_bytes(scene, document, background=svg_background)
+    outputs.text = payload.decode("utf-8")
+    if outputs.svg is not None:
+        write_bytes(outputs.svg, payload)
+    if outputs.comparison is not None:
+        save_comparison(outputs.comparison, target_rgb, initial_rgb, final_rgb)
     seconds = time.perf_counter() - started
     report = {
         "vecfit": __version__,
         **{k: v() if callable(v) else v for k, v in (inputs or {}).items()},
-        "output": str(outputs.svg),
-        "comparison": str(outputs.comparison),
-        "report": str(outputs.report),
+        "output": None if outputs.svg is None else str(outputs.svg),
+        "comparison": None if outputs.comparison is None else str(outputs.comparison),
+        "report": None if outputs.report is None else str(outputs.report),
         "size": [w, h],
         "optimized_size": [sw, sh],  # the metrics and the comparison picture are at this size
         "background": None if background is None else hex_color(background),
@@ -171,5 +182,6 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         "device": opt["device"],  # what "auto" came to
         "config": config,
     }
-    save_report(outputs.report, report)
+    if outputs.report is not None:
+        save_report(outputs.report, report)
     return report

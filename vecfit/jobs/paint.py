@@ -14,9 +14,9 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     """`vecfit paint`: random strokes or shapes fitted to inputs.image; writes SVG, report
     and comparison (and frames into outputs.frames, when given)."""
     inputs.need("paint", "image")
-    target_path, frames = inputs.image, outputs.frames
+    target_path, frames = inputs.name("image"), outputs.frames
     outputs.check_against(inputs)
-    target = load_target(target_path)
+    target = load_target(inputs.image)
     settings = settings_of(PaintSettings, config["paint"], seed=config["optimize"]["seed"])
     reseeder = Reseeder(settings, config["optimize"]["iterations"])
     hooks = [reseeder]

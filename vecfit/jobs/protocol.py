@@ -28,14 +28,18 @@ def job_function(name: str) -> Callable[..., dict]:
 
 @dataclass(frozen=True)
 class Inputs:
-    image: Path | None = None  # the target (refine, trace, paint) or the edited render (edit)
-    svg: Path | None = None    # the SVG to start from (refine, edit, retarget)
-    mask: Path | None = None   # edit: white where the edit is (default: where it differs)
+    """The files a job reads. From Python, ``image`` may also be the image itself (bytes of
+    a PNG or JPEG, a NumPy array, a PIL image) and ``svg`` the SVG's text."""
+    image: object = None  # the target (refine, trace, paint) or the edited render (edit)
+    svg: object = None    # the SVG to start from (refine, edit, retarget)
+    mask: Path | None = None  # edit: white where the edit is (default: where it differs)
 
     def __post_init__(self):
         for name in ("image", "svg", "mask"):
             value = getattr(self, name)
-            if value is not None and not isinstance(value, Path):
+            if isinstance(value, str) and not (name == "svg" and value.lstrip().startswith("<")):
+                object.__setattr__(self, name, Path(value))
+            elif hasattr(value, "__fspath__") and not isinstance(value, Path):
                 object.__setattr__(self, name, Path(value))
 
     def need(self, job: str, *names: str) -> None:
@@ -45,19 +49,31 @@ class Inputs:
 
     @property
     def main(self) -> Path:
-        """The input that outputs are named after: the image, else the SVG."""
-        return self.image if self.image is not None else self.svg
+        """The input file that outputs are named after: the image, else the SVG."""
+        return self.image if isinstance(self.image, Path) else self.svg
 
     def files(self) -> list[Path]:
-        return [p for p in (self.image, self.svg, self.mask) if p is not None]
+        return [p for p in (self.image, self.svg, self.mask) if isinstance(p, Path)]
+
+    def name(self, which: str) -> str:
+        """How messages name an input: its path, or what it is."""
+        value = getattr(self, which)
+        return str(value) if isinstance(value, Path) else f"the {which} given"
 
 
 @dataclass
 class Outputs:
-    svg: Path
-    report: Path
-    comparison: Path
+    """The files a job writes; None writes nothing there (the Python API writes nothing
+    unless asked). ``text`` is set by the job: the SVG it wrote, or would have written."""
+    svg: Path | None
+    report: Path | None
+    comparison: Path | None
     frames: Path | None = None  # paint: a folder for frame_NNNNN.png and a GIF
+    text: str | None = None
+
+    @classmethod
+    def nowhere(cls) -> "Outputs":
+        return cls(None, None, None)
 
     @classmethod
     def beside(cls, main: Path, svg: Path | None = None, report: Path | None = None,
@@ -73,7 +89,7 @@ class Outputs:
 
     def check_against(self, inputs: Inputs) -> None:
         """Refuses outputs that would overwrite an input or each other."""
-        paths = [self.svg, self.report, self.comparison]
+        paths = [p for p in (self.svg, self.report, self.comparison) if p is not None]
         for out in paths:
             for src in inputs.files():
                 if same_path(out, src):

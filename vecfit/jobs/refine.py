@@ -10,10 +10,10 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     """`vecfit refine`: the SVG (inputs.svg) fitted to the image (inputs.image); see
     vecfit.jobs.fit.fit_and_write and the job protocol (protocol.py)."""
     inputs.need("refine", "image", "svg")
-    target_path, svg_path = inputs.image, inputs.svg
+    target_path, svg_path = inputs.name("image"), inputs.name("svg")
     outputs.check_against(inputs)
-    target = load_target(target_path)
-    scene, document = load_scene_to_fit(svg_path)
+    target = load_target(inputs.image)
+    scene, document = load_scene_to_fit(inputs.svg)
     check_sizes(scene, target, svg_path, target_path)
     return fit_and_write(scene, document, target, config, outputs, progress,
                inputs={"command": "refine", "target": str(target_path), "init": str(svg_path)})

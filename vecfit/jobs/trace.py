@@ -15,9 +15,9 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     """`vecfit trace`: trace the image, refine the trace (optimize.iterations 0 writes the
     trace as it is, with its report), write SVG, report and comparison."""
     inputs.need("trace", "image")
-    target_path, progress = inputs.image, listener(progress)
+    target_path, progress = inputs.name("image"), listener(progress)
     outputs.check_against(inputs)
-    target = load_target(target_path)
+    target = load_target(inputs.image)
     settings = settings_of(TraceSettings, config["trace"], seed=config["optimize"]["seed"])
     progress.status(f"tracing {target_path} ({target.shape[1]}x{target.shape[0]})")
     traced = trace_image(target, settings)

@@ -36,7 +36,7 @@ from .skips import VecfitWarning
 from .style import INHERITED
 from .units import parse_length, parse_viewbox, translate
 
-__all__ = ["write_svg"]
+__all__ = ["svg_bytes", "write_bytes", "write_svg"]
 
 # Initial values of the properties written here (used to decide whether a property can be
 # dropped instead of written).
@@ -172,7 +172,11 @@ def write_svg(scene: Scene, document, out_path, *, full: bool = False, backgroun
     Raises VecfitError for non-finite values (nothing is written then) or a scene that
     does not match the document.
     """
-    payload = svg_bytes(scene, document, full=full, background=background, canvas=canvas)
+    write_bytes(out_path, svg_bytes(scene, document, full=full, background=background, canvas=canvas))
+
+
+def write_bytes(out_path, payload: bytes) -> None:
+    """SVG bytes (svg_bytes) saved atomically at ``out_path``, gzip-compressed for .svgz."""
     if str(out_path).endswith(".svgz"):
         payload = gzip.compress(payload)
 

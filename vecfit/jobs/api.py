@@ -1,0 +1,38 @@
+"""The jobs from Python: ``vecfit.trace``, ``vecfit.refine`` and ``vecfit.paint`` take the
+image as a path, bytes, a NumPy array or a PIL image and the SVG as a path or its text,
+and return the SVG text and the report. They write nothing unless given ``output`` (then
+the SVG there, with its report and comparison picture beside it, as the command does).
+Settings are the command's: defaults from configs/, then ``preset``, ``config_file`` and
+``settings`` (a nested dict like the TOML files: {"optimize": {"iterations": 50},
+"trace": {"paths": 64}})."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from .config import resolve
+from .protocol import Inputs, Outputs, job_function
+
+
+def _run(command: str, inputs: Inputs, output, settings, preset, config_file, progress) -> tuple[str, dict]:
+    config = resolve(command, preset=preset, config_file=config_file, overrides=settings or {})
+    outputs = Outputs.nowhere() if output is None else Outputs.beside(Path(output), output)
+    report = job_function(command)(inputs, config, outputs, progress=progress)
+    return outputs.text, report
+
+
+def trace(image, *, output=None, settings: dict | None = None, preset: str | None = None,
+          config_file=None, progress=None) -> tuple[str, dict]:
+    """`vecfit trace` from Python: (SVG text, report)."""
+    return _run("trace", Inputs(image=image), output, settings, preset, config_file, progress)
+
+
+def refine(image, svg, *, output=None, settings: dict | None = None, config_file=None,
+           progress=None) -> tuple[str, dict]:
+    """`vecfit refine` from Python: ``svg`` (a path, or SVG text) fitted to ``image``."""
+    return _run("refine", Inputs(image=image, svg=svg), output, settings, None, config_file, progress)
+
+
+def paint(image, *, output=None, settings: dict | None = None, preset: str | None = None,
+          config_file=None, progress=None) -> tuple[str, dict]:
+    """`vecfit paint` from Python: (SVG text, report)."""
+    return _run("paint", Inputs(image=image), output, settings, preset, config_file, progress)
