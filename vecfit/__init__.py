@@ -21,11 +21,12 @@ __version__ = "0.1.0"
 
 __all__ = ["Circle", "Ellipse", "Group", "LinearGradient", "Path", "RadialGradient", "Rect", "Scene",
            "Shape", "Solid", "SvgError", "VecfitError", "cuda_device_count", "has_cuda", "load_svg",
-           "render", "render_batch", "trace", "refine", "paint", "__version__"]
+           "render", "render_batch", "trace", "refine", "paint", "edit", "retarget", "__version__"]
 
 _LAZY = {"render": ".renderer.raster", "render_batch": ".renderer.many",
          "cuda_device_count": ".renderer.device", "has_cuda": ".renderer.device",
-         "trace": ".jobs.api", "refine": ".jobs.api", "paint": ".jobs.api",
+         "trace": ".jobs.api", "refine": ".jobs.api", "paint": ".jobs.api", "edit": ".jobs.api",
+         "retarget": ".jobs.api",
          **{name: ".scene" for name in ("Circle", "Ellipse", "Group", "LinearGradient", "Path",
                                                  "RadialGradient", "Rect", "Scene", "Shape", "Solid")}}
 

@@ -1,5 +1,6 @@
-"""The jobs from Python: ``vecfit.trace``, ``vecfit.refine`` and ``vecfit.paint`` take the
-image as a path, bytes, a NumPy array or a PIL image and the SVG as a path or its text,
+"""The jobs from Python: ``vecfit.trace``, ``vecfit.refine``, ``vecfit.paint``,
+``vecfit.edit`` and ``vecfit.retarget`` take an image as a path, bytes, a NumPy array or
+a PIL image and the SVG as a path or its text,
 and return the SVG text and the report. They write nothing unless given ``output`` (then
 the SVG there, with its report and comparison picture beside it, as the command does).
 Settings are the command's: defaults from configs/, then ``preset``, ``config_file`` and
@@ -36,3 +37,19 @@ def paint(image, *, output=None, settings: dict | None = None, preset: str | Non
           config_file=None, progress=None) -> tuple[str, dict]:
     """`vecfit paint` from Python: (SVG text, report)."""
     return _run("paint", Inputs(image=image), output, settings, preset, config_file, progress)
+
+
+def edit(svg, edited, *, mask=None, output=None, settings: dict | None = None, config_file=None,
+         progress=None) -> tuple[str, dict]:
+    """`vecfit edit` from Python: ``svg`` fitted to ``edited`` (its render, edited), changing
+    little outside the edit (``mask``: a PNG path, white where the edit is)."""
+    return _run("edit", Inputs(image=edited, svg=svg, mask=mask), output, settings, None, config_file, progress)
+
+
+def retarget(svg, width, height=None, *, output=None, settings: dict | None = None, config_file=None,
+             progress=None) -> tuple[str, dict]:
+    """`vecfit retarget` from Python: ``svg`` resized to ``width`` (and ``height``), each in
+    pixels or a percentage ("70%")."""
+    size = {"width": str(width), **({} if height is None else {"height": str(height)})}
+    settings = {**(settings or {}), "retarget": {**(settings or {}).get("retarget", {}), **size}}
+    return _run("retarget", Inputs(svg=svg), output, settings, None, config_file, progress)

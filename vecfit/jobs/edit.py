@@ -23,7 +23,7 @@ from vecfit.io.report import error_map, panels_image, save_panels, save_report
 from vecfit.renderer import device as devices
 from vecfit.scene import Scene
 from vecfit.svg.numbers import hex_color
-from vecfit.svg.write import write_svg
+from vecfit.svg.write import svg_bytes
 
 from .config import settings_of
 from .fit import _render_full, background_for, load_scene_to_fit, load_target
@@ -91,11 +91,12 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     difference) and the report (last)."""
     started = time.perf_counter()
     inputs.need("edit", "image", "svg")
-    edited_path, svg_path, mask, progress = inputs.image, inputs.svg, inputs.mask, listener(progress)
+    edited_path, svg_path, mask = inputs.name("image"), inputs.name("svg"), inputs.mask
+    progress = listener(progress)
     outputs.check_against(inputs)
-    outputs.report.unlink(missing_ok=True)  # a report marks a finished run
-    target = load_target(edited_path)
-    scene, document = load_scene_to_fit(svg_path)
+    outputs.forget_report()
+    target = load_target(inputs.image)
+    scene, document = load_scene_to_fit(inputs.svg)
     fit_canvas(scene, target, svg_path, edited_path)
     edit = settings_of(EditSettings, config["edit"])
     edit.check()
@@ -151,9 +152,10 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
 
     # The SVG keeps its elements: no background rect is added (an uncovered canvas stays
     # transparent, which over the background looks as optimised).
-    write_svg(scene, document, outputs.svg)
-    save_panels(outputs.comparison, panels_image(
-        [original_rgb, target_rgb, final_rgb, error_map(final_rgb, target_rgb)]))
+    outputs.keep_svg(svg_bytes(scene, document))
+    if outputs.comparison is not None:
+        save_panels(outputs.comparison, panels_image(
+            [original_rgb, target_rgb, final_rgb, error_map(final_rgb, target_rgb)]))
     seconds = time.perf_counter() - started
     report = {
         "vecfit": __version__,
@@ -161,9 +163,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
         "target": str(edited_path),
         "init": str(svg_path),
         "mask": None if mask is None else str(mask),
-        "output": str(outputs.svg),
-        "comparison": str(outputs.comparison),
-        "report": str(outputs.report),
+        **outputs.names(),
         "size": [w, h],
         "optimized_size": [sw, sh],
         "background": None if background is None else hex_color(background),
@@ -194,5 +194,6 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
         "device": opt["device"],
         "config": config,
     }
-    save_report(outputs.report, report)
+    if outputs.report is not None:
+        save_report(outputs.report, report)
     return report

@@ -24,7 +24,7 @@ from vecfit.scene import Scene
 from vecfit.svg.numbers import hex_color
 from vecfit.svg.document import SvgDocument
 from vecfit.svg.read import read_svg, scene_of
-from vecfit.svg.write import svg_bytes, write_bytes
+from vecfit.svg.write import svg_bytes
 
 from .protocol import Outputs, listener
 
@@ -116,8 +116,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     progress = listener(progress)
     # The report marks a finished run: an old one must not sit beside new outputs if this
     # run dies before it writes its own.
-    if outputs.report is not None:
-        outputs.report.unlink(missing_ok=True)
+    outputs.forget_report()
     # "auto" settled once, for the loop, the full-size renders and the report alike
     opt = {**config["optimize"], "device": devices.device_name(devices.resolve(config["optimize"]["device"]))}
     settings = Settings.from_config(opt)
@@ -147,19 +146,14 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     # uncovered, the background is written in as a first rect.
     covered = float(final_image[..., 3].min()) >= OPAQUE
     svg_background = background if background is not None and not covered else None
-    payload = svg_bytes(scene, document, background=svg_background)
-    outputs.text = payload.decode("utf-8")
-    if outputs.svg is not None:
-        write_bytes(outputs.svg, payload)
+    outputs.keep_svg(svg_bytes(scene, document, background=svg_background))
     if outputs.comparison is not None:
         save_comparison(outputs.comparison, target_rgb, initial_rgb, final_rgb)
     seconds = time.perf_counter() - started
     report = {
         "vecfit": __version__,
         **{k: v() if callable(v) else v for k, v in (inputs or {}).items()},
-        "output": None if outputs.svg is None else str(outputs.svg),
-        "comparison": None if outputs.comparison is None else str(outputs.comparison),
-        "report": None if outputs.report is None else str(outputs.report),
+        **outputs.names(),
         "size": [w, h],
         "optimized_size": [sw, sh],  # the metrics and the comparison picture are at this size
         "background": None if background is None else hex_color(background),

@@ -75,6 +75,24 @@ class Outputs:
     def nowhere(cls) -> "Outputs":
         return cls(None, None, None)
 
+    def names(self) -> dict:
+        """The report's entries naming the outputs (None where nothing is written)."""
+        return {key: None if path is None else str(path)
+                for key, path in (("output", self.svg), ("comparison", self.comparison), ("report", self.report))}
+
+    def forget_report(self) -> None:
+        """The report marks a finished run: an old one must not sit beside new outputs if
+        this run dies before it writes its own."""
+        if self.report is not None:
+            self.report.unlink(missing_ok=True)
+
+    def keep_svg(self, payload: bytes) -> None:
+        """The job's SVG (UTF-8 bytes): kept as ``text``, and written where asked."""
+        from vecfit.svg.write import write_bytes
+        self.text = payload.decode("utf-8")
+        if self.svg is not None:
+            write_bytes(self.svg, payload)
+
     @classmethod
     def beside(cls, main: Path, svg: Path | None = None, report: Path | None = None,
                comparison: Path | None = None, frames: Path | None = None) -> "Outputs":

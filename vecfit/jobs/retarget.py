@@ -30,7 +30,7 @@ from vecfit.io.report import save_panels, save_report, side_by_side
 from vecfit.renderer import device as devices
 from vecfit.renderer.raster import render
 from vecfit.svg.numbers import hex_color
-from vecfit.svg.write import write_svg
+from vecfit.svg.write import svg_bytes
 
 from .config import settings_of
 from .fit import background_for, load_scene_to_fit
@@ -70,16 +70,16 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     report (last)."""
     started = time.perf_counter()
     inputs.need("retarget", "svg")
-    svg_path, progress = inputs.svg, listener(progress)
+    svg_path, progress = inputs.name("svg"), listener(progress)
     outputs.check_against(inputs)
-    outputs.report.unlink(missing_ok=True)  # a report marks a finished run
+    outputs.forget_report()
     retarget = settings_of(RetargetSettings, config["retarget"])
     retarget.check()
     width = str(retarget.width).strip() or None
     height = str(retarget.height).strip() or None
     if width is None and height is None:
         raise VecfitError("no new size: give --width (or --height), or retarget.width in the config")
-    scene, document = load_scene_to_fit(svg_path)
+    scene, document = load_scene_to_fit(inputs.svg)
     w0, h0 = scene.width, scene.height
     if not (w0 > 0 and h0 > 0):
         raise VecfitError(f"{svg_path}: the SVG has no size")
@@ -169,19 +169,18 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     fit = compare(final_rgb, goal_rgb)
     if not all(math.isfinite(fit[k]) or (k == "psnr" and fit["mse"] == 0) for k in fit):
         raise VecfitError(f"the retargeted image has non-finite values ({fit}); nothing written")
-    write_svg(scene, document, outputs.svg, canvas=(out_w, out_h))
+    outputs.keep_svg(svg_bytes(scene, document, canvas=(out_w, out_h)))
     original_rgb = to_rgb(original, background)
     scaled_rgb = cv2.resize(original_rgb.astype(np.float32), (cur_w, cur_h), interpolation=cv2.INTER_AREA)
-    save_panels(outputs.comparison, side_by_side([original_rgb, scaled_rgb, final_rgb]))
+    if outputs.comparison is not None:
+        save_panels(outputs.comparison, side_by_side([original_rgb, scaled_rgb, final_rgb]))
     plain = compare(scaled_rgb.astype(np.float64), goal_rgb) if scaled_rgb.shape == goal_rgb.shape else None
     seconds = time.perf_counter() - started
     report = {
         "vecfit": __version__,
         "command": "retarget",
         "init": str(svg_path),
-        "output": str(outputs.svg),
-        "comparison": str(outputs.comparison),
-        "report": str(outputs.report),
+        **outputs.names(),
         "size_before": [w0, h0],
         "size": [out_w, out_h],
         "working_size": {"before": [ww, wh], "after": [cur_w, cur_h]},
@@ -202,7 +201,8 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
         "device": opt["device"],
         "config": config,
     }
-    save_report(outputs.report, report)
+    if outputs.report is not None:
+        save_report(outputs.report, report)
     return report
 
 

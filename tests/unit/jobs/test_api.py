@@ -69,3 +69,27 @@ def test_paint_and_bad_images_are_refused_clearly(tmp_path):
             assert words in str(e), str(e)
         else:
             raise AssertionError(f"{words}: not refused")
+
+
+def test_edit_and_retarget_from_python(tmp_path, monkeypatch):
+    svg = ('<svg xmlns="http://www.w3.org/2000/svg" width="48" height="36" viewBox="0 0 48 36">'
+           '<rect id="bg" width="48" height="36" fill="#eeeeee"/>'
+           '<circle id="c" cx="16" cy="18" r="9" fill="#cc3322"/><rect id="r" x="28" y="8" width="14" '
+           'height="20" fill="#2255aa"/></svg>')
+    scene_image = vecfit.render(vecfit.load_svg(_write(tmp_path / "d.svg", svg)), 48, 36, samples=2)
+    edited = (scene_image.numpy() * 255 + 0.5).astype(np.uint8)
+    edited[14:22, 12:20, :3] = (30, 160, 60)  # paint over the circle's middle
+    monkeypatch.chdir(tmp_path)
+    before = sorted(os.listdir(tmp_path))
+    out, report = vecfit.edit(svg, edited, settings={"optimize": {"iterations": 8, "threads": 1}})
+    assert report["command"] == "edit" and report["iterations"] == 8 and 'id="c"' in out
+    narrow, report = vecfit.retarget(tmp_path / "d.svg", "75%", settings={
+        "optimize": {"threads": 1}, "retarget": {"steps": 1, "iterations_per_step": 2, "final_iterations": 2,
+                                                 "work_size": 0}})
+    assert report["size"][0] == 36 and 'width="36"' in narrow and 'id="r"' in narrow
+    assert sorted(os.listdir(tmp_path)) == before  # nothing written
+
+
+def _write(path, text):
+    path.write_text(text)
+    return path
