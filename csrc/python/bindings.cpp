@@ -56,12 +56,12 @@ int parse_mode(const std::string& m) {
     throw std::invalid_argument("mode must be 'mc' or 'analytic', not '" + m + "'");
 }
 
+// The pixel filters by their FilterKind value.
+const char* const FILTER_NAMES[] = {"box", "tent", "gaussian", "parabolic", "hann"};
+
 int parse_filter(const std::string& f) {
-    if (f == "box") return 0;
-    if (f == "tent") return 1;
-    if (f == "gaussian") return 2;
-    if (f == "parabolic") return 3;
-    if (f == "hann") return 4;
+    for (int k = 0; k < 5; ++k)
+        if (f == FILTER_NAMES[k]) return k;
     throw std::invalid_argument("filter must be 'box', 'tent', 'gaussian', 'parabolic' or 'hann', not '" + f + "'");
 }
 
@@ -117,10 +117,7 @@ SceneInput scene_input(const py::dict& s) {
 
 const char* mode_name(int mode) { return mode == MODE_ANALYTIC ? "analytic" : "mc"; }
 
-const char* filter_name(int filter) {
-    static const char* names[] = {"box", "tent", "gaussian", "parabolic", "hann"};
-    return filter >= 0 && filter < 5 ? names[filter] : "box";
-}
+const char* filter_name(int filter) { return filter >= 0 && filter < 5 ? FILTER_NAMES[filter] : "box"; }
 
 // vecfit._core.RenderOptions(...): the options of every pass, checked once here.
 RenderOptions make_options(int width, int height, int samples, const std::string& mode, const std::string& filter,

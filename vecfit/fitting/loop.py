@@ -311,10 +311,9 @@ class _Fit:
             for state in (self.kinds[i].m, self.kinds[i].v, self.kinds[i].steps):
                 state[offset:offset + n] = 0
 
-    def gradients(self, loss) -> list | None:
-        """The kinds' gradients of this iteration's loss; None where the loss or a
-        gradient is not finite."""
-        value = float(loss.detach()) if loss is not None else math.nan
+    def gradients(self, loss, value: float) -> list | None:
+        """The kinds' gradients of this iteration's loss (``value``: its float); None where
+        the loss or a gradient is not finite."""
         grads = None
         if math.isfinite(value):
             self.keep_if_best(value)
@@ -344,7 +343,7 @@ class _Fit:
         except NonFiniteScene:
             loss = None  # treated like a NaN loss
         value = float(loss.detach()) if loss is not None else math.nan
-        grads = self.gradients(loss)
+        grads = self.gradients(loss, value)
         if grads is None:
             # A non-finite loss or gradient: go back to the best parameters and try again
             # with smaller steps rather than let NaN into the Scene.

@@ -37,16 +37,14 @@ class RenderOptions:
         if self.interior_samples < 0:
             raise VecfitError("interior_samples must be 0 or more")
 
-    def core(self, **changes) -> "_core.RenderOptions":
-        """The core's struct (with ``changes``, e.g. another seed)."""
-        values = {**self.__dict__, **changes}
-        bg = values["background"]
+    def core(self) -> "_core.RenderOptions":
+        """The core's struct."""
+        bg = self.background
         return _core.RenderOptions(
-            width=int(values["width"]), height=int(values["height"]), samples=int(values["samples"]),
-            mode=values["mode"], filter=values["filter"], filter_radius=float(values["filter_radius"]),
-            seed=int(values["seed"]), threads=int(values["threads"] or 0),
-            background=None if bg is None else [float(v) for v in bg],
-            interior_samples=int(values["interior_samples"]), brute_force=bool(values["brute_force"]))
+            width=int(self.width), height=int(self.height), samples=int(self.samples), mode=self.mode,
+            filter=self.filter, filter_radius=float(self.filter_radius), seed=int(self.seed),
+            threads=int(self.threads or 0), background=None if bg is None else [float(v) for v in bg],
+            interior_samples=int(self.interior_samples), brute_force=bool(self.brute_force))
 
 
 def check_options(samples, mode: str, filter: str, filter_radius: float) -> None:

@@ -60,9 +60,10 @@ def load_svg(path) -> Scene:
 
     Raises SvgError for a file that cannot be read as SVG. What is not supported is left
     out (or drawn approximately) with one VecfitWarning per kind, and listed in
-    ``scene.skipped``. An SVG without drawable shapes gives an empty Scene.
+    ``scene.skipped``. An SVG without drawable shapes gives an empty Scene. (To write the
+    Scene back, read it with ``read_svg``, which also keeps the document.)
     """
-    return read_svg(path)[0]
+    return scene_of(SvgDocument.read(path), for_writing=False)
 
 
 def read_svg(path) -> tuple[Scene, SvgDocument]:
@@ -72,17 +73,19 @@ def read_svg(path) -> tuple[Scene, SvgDocument]:
     return scene_of(document), document
 
 
-def scene_of(document: SvgDocument) -> Scene:
-    """The Scene that ``document`` draws. Records on the document what the writer needs
-    (the Scene as read, the viewport)."""
+def scene_of(document: SvgDocument, for_writing: bool = True) -> Scene:
+    """The Scene that ``document`` draws. ``for_writing``: records on the document what the
+    writer needs (the Scene as read, a copy of every tensor, and the viewport); rendering
+    alone (load_svg) does without that copy."""
     reader = Reader(document)
     try:
         scene = reader.read()
     except RecursionError:
         raise SvgError(document.name, f"elements nested too deeply (at most {MAX_NESTING} levels)") from None
     reader.skips.warn(document.name)
-    document.original = scene.detached_copy()
-    document.viewport = reader.viewport
+    if for_writing:
+        document.original = scene.detached_copy()
+        document.viewport = reader.viewport
     return scene
 
 
