@@ -27,3 +27,9 @@ MAX_LAYER_DEPTH = 64
 # Target images for refine, trace and paint (and batch): width x height pixels, checked
 # from the header before the pixels are decoded.
 MAX_IMAGE_PIXELS = 100_000_000
+
+# Dashes of the dashed strokes (stroke-dasharray) in a whole scene: each dash is at least
+# one segment, so a pattern of 0.001 along a long path would make millions (and they come
+# on top of MAX_SEGMENTS). A stroke whose dashes (as estimated from its length) would take
+# the scene past it is drawn solid, with a warning naming the element.
+MAX_DASHES = 100_000

@@ -140,7 +140,14 @@ class Group:
 
 @dataclass
 class Shape:
-    """One drawn element: geometry with an optional fill and an optional stroke."""
+    """One drawn element: geometry with an optional fill and an optional stroke.
+
+    ``dash_array`` and ``dash_offset``: the stroke's ``stroke-dasharray`` and
+    ``stroke-dashoffset`` in the geometry's own units (like ``stroke_width``), plain floats
+    that are not optimised. None, or a pattern SVG draws solid (a negative value, a zero
+    sum), strokes without dashes; an odd-length pattern repeats to even length. The stroke
+    is then drawn from the dashes of the geometry (vecfit.scene.dashes); the fill is not
+    affected."""
     geometry: Geometry
     fill: Optional[Paint] = None
     stroke: Optional[Paint] = None
@@ -155,6 +162,8 @@ class Shape:
     transform: torch.Tensor = field(default_factory=identity)  # [3, 3] to group's space
     group: int = -1                # index into Scene.groups, -1 for the root
     source: Any = None             # id (or other handle) of the element, for write-back
+    dash_array: Optional[tuple[float, ...]] = None  # stroke-dasharray (own units), or None
+    dash_offset: float = 0.0       # stroke-dashoffset (own units)
 
 
 @dataclass
