@@ -229,7 +229,9 @@ class Packer:
                           and scale_np[i] > 0)
             # A dashed stroke is drawn from its dashes, a path of its own (None: solid).
             dashes = dashed_stroke(shape, _limits.MAX_DASHES - self._dash_count) if has_stroke else None
-            self._dash_count += len(dashes.subpaths) if dashes is not None else 0
+            if dashes is not None:
+                pattern = dash_pattern(shape.dash_array)
+                self._dash_count += len(dashes.subpaths) * max(1.0, dash_width(shape) / sum(pattern))
             if dashes is not None and not dashes.subpaths:
                 has_stroke = False  # no dash at all (a zero-length path)
             if not (has_fill or has_stroke):
@@ -461,10 +463,10 @@ class _PathBatch:
         out.segments.append(np.concatenate([deg[:, None], idx], axis=1))
 
 
-def dashed_stroke(shape: Shape, max_dashes: int | None = None) -> Path | None:
+def dashed_stroke(shape: Shape, max_dashes: float | None = None) -> Path | None:
     """The dashes the shape's stroke is drawn from (vecfit.scene.dashes), or None where it
-    is drawn solid: no dash pattern or one SVG draws solid, or more than ``max_dashes``
-    dashes (limits.MAX_DASHES by default; with a warning naming the element)."""
+    is drawn solid: no dash pattern or one SVG draws solid, or a dash_count over
+    ``max_dashes`` (limits.MAX_DASHES by default; with a warning naming the element)."""
     if shape.dash_array is None:
         return None
     pattern = dash_pattern(shape.dash_array)
@@ -473,13 +475,20 @@ def dashed_stroke(shape: Shape, max_dashes: int | None = None) -> Path | None:
     g = outline_path(shape.geometry)
     if g is None or not g.subpaths:
         return None
-    dashes = dash_path(g, pattern, float(shape.dash_offset), max_dashes=max(0, max_dashes)
-                       if max_dashes is not None else None)
+    dashes = dash_path(g, pattern, float(shape.dash_offset), max_dashes=max_dashes, width=dash_width(shape))
     if dashes is None:
         warnings.warn(f"{shape.source if shape.source is not None else 'a shape'}: stroke-dasharray makes more "
                       f"than {_limits.MAX_DASHES} dashes in the scene (the limit); stroked solid", VecfitWarning,
                       stacklevel=2)
     return dashes
+
+
+def dash_width(shape: Shape) -> float:
+    """The stroke's widest width (what dash_count weighs dashes by)."""
+    g = shape.geometry
+    if isinstance(g, Path) and g.widths is not None and g.widths.numel():
+        return value(g.widths.detach().max())
+    return value(shape.stroke_width)
 
 
 def _geometry_tensors(geometry) -> list:

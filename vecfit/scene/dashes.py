@@ -13,15 +13,16 @@ subpath has no dashes; a zero-length dash is a zero-length subpath (the core dra
 a dot with round caps, an axis-aligned square with square caps, nothing with butt caps,
 as tiny-skia's stroker does).
 
-Arc lengths are integrated numerically (composite Gauss-Legendre, 8 nodes, sub-intervals
-halved until two estimates agree) in float64 on detached values; a dash's ends are found
-by Newton's method on them and the segments split there by de Casteljau (the blossom).
-Gradients: a dash end at arc length s sits at parameter t(s) of its segment. Its value is
-computed detached, and then t is made differentiable by the implicit function theorem:
-t + (l(t) - l(t).detach()) / |B'(t)|, with l the arc length from the subpath's start in
-torch, so a control point that lengthens the path upstream moves the dash ends along it,
-as a finite difference sees. Ends clipped to a subpath's start or end are fixed
-parameters (0 or 1).
+Arc lengths are integrated numerically in float64 on detached values (adaptive
+Gauss-Legendre, 8 nodes: a sub-interval is halved where its halves disagree with it); a
+dash's ends are found by Newton's method on them and the segments split there by de
+Casteljau (the blossom, in torch). Gradients: a dash end at arc length s sits at
+parameter t(s) of its segment. Its value is computed detached, and then t is made
+differentiable by the implicit function theorem: t - (l(t) - l(t).detach()) / |B'(t)|,
+with l the arc length from the subpath's start as a linear function of the points whose
+coefficients are dl/d(points) (integrated like the lengths), so a control point that
+lengthens the path upstream moves the dash ends along it, as a finite difference sees.
+Ends clipped to a subpath's start or end are fixed parameters (0 or 1).
 """
 from __future__ import annotations
 
@@ -63,11 +64,11 @@ def dash_pattern(array) -> tuple[float, ...] | None:
         return None
     if not values or any(not math.isfinite(v) or math.copysign(1.0, v) < 0 for v in values):
         return None  # (resvg: -0 is negative too)
-    total = math.fsum(values)
-    if not (total > 0 and math.isfinite(total)):
-        return None
     if len(values) % 2:
         values = values * 2
+    total = sum(values)  # (math.fsum raises on overflow)
+    if not (total > 0 and math.isfinite(total)):
+        return None
     return tuple(values)
 
 
@@ -244,13 +245,22 @@ def outline_path(geometry) -> Path | None:
     return geometry
 
 
-def dash_count(path: Path, pattern: tuple[float, ...]) -> float:
-    """About how many dashes the pattern makes along the path (as tiny-skia estimates)."""
-    segs = _Segments(path)
+def dash_count(path: Path, pattern: tuple[float, ...], width: float = 0.0) -> float:
+    """What the pattern's dashes along the path count against limits.MAX_DASHES: about how
+    many dashes it makes (as tiny-skia estimates, plus the pattern's length per subpath:
+    the work of starting it anew), times max(1, width / the pattern's length). Dashes
+    closer than the stroke is wide overlap that many neighbours, and the backward pass's
+    work grows with the product (2 x 10^4 dashes each overlapping 2,000: 5 minutes)."""
+    return _estimate(_Segments(path), path, pattern, width)
+
+
+def _estimate(segs: _Segments, path: Path, pattern: tuple[float, ...], width: float) -> float:
     total = float(np.nansum(segs.length))
+    period = math.fsum(pattern)
+    overlap = max(1.0, width / period) if math.isfinite(width) else math.inf
     if not math.isfinite(total):
         return math.inf
-    return total * (len(pattern) // 2) / math.fsum(pattern) + len(pattern) * len(path.subpaths)
+    return (total * (len(pattern) // 2) / period + len(pattern) * len(path.subpaths)) * overlap
 
 
 def _intervals(length: float, closed: bool, pattern: tuple[float, ...], first_index: int,
@@ -280,18 +290,19 @@ def _intervals(length: float, closed: bool, pattern: tuple[float, ...], first_in
     return a, b, dash
 
 
-def dash_path(path: Path, pattern, offset: float = 0.0, max_dashes: int | None = None) -> Path | None:
+def dash_path(path: Path, pattern, offset: float = 0.0, max_dashes: float | None = None,
+              width: float = 0.0) -> Path | None:
     """The dashes of ``path`` for ``pattern`` (a dash_pattern) and ``offset``, both in the
-    path's own units, as open subpaths; None where the stroke is drawn solid (an invalid
-    pattern or offset, or more than ``max_dashes`` dashes, limits.MAX_DASHES by default)."""
+    path's own units, as open subpaths; None where the stroke is drawn solid: an invalid
+    pattern or offset, or a dash_count (for a stroke ``width`` wide) over ``max_dashes``
+    (limits.MAX_DASHES by default)."""
     pattern = dash_pattern(pattern)
     offset = float(offset)
     if pattern is None or not math.isfinite(offset):
         return None
     max_dashes = limits.MAX_DASHES if max_dashes is None else max_dashes
     segs = _Segments(path)
-    total = float(np.nansum(segs.length))
-    if not math.isfinite(total) or total * (len(pattern) // 2) / math.fsum(pattern) > max_dashes:
+    if _estimate(segs, path, pattern, width) > max_dashes:
         return None
     first_index, first_len = _phase(pattern, offset)
 
@@ -310,8 +321,6 @@ def dash_path(path: Path, pattern, offset: float = 0.0, max_dashes: int | None =
         a, b, dash = _intervals(L, bool(closed), pattern, first_index, first_len)
         parts.append((a, b, dash + dashes, np.full(len(a), L), np.full(len(a), first), np.full(len(a), count)))
         dashes += int(dash.max()) + 1 if len(dash) else 0
-        if dashes > max_dashes + len(pattern) * len(path.subpaths):
-            return None
     if not dashes:
         return Path(points=path.points[:0], degrees=np.zeros(0, dtype=np.int64), subpaths=[],
                     widths=None if path.widths is None else path.widths[:0])

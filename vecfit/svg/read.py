@@ -301,7 +301,7 @@ class Reader:
         # A shape with neither paint is kept: it draws nothing, but the Scene stays one
         # shape per drawable element (counts, write-back).
         self._note_shape_effects(tag, style, name, stroked=stroke is not None)
-        dash_array, dash_offset = self._dashes(style, geometry, name) if stroke is not None else (None, 0.0)
+        dash_array, dash_offset = self._dashes(style, geometry, width, name) if stroke is not None else (None, 0.0)
         shape = Shape(
             geometry=geometry, fill=fill, stroke=stroke,
             stroke_width=lim.tensor(width),
@@ -326,7 +326,7 @@ class Reader:
             value = parse_paint(default)
         return self.paints.resolve(value, current, name)
 
-    def _dashes(self, style, geometry, name) -> tuple[tuple[float, ...] | None, float]:
+    def _dashes(self, style, geometry, width, name) -> tuple[tuple[float, ...] | None, float]:
         """stroke-dasharray (lengths, percentages of the diagonal; an invalid list or one SVG
         draws solid: None) and stroke-dashoffset, in user units. A pattern that would take
         the scene past limits.MAX_DASHES dashes is noted and drawn solid."""
@@ -336,7 +336,7 @@ class Reader:
             return None, 0.0
         offset = parse_length(style.get("stroke-dashoffset"), self._diagonal())
         outline = outline_path(geometry)
-        count = dash_count(outline, pattern) if outline is not None else 0.0
+        count = dash_count(outline, pattern, width) if outline is not None else 0.0
         if self._dash_count + count > limits.MAX_DASHES:
             self.skips.add("stroke-dasharray", name)
             return None, 0.0

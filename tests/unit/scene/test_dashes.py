@@ -209,6 +209,17 @@ def test_many_dashes_fall_back_quickly():
     assert limits.MAX_DASHES >= 10_000
 
 
+def test_dashes_closer_than_the_width_count_more():
+    """Each dash counts max(1, width / pattern length): overlapping dashes cost the backward
+    pass in proportion."""
+    assert dash_count(LINE, (1.0, 1.0)) == pytest.approx(52)
+    assert dash_count(LINE, (1.0, 1.0), width=1.5) == pytest.approx(52)
+    assert dash_count(LINE, (1.0, 1.0), width=20.0) == pytest.approx(520)
+    line = make([[0, 0], [65, 0]], [1])
+    assert dash_path(line, (1e-3, 1e-3), 0.0) is not None   # 32,500 hairline dashes: drawn
+    assert dash_path(line, (1e-3, 1e-3), 0.0, width=6.0) is None  # each overlapping 3,000: solid
+
+
 @pytest.mark.parametrize("path, pattern, offset", [
     (CUBIC, (7.0, 3.0, 2.0, 4.0), 2.5),
     (MIXED, (7.0, 3.0, 2.0, 4.0), 2.5),
