@@ -161,6 +161,8 @@ class PersistentPack:
     def build(cls, scene: Scene, width: int, height: int, kinds: list[FlatTensors]) -> "PersistentPack | None":
         """The pack of ``scene`` at width x height whose floats follow the values in
         ``kinds`` (side by side, in order), or None where they are not affine in them."""
+        if scene.has_effects():  # drawn in layers (renderer/layers.py), several packs a render
+            return None
         kinds = list(kinds)
         optimised = {id(t) for k in kinds for t in k.tensors}
         parameters = scene.parameters()

@@ -140,6 +140,14 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     CPU backward pass run first with a GPU thread's list sizes, see backward_fallbacks.)
     """
     width, height = output_size(scene, width, height)
+    if packed is None and scene.has_effects():  # clip paths, masks, filters: in layers
+        from .layers import render_layered
+
+        def draw(sub: Scene) -> torch.Tensor:
+            return render(sub, samples=samples, mode=mode, filter=filter, filter_radius=filter_radius, seed=seed,
+                          threads=threads, boundary_samples=boundary_samples, interior_samples=interior_samples,
+                          device=device, _brute_force=_brute_force, _gpu_lists=_gpu_lists)
+        return render_layered(scene, width, height, draw, background_rgba(background))
     options = RenderOptions(width, height, samples=int(samples), mode=mode, filter=filter,
                             filter_radius=float(filter_radius), seed=int(seed), threads=int(threads or 0),
                             background=background_rgba(background), interior_samples=int(interior_samples),

@@ -21,9 +21,10 @@ import torch
 
 from vecfit import limits
 from vecfit.errors import SvgError
-from vecfit.scene import Group, Scene, Shape
+from vecfit.scene import ClipPath, Filter, Group, Mask, Rect, Scene, Shape
 
-from .paints import BLACK, Paints, parse_opacity, parse_paint
+from .effects import func_iri, parse_filter, region, units_of
+from .paints import BLACK, Paints, parse_opacity, parse_paint, solid
 from .color import parse_color
 from .document import SvgDocument
 from .dom import href_id, is_svg, local_name
@@ -53,6 +54,9 @@ MAX_ELEMENTS = limits.MAX_ELEMENTS
 MAX_SEGMENTS = limits.MAX_SEGMENTS
 # Elements nested in each other (Python's recursion would fail around 300).
 MAX_NESTING = 200
+# Clip paths and masks whose content uses clip paths or masks, ... (each level is a
+# layer of every render).
+MAX_EFFECT_NESTING = 16
 
 
 def load_svg(path) -> Scene:
@@ -117,6 +121,12 @@ class Reader:
         self.paints = Paints(self.ids, document.computed, self.viewport, self.skips.add)
         self.shapes: list[Shape] = []
         self.groups: list[Group] = []
+        # Clip paths, masks and filters read so far (by element: one object per element,
+        # shared by every reference), those being read (a reference to one of them is a
+        # loop), and whether a clip path's content is being read.
+        self._effects: dict[tuple[str, int], object] = {}
+        self._reading: tuple[int, ...] = ()
+        self._in_clip = False
 
     # --------------------------------------------------------------- document
 
@@ -159,8 +169,9 @@ class Reader:
             transform = parse_transform(self.root.get("transform"))
             opacity = parse_opacity(style.get("opacity"))
             if not _singular(transform):
-                if opacity < 1 or transform is not None:
-                    group = self._group(transform, opacity, -1, self.root)
+                effects = self._layer_effects(self.root, style)
+                if opacity < 1 or transform is not None or any(e is not None for e in effects):
+                    group = self._group(transform, opacity, -1, self.root, effects)
                 self._children(self.root, style, group, ())
         lim = Limiter()
         view = lim.tensor(self.view)
@@ -195,40 +206,138 @@ class Reader:
         transform = parse_transform(element.get("transform"))
         if _singular(transform):
             return  # SVG: a non-invertible transform draws nothing
-        self._note_layer_effects(element, style)
+        if self._in_clip and tag not in SHAPES and tag != "use":
+            return  # a clip path draws only shapes, directly or through <use>
+        effects = self._layer_effects(element, style)
         if tag in CONTAINERS:
-            g = self._group(transform, parse_opacity(style.get("opacity")), group, element)
+            g = self._group(transform, parse_opacity(style.get("opacity")), group, element, effects)
             self._children(element, style, g, stack, depth)
         elif tag == "switch":
-            g = self._group(transform, parse_opacity(style.get("opacity")), group, element)
+            g = self._group(transform, parse_opacity(style.get("opacity")), group, element, effects)
             child = _switch_choice(element)
             if child is not None:
                 self._element(child, style, g, stack, depth + 1)
         elif tag == "use":
-            self._use(element, style, transform, group, stack, depth)
+            self._use(element, style, transform, group, stack, depth, effects)
         elif tag == "svg":
-            self._nested_svg(element, element, style, transform, group, stack, depth)
+            self._nested_svg(element, element, style, transform, group, stack, depth, effects)
         else:
-            self._shape(tag, element, style, transform, group)
+            self._shape(tag, element, style, transform, group, effects)
 
-    def _note_layer_effects(self, element, style):
-        for prop in ("clip-path", "mask", "filter"):
-            value = (style.get(prop) or "none").strip()
-            if value != "none":
-                self.skips.add(prop, _name(element))
+    # ---------------------------------------------------- clip paths, masks, filters
 
-    def _group(self, transform, opacity, parent, element) -> int:
+    def _layer_effects(self, element, style) -> tuple:
+        """(clip, mask, filter) of an element. A reference that leads nowhere (or back to
+        the clip path or mask being read) is left out with a warning, as resvg does; a
+        filter reference that leads nowhere gives a filter without steps: SVG draws the
+        element as nothing."""
+        name = _name(element)
+        clip = self._reference(style, "clip-path", "clipPath", name, self._clip_path)
+        if self._in_clip:
+            return clip, None, None  # a clip path's shapes take no mask and no filter
+        mask = self._reference(style, "mask", "mask", name, self._mask)
+        value = (style.get("filter") or "none").strip()
+        filt = None
+        if value != "none":
+            ref = func_iri(value)
+            target = self.ids.get(ref) if ref else None
+            if ref is None:
+                self.skips.add("filter", f"{name} ({value[:40]})")
+            elif target is None or local_name(target.tag) != "filter":
+                self.skips.add("filter reference", f"{name} (no <filter> #{ref})")
+                filt = _NO_FILTER
+            else:
+                key = ("filter", id(target))
+                if key not in self._effects:
+                    self._effects[key] = parse_filter(target, self.ids, self.document.computed, self.viewport,
+                                                      self.skips.add, name)
+                filt = self._effects[key]
+        return clip, mask, filt
+
+    def _reference(self, style, prop: str, tag: str, name: str, build):
+        value = (style.get(prop) or "none").strip()
+        if value == "none":
+            return None
+        ref = func_iri(value)
+        if ref is None:
+            self.skips.add(prop, f"{name} ({value[:40]})")  # CSS shapes and other forms
+            return None
+        target = self.ids.get(ref)
+        if target is None or not is_svg(target) or local_name(target.tag) != tag:
+            self.skips.add(prop, f"{name} (no <{tag}> #{ref})")
+            return None
+        if id(target) in self._reading:
+            self.skips.add(prop, f"{name} (#{ref} refers back to itself)")
+            return None
+        if len(self._reading) >= MAX_EFFECT_NESTING:
+            self.skips.add(prop, f"{name} (nested more than {MAX_EFFECT_NESTING} deep)")
+            return None
+        key = (tag, id(target))
+        if key not in self._effects:
+            self._reading += (id(target),)
+            try:
+                self._effects[key] = build(target)
+            finally:
+                self._reading = self._reading[:-1]
+        return self._effects[key]
+
+    def _content(self, element, clip: bool) -> Scene:
+        """What a <clipPath> or <mask> draws, as a Scene of its own (in the user space of
+        the element that references it)."""
+        saved = self.shapes, self.groups, self._in_clip
+        self.shapes, self.groups, self._in_clip = [], [], clip
+        try:
+            self._children(element, self.document.computed(element), -1, ())
+            return Scene(width=self.width, height=self.height, shapes=self.shapes, groups=self.groups)
+        finally:
+            self.shapes, self.groups, self._in_clip = saved
+
+    def _clip_path(self, element) -> ClipPath:
+        transform = parse_transform(element.get("transform"))
+        content = self._content(element, clip=True)
+        if _singular(transform):
+            content.shapes, content.groups = [], []  # draws nothing: lets nothing through
+        elif transform is not None:
+            content.view = torch.tensor(transform, dtype=torch.float32)
+        clip = ClipPath(content=content, units=units_of(element, "clipPathUnits", "userSpaceOnUse"),
+                        source=self.document.handle_of(element))
+        clip.clip = self._reference(self.document.computed(element), "clip-path", "clipPath", _name(element),
+                                    self._clip_path)
+        return clip
+
+    def _mask(self, element) -> Mask:
+        style = self.document.computed(element)
+        units = units_of(element, "maskUnits", "objectBoundingBox")
+        kind = "alpha" if (style.get("mask-type") or "").strip() == "alpha" else "luminance"
+        mask = Mask(content=self._content(element, clip=False), kind=kind, units=units,
+                    content_units=units_of(element, "maskContentUnits", "userSpaceOnUse"),
+                    region=region(element, units, self.viewport), source=self.document.handle_of(element))
+        mask.mask = self._reference(style, "mask", "mask", _name(element), self._mask)
+        return mask
+
+    def _viewport_clip(self, width: float, height: float, inverse_view) -> ClipPath:
+        """The clip of a nested <svg> or <symbol> instance to its viewport (overflow
+        hidden): a rect 0, 0, width, height before the viewBox's mapping."""
+        rect = Shape(geometry=Rect(p_min=torch.zeros(2), p_max=torch.tensor([float(width), float(height)])),
+                     fill=solid(BLACK))
+        view = torch.eye(3) if inverse_view is None else torch.tensor(inverse_view, dtype=torch.float32)
+        return ClipPath(content=Scene(width=self.width, height=self.height, shapes=[rect], view=view))
+
+    def _group(self, transform, opacity, parent, element, effects=(None, None, None)) -> int:
         lim = Limiter()
         m = torch.eye(3) if transform is None else lim.tensor(transform)
         if lim.clamped:
             self.skips.add("out-of-range numbers", _name(element))
-        self.groups.append(Group(transform=m, opacity=torch.tensor(float(opacity)),
-                                 parent=parent, source=self.document.handle_of(element)))
+        if self._in_clip:
+            opacity = 1.0  # a clip path's content has no opacity
+        clip, mask, filt = effects
+        self.groups.append(Group(transform=m, opacity=torch.tensor(float(opacity)), parent=parent,
+                                 source=self.document.handle_of(element), clip=clip, mask=mask, filter=filt))
         return len(self.groups) - 1
 
     # ------------------------------------------------------------- references
 
-    def _use(self, element, style, transform, group, stack, depth):
+    def _use(self, element, style, transform, group, stack, depth, effects):
         name = _name(element)
         ref = href_id(element)
         target = self.ids.get(ref) if ref else None
@@ -241,7 +350,7 @@ class Reader:
         x = parse_length(element.get("x"), self.viewport[0]) or 0.0
         y = parse_length(element.get("y"), self.viewport[1]) or 0.0
         m = (transform if transform is not None else np.eye(3)) @ translate(x, y)
-        g = self._group(m, parse_opacity(style.get("opacity")), group, element)
+        g = self._group(m, parse_opacity(style.get("opacity")), group, element, effects)
         stack = stack + (id(target),)
         tag = local_name(target.tag)
         if tag in ("symbol", "svg"):
@@ -252,7 +361,7 @@ class Reader:
         else:
             self._element(target, style, g, stack, depth + 1)
 
-    def _nested_svg(self, element, sizer, style, transform, group, stack, depth):
+    def _nested_svg(self, element, sizer, style, transform, group, stack, depth, effects=(None, None, None)):
         """A nested <svg> or an instanced <symbol>: a group mapping its viewBox onto its
         viewport (width and height from ``sizer``, the element or the <use>)."""
         vw, vh = self.viewport
@@ -265,18 +374,23 @@ class Reader:
             return
         m = (transform if transform is not None else np.eye(3)) @ translate(x, y)
         vb = parse_viewbox(element.get("viewBox"))
+        inverse_view = None
         if vb is not None:
             if vb[2] <= 0 or vb[3] <= 0:
                 return
-            m = m @ view_transform(vb, w, h, element.get("preserveAspectRatio"))
-        if (style.get("overflow") or "hidden").strip() in ("hidden", "scroll"):
-            self.skips.add("svg viewport clipping", _name(element))
-        g = self._group(m, parse_opacity(style.get("opacity")), group, element)
+            view = view_transform(vb, w, h, element.get("preserveAspectRatio"))
+            m = m @ view
+            inverse_view = np.linalg.inv(view)
+        clip, mask, filt = effects
+        if (style.get("overflow") or "hidden").strip() in ("hidden", "scroll") and not self._in_clip:
+            viewport = self._viewport_clip(w, h, inverse_view)
+            viewport.clip, clip = clip, viewport
+        g = self._group(m, parse_opacity(style.get("opacity")), group, element, (clip, mask, filt))
         self._children(element, style, g, stack, depth)
 
     # ----------------------------------------------------------------- shapes
 
-    def _shape(self, tag, element, style, transform, group):
+    def _shape(self, tag, element, style, transform, group, effects=(None, None, None)):
         name = _name(element)
         lim = Limiter()
         reader = ShapeReader(self.viewport, lim, max_segments=MAX_SEGMENTS - self._segments)
@@ -295,13 +409,17 @@ class Reader:
         width = 1.0 if width is None else width
         if width <= 0:
             stroke = None  # SVG: zero or negative width draws no stroke
+        rule_property = "fill-rule"
+        if self._in_clip:  # a clip path's shapes are filled, opaque, with their clip-rule
+            fill, stroke, rule_property = solid(BLACK), None, "clip-rule"
+            style = {k: v for k, v in style.items() if k not in ("opacity", "fill-opacity")}
         # A shape with neither paint is kept: it draws nothing, but the Scene stays one
         # shape per drawable element (counts, write-back).
         self._note_shape_effects(tag, style, name, stroked=stroke is not None)
         shape = Shape(
             geometry=geometry, fill=fill, stroke=stroke,
             stroke_width=lim.tensor(width),
-            fill_rule="evenodd" if (style.get("fill-rule") or "").strip() == "evenodd" else "nonzero",
+            fill_rule="evenodd" if (style.get(rule_property) or "").strip() == "evenodd" else "nonzero",
             linecap=_choice(style.get("stroke-linecap"), CAPS, "butt"),
             linejoin=JOINS.get((style.get("stroke-linejoin") or "").strip(), "miter"),
             miter_limit=_miter_limit(style.get("stroke-miterlimit")),
@@ -309,7 +427,8 @@ class Reader:
             fill_opacity=torch.tensor(parse_opacity(style.get("fill-opacity"))),
             stroke_opacity=torch.tensor(parse_opacity(style.get("stroke-opacity"))),
             transform=torch.eye(3) if transform is None else lim.tensor(transform),
-            group=group, source=self.document.handle_of(element))
+            group=group, source=self.document.handle_of(element),
+            clip=effects[0], mask=effects[1], filter=effects[2])
         if lim.clamped:
             self.skips.add("out-of-range numbers", name)
         self.shapes.append(shape)
@@ -333,6 +452,10 @@ class Reader:
     def _diagonal(self) -> float:
         vw, vh = self.viewport
         return math.sqrt((vw * vw + vh * vh) / 2)
+
+
+# A filter reference that leads nowhere: SVG (and resvg) then draws the element as nothing.
+_NO_FILTER = Filter(steps=[])
 
 
 def _choice(text, allowed, default):
