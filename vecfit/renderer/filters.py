@@ -290,8 +290,15 @@ _BLENDS = {
     "exclusion": lambda s, d: s + d - 2 * s * d,
     "overlay": lambda s, d: torch.where(d <= 0.5, 2 * s * d, 1 - 2 * (1 - s) * (1 - d)),
     "hard-light": lambda s, d: torch.where(s <= 0.5, 2 * s * d, 1 - 2 * (1 - s) * (1 - d)),
+    "color-dodge": lambda s, d: torch.where(d <= 0, torch.zeros_like(d), torch.where(
+        s >= 1, torch.ones_like(d), torch.clamp(d / (1 - s).clamp_min(1e-6), max=1))),
+    "color-burn": lambda s, d: torch.where(d >= 1, torch.ones_like(d), torch.where(
+        s <= 0, torch.zeros_like(d), 1 - torch.clamp((1 - d) / s.clamp_min(1e-6), max=1))),
+    "soft-light": lambda s, d: torch.where(
+        s <= 0.5, d - (1 - 2 * s) * d * (1 - d),
+        d + (2 * s - 1) * (torch.where(d <= 0.25, ((16 * d - 12) * d + 4) * d, d.clamp_min(0).sqrt()) - d)),
 }
-BLEND_MODES = frozenset({"normal", *_BLENDS})
+# (the keywords: vecfit.scene.BLEND_MODES, the ones here and normal)
 
 
 def blend(a: torch.Tensor, b: torch.Tensor, mode: str) -> torch.Tensor:

@@ -159,7 +159,7 @@ class LayeredRender:
                 add(self._plain(run, parent, frame))
                 run.clear()
 
-        for kind, index in self.children[parent]:
+        for kind, index in self._inline_children(parent):
             if kind == "shape" and not _has_effects(self.scene.shapes[index]):
                 run.append(index)
             elif kind == "group" and not self.layered[index]:
@@ -167,10 +167,26 @@ class LayeredRender:
             else:
                 flush()
                 layer = self._unit(kind, index, frame)
-                if layer is not None:
+                owner = self.scene.shapes[index] if kind == "shape" else self.scene.groups[index]
+                if layer is not None and owner.blend != "normal":
+                    below = result if result is not None else torch.zeros_like(layer)
+                    result = filters.blend(layer, below, owner.blend)
+                elif layer is not None:
                     add(layer)
         flush()
         return result if result is not None else torch.zeros((frame.height, frame.width, 4))
+
+    def _inline_children(self, parent: int):
+        """``parent``'s children, with those of groups that are no layer of their own (no
+        effects, opacity 1, not isolated) in their place: what they hold blends with
+        what lies below them."""
+        for kind, index in self.children[parent]:
+            group = self.scene.groups[index] if kind == "group" else None
+            if (group is not None and self.layered[index] and not _has_effects(group) and not group.isolate
+                    and float(group.opacity.detach()) == 1.0):
+                yield from self._inline_children(index)
+            else:
+                yield kind, index
 
     def _plain(self, shapes: list[int], parent: int, frame: Frame, own_opacity: bool = True) -> torch.Tensor:
         """Shapes without effects in one pass of the core. The opacities (and effects) of
@@ -178,13 +194,13 @@ class LayeredRender:
         them as 1 (and none)."""
         neutral = set(self._chain(parent))
         groups = [dataclasses.replace(g, opacity=ONE if i in neutral else g.opacity, clip=None, mask=None,
-                                      filter=None) if i in neutral or _has_effects(g) else g
+                                      filter=None, blend="normal") if i in neutral or _has_effects(g) else g
                   for i, g in enumerate(self.scene.groups)]
         chosen = []
         for i in shapes:
             shape = self.scene.shapes[i]
             if _has_effects(shape) or not own_opacity:
-                shape = dataclasses.replace(shape, clip=None, mask=None, filter=None,
+                shape = dataclasses.replace(shape, clip=None, mask=None, filter=None, blend="normal",
                                             opacity=shape.opacity if own_opacity else ONE)
             chosen.append(shape)
         sub = Scene(width=frame.width, height=frame.height, shapes=chosen, groups=groups,
@@ -348,7 +364,7 @@ def straight(image: torch.Tensor) -> torch.Tensor:
 
 
 def _has_effects(x) -> bool:
-    return x.clip is not None or x.mask is not None or x.filter is not None
+    return x.clip is not None or x.mask is not None or x.filter is not None or x.blend != "normal"
 
 
 def _unit_square(bounds) -> Optional[torch.Tensor]:

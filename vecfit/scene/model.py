@@ -22,6 +22,9 @@ import numpy as np
 import torch
 
 LINE, QUADRATIC, CUBIC = 1, 2, 3
+# mix-blend-mode and feBlend modes drawn (renderer/filters.py): the separable ones.
+BLEND_MODES = frozenset({"normal", "multiply", "screen", "overlay", "darken", "lighten", "color-dodge",
+                         "color-burn", "hard-light", "soft-light", "difference", "exclusion"})
 
 
 def identity() -> torch.Tensor:
@@ -201,11 +204,13 @@ class Group:
     parent: int = -1          # index into Scene.groups, -1 for the root
     source: Any = None        # id (or other handle) of the element, for write-back
     # Effects on the group's layer, in SVG's order: filter, then clip, then mask, then
-    # opacity (renderer/layers.py). The clip and mask are in the group's user space,
-    # after its transform.
+    # opacity, then the blend onto what is below (renderer/layers.py). The clip and mask
+    # are in the group's user space, after its transform.
     clip: Optional[ClipPath] = None
     mask: Optional[Mask] = None
     filter: Optional[Filter] = None
+    blend: str = "normal"          # mix-blend-mode: normal, multiply, screen, ...
+    isolate: bool = False          # isolation: isolate (its children blend only within it)
 
 
 @dataclass
@@ -230,6 +235,7 @@ class Shape:
     clip: Optional[ClipPath] = None
     mask: Optional[Mask] = None
     filter: Optional[Filter] = None
+    blend: str = "normal"          # mix-blend-mode
 
 
 @dataclass
@@ -242,9 +248,9 @@ class Scene:
     skipped: dict[str, list[str]] = field(default_factory=dict)  # kind -> element names
 
     def has_effects(self) -> bool:
-        """Whether a shape or group has a clip, a mask or a filter (drawn in layers by
-        renderer/layers.py rather than in one pass of the core)."""
-        return any(x.clip is not None or x.mask is not None or x.filter is not None
+        """Whether a shape or group has a clip, a mask, a filter or a blend mode (drawn in
+        layers by renderer/layers.py rather than in one pass of the core)."""
+        return any(x.clip is not None or x.mask is not None or x.filter is not None or x.blend != "normal"
                    for x in (*self.shapes, *self.groups))
 
     def effect_contents(self) -> list[tuple["Scene", bool]]:

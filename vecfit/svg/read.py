@@ -21,7 +21,7 @@ import torch
 
 from vecfit import limits
 from vecfit.errors import SvgError
-from vecfit.scene import ClipPath, Filter, Group, Mask, Rect, Scene, Shape
+from vecfit.scene import BLEND_MODES, ClipPath, Filter, Group, Mask, Rect, Scene, Shape
 
 from .effects import func_iri, parse_filter, region, units_of
 from .paints import BLACK, Paints, parse_opacity, parse_paint, solid
@@ -170,7 +170,7 @@ class Reader:
             opacity = parse_opacity(style.get("opacity"))
             if not _singular(transform):
                 effects = self._layer_effects(self.root, style)
-                if opacity < 1 or transform is not None or any(e is not None for e in effects):
+                if opacity < 1 or transform is not None or effects != NO_EFFECTS:
                     group = self._group(transform, opacity, -1, self.root, effects)
                 self._children(self.root, style, group, ())
         lim = Limiter()
@@ -227,14 +227,19 @@ class Reader:
     # ---------------------------------------------------- clip paths, masks, filters
 
     def _layer_effects(self, element, style) -> tuple:
-        """(clip, mask, filter) of an element. A reference that leads nowhere (or back to
-        the clip path or mask being read) is left out with a warning, as resvg does; a
-        filter reference that leads nowhere gives a filter without steps: SVG draws the
-        element as nothing."""
+        """(clip, mask, filter, blend mode, isolated) of an element. A reference that leads
+        nowhere (or back to the clip path or mask being read) is left out with a warning,
+        as resvg does; a filter reference that leads nowhere gives a filter without steps:
+        SVG draws the element as nothing."""
         name = _name(element)
         clip = self._reference(style, "clip-path", "clipPath", name, self._clip_path)
         if self._in_clip:
-            return clip, None, None  # a clip path's shapes take no mask and no filter
+            return clip, None, None, "normal", False  # a clip path's shapes take none of the rest
+        blend = (style.get("mix-blend-mode") or "normal").strip()
+        if blend not in BLEND_MODES:
+            self.skips.add("mix-blend-mode", f"{name} ({blend[:20]})")
+            blend = "normal"
+        isolate = (style.get("isolation") or "").strip() == "isolate"
         mask = self._reference(style, "mask", "mask", name, self._mask)
         value = (style.get("filter") or "none").strip()
         filt = None
@@ -252,7 +257,7 @@ class Reader:
                     self._effects[key] = parse_filter(target, self.ids, self.document.computed, self.viewport,
                                                       self.skips.add, name)
                 filt = self._effects[key]
-        return clip, mask, filt
+        return clip, mask, filt, blend, isolate
 
     def _reference(self, style, prop: str, tag: str, name: str, build):
         value = (style.get(prop) or "none").strip()
@@ -323,16 +328,17 @@ class Reader:
         view = torch.eye(3) if inverse_view is None else torch.tensor(inverse_view, dtype=torch.float32)
         return ClipPath(content=Scene(width=self.width, height=self.height, shapes=[rect], view=view))
 
-    def _group(self, transform, opacity, parent, element, effects=(None, None, None)) -> int:
+    def _group(self, transform, opacity, parent, element, effects=None) -> int:
         lim = Limiter()
         m = torch.eye(3) if transform is None else lim.tensor(transform)
         if lim.clamped:
             self.skips.add("out-of-range numbers", _name(element))
         if self._in_clip:
             opacity = 1.0  # a clip path's content has no opacity
-        clip, mask, filt = effects
+        clip, mask, filt, blend, isolate = effects or NO_EFFECTS
         self.groups.append(Group(transform=m, opacity=torch.tensor(float(opacity)), parent=parent,
-                                 source=self.document.handle_of(element), clip=clip, mask=mask, filter=filt))
+                                 source=self.document.handle_of(element), clip=clip, mask=mask, filter=filt,
+                                 blend=blend, isolate=isolate))
         return len(self.groups) - 1
 
     # ------------------------------------------------------------- references
@@ -361,7 +367,7 @@ class Reader:
         else:
             self._element(target, style, g, stack, depth + 1)
 
-    def _nested_svg(self, element, sizer, style, transform, group, stack, depth, effects=(None, None, None)):
+    def _nested_svg(self, element, sizer, style, transform, group, stack, depth, effects=None):
         """A nested <svg> or an instanced <symbol>: a group mapping its viewBox onto its
         viewport (width and height from ``sizer``, the element or the <use>)."""
         vw, vh = self.viewport
@@ -381,16 +387,16 @@ class Reader:
             view = view_transform(vb, w, h, element.get("preserveAspectRatio"))
             m = m @ view
             inverse_view = np.linalg.inv(view)
-        clip, mask, filt = effects
+        clip, mask, filt, blend, isolate = effects or NO_EFFECTS
         if (style.get("overflow") or "hidden").strip() in ("hidden", "scroll") and not self._in_clip:
             viewport = self._viewport_clip(w, h, inverse_view)
             viewport.clip, clip = clip, viewport
-        g = self._group(m, parse_opacity(style.get("opacity")), group, element, (clip, mask, filt))
+        g = self._group(m, parse_opacity(style.get("opacity")), group, element, (clip, mask, filt, blend, isolate))
         self._children(element, style, g, stack, depth)
 
     # ----------------------------------------------------------------- shapes
 
-    def _shape(self, tag, element, style, transform, group, effects=(None, None, None)):
+    def _shape(self, tag, element, style, transform, group, effects=None):
         name = _name(element)
         lim = Limiter()
         reader = ShapeReader(self.viewport, lim, max_segments=MAX_SEGMENTS - self._segments)
@@ -428,7 +434,7 @@ class Reader:
             stroke_opacity=torch.tensor(parse_opacity(style.get("stroke-opacity"))),
             transform=torch.eye(3) if transform is None else lim.tensor(transform),
             group=group, source=self.document.handle_of(element),
-            clip=effects[0], mask=effects[1], filter=effects[2])
+            **dict(zip(("clip", "mask", "filter", "blend"), (effects or NO_EFFECTS)[:4])))
         if lim.clamped:
             self.skips.add("out-of-range numbers", name)
         self.shapes.append(shape)
@@ -454,6 +460,8 @@ class Reader:
         return math.sqrt((vw * vw + vh * vh) / 2)
 
 
+# (clip, mask, filter, blend mode, isolated) of an element without them.
+NO_EFFECTS = (None, None, None, "normal", False)
 # A filter reference that leads nowhere: SVG (and resvg) then draws the element as nothing.
 _NO_FILTER = Filter(steps=[])
 

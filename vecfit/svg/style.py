@@ -21,7 +21,7 @@ INHERITED = frozenset({
 })
 NOT_INHERITED = frozenset({
     "opacity", "display", "stop-color", "stop-opacity", "clip-path", "mask", "filter",
-    "overflow", "mask-type", "flood-color", "flood-opacity",
+    "overflow", "mask-type", "flood-color", "flood-opacity", "mix-blend-mode", "isolation",
 })
 PROPERTIES = INHERITED | NOT_INHERITED
 

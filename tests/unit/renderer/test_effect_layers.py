@@ -195,3 +195,19 @@ def test_a_huge_deviation_fades_and_takes_little_time():
     alpha = render(Scene(width=SIZE, height=SIZE, shapes=[shape]))[..., 3]
     assert time.perf_counter() - start < 5
     assert float(alpha.max()) < 1e-3 and torch.isfinite(alpha).all()
+
+
+def test_blend_modes_onto_what_is_below_and_isolation():
+    below = rect(0, 0, 64, 64, color=(0.2, 0.6, 1.0, 1))
+    top = rect(16, 16, 48, 48, color=(0.5, 0.5, 0.5, 1), blend="multiply", group=0)
+    # A plain group does not isolate: its multiply reaches the rect below the group.
+    image = render(Scene(width=SIZE, height=SIZE, shapes=[below, top], groups=[Group()]))
+    assert image[32, 32].tolist() == pytest.approx([0.1, 0.3, 0.5, 1], abs=1e-5)
+    assert image[4, 4].tolist() == pytest.approx([0.2, 0.6, 1.0, 1], abs=1e-5)
+    # isolation: isolate: it multiplies what is in the group only (nothing), so over.
+    image = render(Scene(width=SIZE, height=SIZE, shapes=[below, top], groups=[Group(isolate=True)]))
+    assert image[32, 32].tolist() == pytest.approx([0.5, 0.5, 0.5, 1], abs=1e-5)
+    for mode, expected in (("screen", [0.6, 0.8, 1.0]), ("darken", [0.2, 0.5, 0.5]), ("lighten", [0.5, 0.6, 1.0])):
+        shape = rect(16, 16, 48, 48, color=(0.5, 0.5, 0.5, 1), blend=mode)
+        image = render(Scene(width=SIZE, height=SIZE, shapes=[below, shape]))
+        assert image[32, 32, :3].tolist() == pytest.approx(expected, abs=1e-5), mode
