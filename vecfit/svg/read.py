@@ -127,6 +127,7 @@ class Reader:
         self._effects: dict[tuple[str, int], object] = {}
         self._reading: tuple[int, ...] = ()
         self._in_clip = False
+        self._loops = _looping_references(self.root, self.ids, document.computed)
 
     # --------------------------------------------------------------- document
 
@@ -232,7 +233,7 @@ class Reader:
         as resvg does; a filter reference that leads nowhere gives a filter without steps:
         SVG draws the element as nothing."""
         name = _name(element)
-        clip = self._reference(style, "clip-path", "clipPath", name, self._clip_path)
+        clip = self._reference(style, "clip-path", "clipPath", name, self._clip_path, element)
         if self._in_clip:
             return clip, None, None, "normal", False  # a clip path's shapes take none of the rest
         blend = (style.get("mix-blend-mode") or "normal").strip()
@@ -240,7 +241,7 @@ class Reader:
             self.skips.add("mix-blend-mode", f"{name} ({blend[:20]})")
             blend = "normal"
         isolate = (style.get("isolation") or "").strip() == "isolate"
-        mask = self._reference(style, "mask", "mask", name, self._mask)
+        mask = self._reference(style, "mask", "mask", name, self._mask, element)
         value = (style.get("filter") or "none").strip()
         filt = None
         if value != "none":
@@ -259,9 +260,12 @@ class Reader:
                 filt = self._effects[key]
         return clip, mask, filt, blend, isolate
 
-    def _reference(self, style, prop: str, tag: str, name: str, build):
+    def _reference(self, style, prop: str, tag: str, name: str, build, element=None):
         value = (style.get(prop) or "none").strip()
         if value == "none":
+            return None
+        if element is not None and (id(element), prop) in self._loops:
+            self.skips.add(prop, f"{name} ({value[:40]} leads back to itself)")
             return None
         ref = func_iri(value)
         if ref is None:
@@ -307,7 +311,7 @@ class Reader:
         clip = ClipPath(content=content, units=units_of(element, "clipPathUnits", "userSpaceOnUse"),
                         source=self.document.handle_of(element))
         clip.clip = self._reference(self.document.computed(element), "clip-path", "clipPath", _name(element),
-                                    self._clip_path)
+                                    self._clip_path, element)
         return clip
 
     def _mask(self, element) -> Mask:
@@ -317,7 +321,7 @@ class Reader:
         mask = Mask(content=self._content(element, clip=False), kind=kind, units=units,
                     content_units=units_of(element, "maskContentUnits", "userSpaceOnUse"),
                     region=region(element, units, self.viewport), source=self.document.handle_of(element))
-        mask.mask = self._reference(style, "mask", "mask", _name(element), self._mask)
+        mask.mask = self._reference(style, "mask", "mask", _name(element), self._mask, element)
         return mask
 
     def _viewport_clip(self, width: float, height: float, inverse_view) -> ClipPath:
@@ -353,6 +357,8 @@ class Reader:
         if id(target) in stack or any(e is element for e in target.iter()):
             self.skips.add("use", f"{name} (recursive)")
             return
+        if self._in_clip and local_name(target.tag) not in SHAPES:
+            return  # in a clip path, a <use> draws a shape or nothing
         x = parse_length(element.get("x"), self.viewport[0]) or 0.0
         y = parse_length(element.get("y"), self.viewport[1]) or 0.0
         m = (transform if transform is not None else np.eye(3)) @ translate(x, y)
@@ -464,6 +470,38 @@ class Reader:
 NO_EFFECTS = (None, None, None, "normal", False)
 # A filter reference that leads nowhere: SVG (and resvg) then draws the element as nothing.
 _NO_FILTER = Filter(steps=[])
+
+
+def _looping_references(root, ids, computed) -> set[tuple[int, str]]:
+    """(element, property) of the references that make clip paths or masks loop, found
+    as resvg finds them (so that which one of a loop is cut is resvg's choice): for each
+    <clipPath> or <mask> in document order, the first element in it (itself included)
+    whose reference leads back to it, directly or through one other."""
+    cut: set[tuple[int, str]] = set()
+
+    def target(element, prop):
+        if (id(element), prop) in cut:
+            return None
+        ref = func_iri((computed(element).get(prop) or "").strip())
+        return ids.get(ref) if ref else None
+
+    for tag, prop in (("clipPath", "clip-path"), ("mask", "mask")):
+        holders = [e for e in root.iter() if isinstance(e.tag, str) and local_name(e.tag) == tag]
+        found = True
+        while found:
+            found = False
+            for node in holders:
+                for child in node.iter():
+                    link = target(child, prop)
+                    culprit = child if link is node else next(
+                        (e for e in (link.iter() if link is not None else ()) if target(e, prop) is node), None)
+                    if culprit is not None:
+                        cut.add((id(culprit), prop))
+                        found = True
+                        break
+                if found:
+                    break
+    return cut
 
 
 def _choice(text, allowed, default):

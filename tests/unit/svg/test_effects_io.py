@@ -87,9 +87,9 @@ def test_clip_geometry_is_written_back_and_nothing_else_changes(tmp_path):
 
 @pytest.mark.parametrize("body, kind, says", [
     ('<clipPath id="c"><rect width="9" height="9" clip-path="url(#c)"/></clipPath>'
-     '<rect width="50" height="50" clip-path="url(#c)"/>', "clip-path", "refers back to itself"),
+     '<rect width="50" height="50" clip-path="url(#c)"/>', "clip-path", "leads back to itself"),
     ('<mask id="m" mask="url(#m)"><rect width="9" height="9" fill="white"/></mask>'
-     '<rect width="50" height="50" mask="url(#m)"/>', "mask", "refers back to itself"),
+     '<rect width="50" height="50" mask="url(#m)"/>', "mask", "leads back to itself"),
     ('<rect width="50" height="50" clip-path="url(#nowhere)"/>', "clip-path", "no <clipPath> #nowhere"),
     ('<rect width="50" height="50" mask="url(#r)"/><rect id="r" width="1" height="1"/>', "mask", "no <mask> #r"),
     ('<rect width="50" height="50" filter="url(#nowhere)"/>', "filter reference", "no <filter> #nowhere"),
