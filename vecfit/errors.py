@@ -1,5 +1,5 @@
-"""Errors that are the user's to fix (the CLI prints them without a traceback), and the
-exit codes of the commands."""
+"""Errors that are the user's to fix (the CLI prints them without a traceback), the
+warning for inputs read in part, and the exit codes of the commands."""
 
 EXIT_OK = 0             # done
 EXIT_FAILED = 1         # a runtime failure (for batch: some image failed; the others are done)
@@ -9,6 +9,11 @@ EXIT_INTERRUPTED = 130  # Ctrl-C, as a shell reports a process stopped by it
 
 class VecfitError(Exception):
     """A problem with the user's input or options, with a message meant for them."""
+
+
+class VecfitWarning(UserWarning):
+    """Something in the input that vecfit reads only in part or not at all (the SVG reader's
+    skips; a dashed stroke drawn solid)."""
 
 
 class NonFiniteScene(VecfitError):

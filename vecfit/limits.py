@@ -27,3 +27,14 @@ MAX_LAYER_DEPTH = 64
 # Target images for refine, trace and paint (and batch): width x height pixels, checked
 # from the header before the pixels are decoded.
 MAX_IMAGE_PIXELS = 100_000_000
+
+# Dashes of the dashed strokes (stroke-dasharray) in a whole scene: each dash is at least
+# one segment, so a pattern of 0.001 along a long path would make millions (and they come
+# on top of MAX_SEGMENTS). Dashes closer together than the stroke is wide overlap their
+# neighbours, and the Monte Carlo backward pass's work grows with the product (2 x 10^4
+# dashes 0.003 apart under a 6-wide stroke: 5 minutes for the gradients at 64 px), so
+# each dash counts max(1, stroke width / pattern length) times (dash_count in
+# vecfit.scene.dashes; at this limit a render and its gradients take a few seconds at
+# 64 px). A stroke that would take the scene past it is drawn solid, with a warning
+# naming the element.
+MAX_DASHES = 100_000

@@ -9,11 +9,12 @@ values; images are broken in the ways image files break. Families added after th
 campaign (issue 28): images with a side of 1 to 12 px through refine, trace, paint, edit
 and retarget, and renders under 7 px on a side; hundreds to thousands of tiny shapes
 (below a pixel, off the canvas, radii near 0) refined against small targets; one path of
-3,000 to 60,000 segments rendered at 64 px in either mode (20 s: a hang). Clip paths,
-masks and filters (issue 27): references to themselves, to each other in a loop, to
-nothing; masks and clips nested up to 1,000 deep; huge, zero and negative deviations,
-regions of zero area, offsets past the canvas, unknown steps; rendered, refined and
-listed by info. The cases run in a worker
+3,000 to 60,000 segments rendered at 64 px in either mode (20 s: a hang); dashed strokes
+(valid and hostile stroke-dasharray and stroke-dashoffset on every kind of shape, rendered
+or refined). Clip paths, masks and filters (issue 27): references to themselves, to each
+other in a loop, to nothing; masks and clips nested up to 1,000 deep; huge, zero and
+negative deviations, regions of zero area, offsets past the canvas, unknown steps;
+rendered, refined and listed by info. The cases run in a worker
 process that imports vecfit once and calls the command line's main in-process (click's
 runner): starting a Python that imports torch costs 1-2 s a case. The worker is killed
 and restarted after a signal or a time-out, which are recorded as failures.
@@ -110,6 +111,8 @@ def _shape(rng: random.Random) -> str:
                      f'stroke-miterlimit="{_num(rng)}"')
     if rng.random() < 0.2:
         attrs.append(f'opacity="{_num(rng)}"')
+    if rng.random() < 0.2:
+        attrs.append(_dash_attrs(rng))
     a = " ".join(attrs)
     kind = rng.randrange(6)
     if kind == 0:
@@ -123,6 +126,54 @@ def _shape(rng: random.Random) -> str:
     if kind == 4:
         return f'<line x1="{_num(rng)}" y1="0" x2="10" y2="{_num(rng)}" {a}/>'
     return f'<path d="{_path_data(rng)}" {a}/>'
+
+
+DASH_ARRAYS = ["5 3", "0 4", "1", "10% 5%", "0.5 0.25 0.1", "3,1", "1e-9", "1e-3 1e-3", "-1 2", "0 0",
+               "nan", "inf 1", "1e308 1e308", "5 -0", "1,,2", "none", "0", "2em 1mm", "1e-7%",
+               " ".join(["1", "2"] * 500)]
+
+
+def _dash_attrs(rng: random.Random) -> str:
+    """stroke-dasharray and -dashoffset, valid or hostile, sometimes with caps that draw dots."""
+    dashes = rng.choice(DASH_ARRAYS) if rng.random() < 0.7 else " ".join(_num(rng) for _ in range(rng.randint(1, 5)))
+    out = f'stroke-dasharray="{dashes}"'
+    if rng.random() < 0.6:
+        out += f' stroke-dashoffset="{_num(rng)}"'
+    if rng.random() < 0.5:
+        out += f' stroke-linecap="{rng.choice(["round", "square", "butt"])}"'
+    return out
+
+
+def dashed_svg(rng: random.Random) -> bytes:
+    """Dashed strokes on every kind of shape: open and closed paths of lines, quadratics
+    and cubics (several subpaths, zero-length ones), circles, ellipses, rounded rects,
+    polylines and lines, under transforms, with per-shape patterns."""
+    parts = []
+    for _ in range(rng.randint(1, 6)):
+        kind = rng.randrange(6)
+        stroke = (f'fill="{rng.choice(["none", "#8c4", "url(#g)"])}" stroke="#123" '
+                  f'stroke-width="{rng.choice(["0.5", "2", "6", "1e-3", "30", _num(rng)])}" {_dash_attrs(rng)}')
+        if rng.random() < 0.3:
+            stroke += f' transform="{rng.choice(TRANSFORMS)}"'
+        if kind == 0:
+            d = "M 5 5 " + " ".join(rng.choice(["L 30 10", "Q 40 40 20 50", "C 0 60 60 0 58 58", "Z", "M 30 30",
+                                                "L 30 30", "H 60", "M 10 50 Z"]) for _ in range(rng.randint(1, 8)))
+            parts.append(f'<path d="{d}" {stroke}/>')
+        elif kind == 1:
+            parts.append(f'<circle cx="32" cy="32" r="{rng.choice(["20", "0.01", "0", "1e5", _num(rng)])}" {stroke}/>')
+        elif kind == 2:
+            parts.append(f'<ellipse cx="32" cy="32" rx="25" ry="{rng.choice(["8", "1e-4", _num(rng)])}" {stroke}/>')
+        elif kind == 3:
+            parts.append(f'<rect x="4" y="8" width="50" height="40" rx="{rng.choice(["0", "6", "40", _num(rng)])}" '
+                         f'{stroke}/>')
+        elif kind == 4:
+            pts = " ".join(f"{rng.uniform(0, 64):.1f},{rng.uniform(0, 64):.1f}" for _ in range(rng.randint(1, 12)))
+            parts.append(f'<{rng.choice(["polyline", "polygon"])} points="{pts}" {stroke}/>')
+        else:
+            parts.append(f'<line x1="2" y1="{rng.uniform(0, 64):.1f}" x2="62" y2="{rng.uniform(0, 64):.1f}" {stroke}/>')
+    defs = ('<defs><linearGradient id="g"><stop offset="0" stop-color="red"/><stop offset="1" '
+            'stop-color="blue"/></linearGradient></defs>')
+    return f'<svg {NS} width="64" height="64">{defs}{"".join(parts)}</svg>'.encode()
 
 
 def _gradient(rng: random.Random) -> str:
@@ -492,6 +543,26 @@ def make_case(seed: int, index: int, seeds: list[Path] | None = None) -> Case:
         return Case(index, "longpath", "render", ["render", "in.svg", "-o", "out.png", "--width", "64", "--mode", mode,
                                                   "--samples", "1", "--threads", "1"],
                     {"in.svg": long_path_svg(rng)}, timeout=20, outputs=["out.png"])
+    if roll < 0.26:  # dashed strokes, rendered, or refined (the dashes follow the points)
+        svg = dashed_svg(rng)
+        mode = rng.choice(["mc", "analytic"])
+        if rng.random() < 0.7:
+            return Case(index, "dashes", "render", ["render", "in.svg", "-o", "out.png", "--width", "64", "--mode", mode,
+                                                    "--samples", "1", "--threads", "1"], {"in.svg": svg},
+                        timeout=30, outputs=["out.png"])
+        import io
+
+        import numpy as np
+        from PIL import Image
+        buf = io.BytesIO()
+        Image.fromarray((np.random.default_rng(index).random((32, 32, 3)) * 255).astype(np.uint8)).save(buf, "PNG")
+        # (the writer keeps attributes it does not change: no NaN or inf words in them,
+        # which the oracle would find in out.svg)
+        svg = re.sub(rb"\b(nan|inf|infinity)\b", b"1e39", svg, flags=re.I)
+        args = ["refine", "target.png", "init.svg", "-o", "out.svg", "--iterations", "2", "-q", "--samples", "1",
+                "--threads", "1", "--mode", mode]
+        return Case(index, "dashes", "refine", args, {"target.png": buf.getvalue(), "init.svg": svg},
+                    timeout=60, outputs=["out.svg", "out.report.json", "out.compare.png"])
     kind = "mutation" if roll < 0.6 else "grammar"
     svg = mutated_svg(rng, seeds) if kind == "mutation" else grammar_svg(rng)
     if rng.random() < 0.2:

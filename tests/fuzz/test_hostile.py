@@ -61,6 +61,33 @@ def test_nested_scales_render_and_differentiate(tmp_path):
         assert all(torch.isfinite(t.grad).all() for t in scene.parameters()["points"])
 
 
+@pytest.mark.parametrize("name, solid, skipped", [
+    ("dasharray-negative", ["neg", "negsum", "minuszero"], []),
+    ("dasharray-zeros", ["zeros", "zero-one"], ["zero-one"]),
+    ("dasharray-tiny-on-long-path", ["long", "rect"], ["long", "rect"]),
+    ("dasharray-nan-inf", ["nan", "inf", "huge", "big"], []),
+    ("dasharray-percent", ["poly"], ["poly"]),
+])
+def test_hostile_dashes(name, solid, skipped):
+    """Dash patterns that draw solid (negative, zero sum, NaN or infinite text: SVG's rule)
+    or that would make millions of dashes (1e-9 on a long path, tiny percentages: the
+    limit, with a warning naming the element): read, rendered and differentiated quickly."""
+    start = time.perf_counter()
+    scene = quiet_load(Path(__file__).parent / "hostile" / f"{name}.svg")
+    for shape in scene.shapes:
+        assert (shape.dash_array is None) == (shape.source in solid), shape.source
+    assert scene.skipped.get("stroke-dasharray", []) == skipped
+    for mode in ("mc", "analytic"):
+        for t in scene.parameters()["points"]:
+            t.requires_grad_(True)
+            t.grad = None
+        image = vecfit.render(scene, 64, None, mode=mode, samples=1)
+        assert torch.isfinite(image).all()
+        image.sum().backward()
+        assert all(t.grad is None or torch.isfinite(t.grad).all() for t in scene.parameters()["points"])
+    assert time.perf_counter() - start < 20
+
+
 def test_huge_coordinates_render_quickly(tmp_path):
     """10^28 px coordinates (as viewBox="0 0 3 1e-30" made at 64 px wide, which grew past
     6 GB before canvases that thin were refused): the boundary samples of the backward

@@ -344,3 +344,34 @@ def test_stroke_under_anisotropic_transform(mode, cap):
         check(build, {"matrix": matrix}, {"matrix": 0.02}, rtol=0.1, atol=0.5)
     else:
         check(build, {"matrix": matrix}, {"matrix": 0.002}, rtol=0.02, atol=0.05, mode="analytic")
+
+
+# ------------------------------------------------------------------------ dashed strokes
+# A dash end sits at a fixed arc length: moving a control point changes the length before
+# it, so every dash downstream slides along the path (vecfit/scene/dashes.py). The
+# patterns keep every dash end away from the path's vertices and ends (there a dash
+# would gain or lose a join or a cap: a kink no derivative has).
+
+@pytest.mark.parametrize("mode", ["mc", "analytic"])
+def test_dashed_open_stroke(mode):
+    zigzag = torch.tensor([[6.0, 30.0], [11.0, 5.0], [20.0, 31.0], [34.0, 12.0], [27.0, 8.0]]) + OFF_GRID
+
+    def build(points, width):
+        path = Path(points=points, degrees=np.array([3, 1]), subpaths=[(0, 2, False)])
+        return Scene(width=40, height=40, shapes=[background(), Shape(
+            geometry=path, stroke=solid(0.1, 0.3, 0.9, 1), stroke_width=width, linecap="butt",
+            linejoin="round", dash_array=(6.0, 3.0), dash_offset=1.0)])
+    if mode == "mc":
+        check(build, {"points": zigzag, "width": torch.tensor(3.0)}, {"points": 0.3, "width": 0.3})
+    else:
+        check(build, {"points": zigzag, "width": torch.tensor(3.0)}, {"points": 0.01, "width": 0.01},
+              rtol=0.02, atol=0.01, mode="analytic")
+
+
+def test_dashed_closed_stroke_analytic():
+    """The last dash runs through the start point into the first (one dash, joined there)."""
+    def build(points):
+        return Scene(width=40, height=40, shapes=[background(), Shape(
+            geometry=blob(points), fill=solid(0.2, 0.8, 0.3, 0.6), stroke=solid(0.1, 0.1, 0.6, 1),
+            stroke_width=torch.tensor(2.5), linejoin="miter", dash_array=(7.0, 4.0))])
+    check(build, {"points": BLOB + OFF_GRID}, {"points": 0.01}, rtol=0.02, atol=0.01, mode="analytic")

@@ -9,13 +9,17 @@ csrc/scene/scene.h).
 """
 from __future__ import annotations
 
+import math
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 import torch
 
-from vecfit.errors import VecfitError
+from vecfit import limits as _limits
+from vecfit.errors import VecfitError, VecfitWarning
 from vecfit.scene import Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect, Scene, Shape, Solid
+from vecfit.scene.dashes import dash_path, dash_pattern, outline_path
 from vecfit.scene.geometry import affine_apply, local_bbox, rect_as_path, value
 from vecfit.scene.placement import canvas_matrix, group_matrices, stacked_shape_matrices
 
@@ -86,6 +90,7 @@ class Packer:
         self.group_matrix: list[torch.Tensor] = []
         self.group_layer: list[int] = []
         self._group_draw_counts = self._count_group_draws()
+        self._dash_count = 0  # dashes of the dashed strokes packed so far (limits.MAX_DASHES)
 
     # --------------------------------------------------------------- structure
 
@@ -222,6 +227,13 @@ class Packer:
             has_fill = shape.fill is not None
             has_stroke = (shape.stroke is not None and _stroke_width_positive(shape)
                           and scale_np[i] > 0)
+            # A dashed stroke is drawn from its dashes, a path of its own (None: solid).
+            dashes = dashed_stroke(shape, _limits.MAX_DASHES - self._dash_count) if has_stroke else None
+            if dashes is not None:
+                pattern = dash_pattern(shape.dash_array)
+                self._dash_count += len(dashes.subpaths) * max(1.0, dash_width(shape) / sum(pattern))
+            if dashes is not None and not dashes.subpaths:
+                has_stroke = False  # no dash at all (a zero-length path)
             if not (has_fill or has_stroke):
                 continue
             layer = 0 if shape.group < 0 else self.group_layer[shape.group]
@@ -242,16 +254,26 @@ class Packer:
                 geometry = rect_as_path(geometry)
                 if geometry is None:
                     continue
-            if isinstance(geometry, Path):
-                if not geometry.subpaths:
-                    continue
-                index = paths.add(geometry, i, len(out.shapes), len(out.subpaths), with_widths=has_stroke, rect=rect)
-                out.shapes.append([SHAPE_PATH, len(out.subpaths), len(geometry.subpaths), -1])
-                out.subpaths.extend([None] * len(geometry.subpaths))  # filled by the batch
+            index = None
+            if dashes is None or has_fill:
+                if isinstance(geometry, Path):
+                    if not geometry.subpaths:
+                        continue
+                    index = paths.add(geometry, i, len(out.shapes), len(out.subpaths),
+                                      with_widths=has_stroke and dashes is None, rect=rect)
+                    out.shapes.append([SHAPE_PATH, len(out.subpaths), len(geometry.subpaths), -1])
+                    out.subpaths.extend([None] * len(geometry.subpaths))  # filled by the batch
+                else:
+                    index = self._add_ellipse(geometry, matrices[i])
+                    if index is None:
+                        continue
+            if dashes is not None and has_stroke:
+                stroke_index = paths.add(dashes, i, len(out.shapes), len(out.subpaths), with_widths=True)
+                out.shapes.append([SHAPE_PATH, len(out.subpaths), len(dashes.subpaths), -1])
+                out.subpaths.extend([None] * len(dashes.subpaths))
+                geometry = dashes
             else:
-                index = self._add_ellipse(geometry, matrices[i])
-                if index is None:
-                    continue
+                stroke_index = index
             if has_fill:
                 paint = paint_index(shape.fill, factors + [shape.fill_opacity], i, shape.geometry)
                 out.draws.append([index, DRAW_FILL, FILL_RULES[shape.fill_rule], paint, layer, 0, 0, 0])
@@ -259,7 +281,7 @@ class Packer:
                 paint = paint_index(shape.stroke, factors + [shape.stroke_opacity], i, shape.geometry)
                 stroke_rows.append((len(out.draws), i))
                 per_point = int(isinstance(geometry, Path) and geometry.widths is not None)
-                out.draws.append([index, DRAW_STROKE, 0, paint, layer,
+                out.draws.append([stroke_index, DRAW_STROKE, 0, paint, layer,
                                   CAPS[shape.linecap], JOINS[shape.linejoin], per_point])
 
         paths.finish(out, matrices, scale, self.provenance)
@@ -439,6 +461,34 @@ class _PathBatch:
         idx = sub_first_point[sub_of_seg][:, None] + local_idx
         idx = np.where(j <= deg[:, None], idx, -1)
         out.segments.append(np.concatenate([deg[:, None], idx], axis=1))
+
+
+def dashed_stroke(shape: Shape, max_dashes: float | None = None) -> Path | None:
+    """The dashes the shape's stroke is drawn from (vecfit.scene.dashes), or None where it
+    is drawn solid: no dash pattern or one SVG draws solid, or a dash_count over
+    ``max_dashes`` (limits.MAX_DASHES by default; with a warning naming the element)."""
+    if shape.dash_array is None:
+        return None
+    pattern = dash_pattern(shape.dash_array)
+    if pattern is None or not math.isfinite(float(shape.dash_offset)):
+        return None
+    g = outline_path(shape.geometry)
+    if g is None or not g.subpaths:
+        return None
+    dashes = dash_path(g, pattern, float(shape.dash_offset), max_dashes=max_dashes, width=dash_width(shape))
+    if dashes is None:
+        warnings.warn(f"{shape.source if shape.source is not None else 'a shape'}: stroke-dasharray makes more "
+                      f"than {_limits.MAX_DASHES} dashes in the scene (the limit); stroked solid", VecfitWarning,
+                      stacklevel=2)
+    return dashes
+
+
+def dash_width(shape: Shape) -> float:
+    """The stroke's widest width (what dash_count weighs dashes by)."""
+    g = shape.geometry
+    if isinstance(g, Path) and g.widths is not None and g.widths.numel():
+        return value(g.widths.detach().max())
+    return value(shape.stroke_width)
 
 
 def _geometry_tensors(geometry) -> list:

@@ -16,7 +16,8 @@ where x is the optimiser's flat parameter tensors side by side; autograd of that
 gather and a scatter, so gradients reach the flat tensors by index.
 
 PersistentPack.build answers None where that does not hold (transforms or opacities
-optimised; a rounded rect's corners, or geometry under a bounding-box gradient, optimised) and the
+optimised; a rounded rect's corners, or geometry under a bounding-box gradient, optimised;
+a dashed stroke, whose dashes change in number and place as the points move) and the
 loop packs on every iteration as before. The build checks itself once against the
 Packer: the same floats, and the same gradients for a random image adjoint.
 """
@@ -29,6 +30,7 @@ import numpy as np
 import torch
 
 from vecfit.scene import Scene
+from vecfit.scene.dashes import dash_pattern
 
 from .layout import COLUMNS
 from .pack import Packer
@@ -164,6 +166,8 @@ class PersistentPack:
         if scene.has_effects():  # drawn in layers (renderer/layers.py), several packs a render
             return None
         kinds = list(kinds)
+        if any(s.stroke is not None and dash_pattern(s.dash_array) is not None for s in scene.shapes):
+            return None  # dashes: the segments and draws change as the points move
         optimised = {id(t) for k in kinds for t in k.tensors}
         parameters = scene.parameters()
         if any(id(t) in optimised for kind in NON_AFFINE_KINDS for t in parameters[kind]):

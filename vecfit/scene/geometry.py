@@ -102,6 +102,22 @@ def rect_as_path(rect: Rect) -> Path | None:
     return Path(points=pts, degrees=np.array(degrees), subpaths=[(0, len(degrees), True)])
 
 
+def ellipse_as_path(geometry: Circle | Ellipse) -> Path | None:
+    """A circle or an ellipse as a closed path of four quarter-ellipse cubics, from
+    (cx + rx, cy) through (cx, cy + ry) (SVG 2's start point and direction, as resvg),
+    differentiable in the centre and radii; None when a radius is not positive."""
+    r = geometry.radius.reshape(1).expand(2) if isinstance(geometry, Circle) else geometry.radii
+    if value(r.min()) <= 0:
+        return None
+    c = geometry.center.reshape(2)
+    rx, ry = r[0], r[1]
+    k = KAPPA
+    unit = torch.tensor([[1, 0], [1, k], [k, 1], [0, 1], [-k, 1], [-1, k], [-1, 0],
+                         [-1, -k], [-k, -1], [0, -1], [k, -1], [1, -k]], dtype=c.dtype)
+    pts = c + unit * torch.stack([rx, ry]).to(c.dtype)
+    return Path(points=pts, degrees=np.array([3, 3, 3, 3]), subpaths=[(0, 4, True)])
+
+
 
 def local_bbox_size(geometry) -> float | None:
     """Geometric mean of the geometry's bounding-box sides (for bounding-box units)."""

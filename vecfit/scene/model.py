@@ -215,7 +215,14 @@ class Group:
 
 @dataclass
 class Shape:
-    """One drawn element: geometry with an optional fill and an optional stroke."""
+    """One drawn element: geometry with an optional fill and an optional stroke.
+
+    ``dash_array`` and ``dash_offset``: the stroke's ``stroke-dasharray`` and
+    ``stroke-dashoffset`` in the geometry's own units (like ``stroke_width``), plain floats
+    that are not optimised. None, or a pattern SVG draws solid (a negative value, a zero
+    sum), strokes without dashes; an odd-length pattern repeats to even length. The stroke
+    is then drawn from the dashes of the geometry (vecfit.scene.dashes); the fill is not
+    affected."""
     geometry: Geometry
     fill: Optional[Paint] = None
     stroke: Optional[Paint] = None
@@ -236,6 +243,8 @@ class Shape:
     mask: Optional[Mask] = None
     filter: Optional[Filter] = None
     blend: str = "normal"          # mix-blend-mode
+    dash_array: Optional[tuple[float, ...]] = None  # stroke-dasharray (own units), or None
+    dash_offset: float = 0.0       # stroke-dashoffset (own units)
 
 
 @dataclass

@@ -15,6 +15,7 @@ position "/i/j/k" in the document when it has no unique id.
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import torch
@@ -22,6 +23,7 @@ import torch
 from vecfit import limits
 from vecfit.errors import SvgError
 from vecfit.scene import BLEND_MODES, ClipPath, Filter, Group, Mask, Rect, Scene, Shape
+from vecfit.scene.dashes import dash_count, dash_pattern, outline_path
 
 from .effects import func_iri, parse_filter, region, units_of
 from .paints import BLACK, Paints, parse_opacity, parse_paint, solid
@@ -111,6 +113,7 @@ class Reader:
         self.ids = document.ids
         self._elements = 0  # elements walked so far, <use> instances included
         self._segments = 0
+        self._dash_count = 0  # dashes of the dashed strokes so far (about)
         elements = sum(1 for e in self.root.iter() if isinstance(e.tag, str))
         if elements > MAX_ELEMENTS:  # entity expansion can make millions from a small file
             self._too_many_elements()
@@ -428,6 +431,7 @@ class Reader:
         # A shape with neither paint is kept: it draws nothing, but the Scene stays one
         # shape per drawable element (counts, write-back).
         self._note_shape_effects(tag, style, name, stroked=stroke is not None)
+        dash_array, dash_offset = self._dashes(style, geometry, width, name) if stroke is not None else (None, 0.0)
         shape = Shape(
             geometry=geometry, fill=fill, stroke=stroke,
             stroke_width=lim.tensor(width),
@@ -440,6 +444,7 @@ class Reader:
             stroke_opacity=torch.tensor(parse_opacity(style.get("stroke-opacity"))),
             transform=torch.eye(3) if transform is None else lim.tensor(transform),
             group=group, source=self.document.handle_of(element),
+            dash_array=dash_array, dash_offset=dash_offset,
             **dict(zip(("clip", "mask", "filter", "blend"), (effects or NO_EFFECTS)[:4])))
         if lim.clamped:
             self.skips.add("out-of-range numbers", name)
@@ -452,11 +457,24 @@ class Reader:
             value = parse_paint(default)
         return self.paints.resolve(value, current, name)
 
-    def _note_shape_effects(self, tag, style, name, stroked):
-        dashes = (style.get("stroke-dasharray") or "none").strip()
-        if stroked and dashes != "none" and any(
-                parse_number(t) for t in dashes.replace(",", " ").split()):
+    def _dashes(self, style, geometry, width, name) -> tuple[tuple[float, ...] | None, float]:
+        """stroke-dasharray (lengths, percentages of the diagonal; an invalid list or one SVG
+        draws solid: None) and stroke-dashoffset, in user units. A pattern that would take
+        the scene past limits.MAX_DASHES dashes is noted and drawn solid."""
+        items = re.split(r"\s*,\s*|\s+", (style.get("stroke-dasharray") or "none").strip())
+        values = [parse_length(t, self._diagonal()) for t in items]
+        if items == ["none"] or any(v is None for v in values) or (pattern := dash_pattern(values)) is None:
+            return None, 0.0
+        offset = parse_length(style.get("stroke-dashoffset"), self._diagonal())
+        outline = outline_path(geometry)
+        count = dash_count(outline, pattern, width) if outline is not None else 0.0
+        if self._dash_count + count > limits.MAX_DASHES:
             self.skips.add("stroke-dasharray", name)
+            return None, 0.0
+        self._dash_count += count
+        return pattern, offset if offset is not None and math.isfinite(offset) else 0.0
+
+    def _note_shape_effects(self, tag, style, name, stroked):
         if tag in ("path", "line", "polyline", "polygon") and any(
                 (style.get(f"marker-{k}") or "none").strip() != "none" for k in ("start", "mid", "end")):
             self.skips.add("marker", name)

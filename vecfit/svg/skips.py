@@ -3,13 +3,16 @@ from __future__ import annotations
 
 import warnings
 
+from vecfit.errors import VecfitWarning  # (in the lowest layer: the renderer warns too)
+
 # What happens to each kind that is not simply left out of the drawing.
 _NOTES = {
     "clip-path": "drawn unclipped",
     "mask": "drawn unmasked",
     "filter": "drawn unfiltered",
     "filter reference": "not drawn, as browsers do",
-    "stroke-dasharray": "stroked without dashes",
+    "stroke-dasharray": "more dashes than the limit (vecfit.limits.MAX_DASHES), stroked solid",
+    "mix-blend-mode": "blended as normal",
     "marker": "markers not drawn",
     "spreadMethod": "drawn as pad",
     "fr": "focal radius taken as 0",
@@ -21,10 +24,6 @@ _NOTES = {
     "pattern": "painted as none or the fallback colour",
 }
 _SHOWN = 8  # names listed in a warning
-
-
-class VecfitWarning(UserWarning):
-    """Something in the input that vecfit reads only in part or not at all."""
 
 
 class Skips:

@@ -343,6 +343,11 @@ class _Writer:
                 wrote = True
         if shape.miter_limit != orig.miter_limit:
             self.doc.set_property(e, "stroke-miterlimit", fmt(shape.miter_limit, 6))
+        if shape.dash_array != orig.dash_array or shape.dash_offset != orig.dash_offset:
+            dashes = shape.dash_array
+            self.doc.set_property(e, "stroke-dasharray", "none" if not dashes else " ".join(fmt(v, 4) for v in dashes))
+            self.doc.set_property(e, "stroke-dashoffset", fmt(shape.dash_offset, 4))
+            wrote = True
         if not _same(shape.transform, orig.transform) or (full and e.get("transform") is not None):
             self._transform(e, finite(shape.transform))
             wrote = True

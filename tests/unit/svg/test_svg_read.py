@@ -693,7 +693,7 @@ def test_skipped_content_warns_once_per_kind(tmp_path):
     path = write(tmp_path, """
         <text id="t1">a</text><text>b</text><text id="t3">c</text>
         <image id="i1"/><image id="i2"/>
-        <rect id="f1" width="1" height="1" filter="url(#f)" stroke="red" stroke-dasharray="2 2"/>
+        <rect id="f1" width="1" height="1" filter="url(#f)" stroke="red" stroke-dasharray="1e-9"/>
         <rect id="f2" width="1" height="1" style="filter: url(#f)" clip-path="url(#c)"/>
         <rect id="ok" width="1" height="1"/>""")
     with pytest.warns(VecfitWarning) as record:
@@ -703,12 +703,59 @@ def test_skipped_content_warns_once_per_kind(tmp_path):
     assert scene.skipped == {"text": ["t1", "text", "t3"], "image": ["i1", "i2"],
                              "filter reference": ["f1 (no <filter> #f)", "f2 (no <filter> #f)"],
                              "stroke-dasharray": ["f1"], "clip-path": ["f2 (no <clipPath> #c)"]}
+    assert "more dashes than the limit" in next(m for m in messages if "stroke-dasharray" in m)
     text_warning = next(m for m in messages if "text" in m)
     assert str(path) in text_warning and "t1" in text_warning and "t3" in text_warning
     # As browsers do: a clip path that is not there clips nothing, a filter that is not
     # there draws nothing (the shapes stay in the Scene, one per element).
     assert len(scene.shapes) == 3
     assert scene.shapes[0].filter.steps == [] and scene.shapes[1].clip is None
+
+
+# ======================================================================== dashes
+
+def test_dash_array_and_offset(tmp_path):
+    """Lengths with units, percentages of the diagonal / sqrt(2), comma or space separated,
+    an odd count repeated, inherited; offsets likewise (not finite: 0)."""
+    diagonal = math.sqrt((200 ** 2 + 100 ** 2) / 2)
+    scene = load(tmp_path, """
+        <path id="a" d="M0 0 H 50" stroke="red" stroke-dasharray="10%, 5mm 2" stroke-dashoffset="-5%"/>
+        <g stroke-dasharray="3 1" stroke-dashoffset="2"><path id="b" d="M0 0 H 50" stroke="red"/></g>
+        <rect id="c" width="5" height="5" stroke="red" stroke-dasharray="1,2" stroke-dashoffset="nan"/>
+        <circle id="d" r="5" stroke="red" style="stroke-dasharray: 1 2; stroke-dashoffset: 1e400"/>
+        <path id="e" d="M0 0 H 50" stroke="red" stroke-dasharray="4 4" stroke-dashoffset="12"/>""",
+                 attrs='width="200" height="100"')
+    a = by_source(scene, "a")
+    assert np.allclose(a.dash_array, [0.1 * diagonal, 5 * 96 / 25.4, 2] * 2) and len(a.dash_array) == 6
+    assert math.isclose(a.dash_offset, -0.05 * diagonal)
+    assert by_source(scene, "b").dash_array == (3.0, 1.0) and by_source(scene, "b").dash_offset == 2.0
+    assert by_source(scene, "c").dash_array == (1.0, 2.0) and by_source(scene, "c").dash_offset == 0.0
+    assert by_source(scene, "d").dash_array == (1.0, 2.0) and by_source(scene, "d").dash_offset == 0.0
+    assert by_source(scene, "e").dash_offset == 12.0
+    assert not scene.skipped
+
+
+@pytest.mark.parametrize("value", ["none", "", "1 x", "-1 2", "0 0", "0", "nan 2", "inf", "1e400 1", "1 -0",
+                                   "1,,", "url(#a)"])
+def test_dash_arrays_that_draw_solid(tmp_path, value):
+    scene = load(tmp_path, f'<path id="p" d="M0 0 H 50" stroke="red" stroke-dasharray="{value}"/>')
+    assert by_source(scene, "p").dash_array is None and not scene.skipped
+
+
+def test_dashes_only_on_strokes(tmp_path):
+    scene = load(tmp_path, '<path id="p" d="M0 0 H 50" fill="red" stroke-dasharray="1 2"/>'
+                           '<path id="q" d="M0 0 H 50" stroke="red" stroke-width="0" stroke-dasharray="1 2"/>')
+    assert by_source(scene, "p").dash_array is None and by_source(scene, "q").dash_array is None
+
+
+def test_too_many_dashes_warn_and_draw_solid(tmp_path):
+    start = time.perf_counter()
+    with pytest.warns(VecfitWarning, match="stroke-dasharray.*long"):
+        scene = load_svg(write(tmp_path, '<path id="long" d="M0 0 H 1e6 V 1e6" stroke="red" stroke-dasharray="1e-9"/>'
+                                         '<path id="ok" d="M0 0 H 1e6" stroke="red" stroke-dasharray="100"/>'))
+    assert by_source(scene, "long").dash_array is None and by_source(scene, "ok").dash_array == (100.0, 100.0)
+    assert scene.skipped == {"stroke-dasharray": ["long"]}
+    assert time.perf_counter() - start < 5
 
 
 def test_huge_numbers_are_clamped_not_infinite(tmp_path):

@@ -109,8 +109,8 @@ def assert_scenes_equal(a, b, tol=1e-4, ctol=1e-4):
             _close(s.stroke_width, t.stroke_width, tol, what + " stroke-width")
         _close(s.opacity, t.opacity, tol, what + " opacity")
         _close(s.transform, t.transform, tol, what + " transform")
-        assert (s.fill_rule, s.linecap, s.linejoin, s.miter_limit) == \
-               (t.fill_rule, t.linecap, t.linejoin, t.miter_limit), what
+        assert (s.fill_rule, s.linecap, s.linejoin, s.miter_limit, s.dash_array, s.dash_offset) == \
+               (t.fill_rule, t.linecap, t.linejoin, t.miter_limit, t.dash_array, t.dash_offset), what
         assert s.group == t.group, what
     for i, (g, h) in enumerate(zip(a.groups, b.groups)):
         assert g.source == h.source and g.parent == h.parent
@@ -356,6 +356,23 @@ def test_polyline_keeps_or_becomes_path(tmp_path):
     assert pl.tag.endswith("path") and pl.get("points") is None and pl.get("class") == "k"
     assert pl.get("d") == "M0 0 Q5 10 10 0 L20 0"
     _close(quiet_load(out).shapes[0].geometry.points, g.points, 1e-6, "path")
+
+
+def test_dash_changes_written(tmp_path):
+    src = tmp_path / "d.svg"
+    src.write_text(f'<svg xmlns="{SVG_NS}" viewBox="0 0 100 100"><g stroke-dasharray="5 5">'
+                   '<path id="a" d="M0 0 H 90" stroke="black"/><path id="b" d="M0 9 H 90" stroke="black"/></g></svg>')
+    scene = quiet_load(src)
+    assert scene.shapes[0].dash_array == (5.0, 5.0)
+    scene.shapes[0].dash_array, scene.shapes[0].dash_offset = (3.0, 1.5, 2.0, 1.0), -2.0
+    out = tmp_path / "o.svg"
+    quiet_write(scene, src, out)
+    back = quiet_load(out)
+    assert back.shapes[0].dash_array == (3.0, 1.5, 2.0, 1.0) and back.shapes[0].dash_offset == -2.0
+    assert back.shapes[1].dash_array == (5.0, 5.0) and _element(out, "b").get("stroke-dasharray") is None
+    scene.shapes[0].dash_array = None
+    quiet_write(scene, src, out)
+    assert quiet_load(out).shapes[0].dash_array is None
 
 
 def test_inherited_opacity_not_lost(tmp_path):
