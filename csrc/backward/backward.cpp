@@ -55,6 +55,11 @@ void pixel_adjoints(const RenderOptions& o, const float* image, const float* d_i
             const float* s = image + 4 * p;
             const float* ds = d_image + 4 * p;
             double* gp = g.data() + 4 * p;
+            if (o.premultiplied) {  // total = scene + (1 - scene.a) * background
+                for (int i = 0; i < 4; ++i) gp[i] = ds[i];
+                gp[3] -= ds[0] * bg[0] + ds[1] * bg[1] + ds[2] * bg[2] + ds[3] * bg[3];
+                continue;
+            }
             double a = s[3];
             if (a <= 0) {
                 // An empty pixel: its straight colour jumps from 0 to the colour of whatever

@@ -162,7 +162,7 @@ void tile_forward(const SceneView& sc, const TileView& bins, const RenderOptions
                 for (int ch = 0; ch < 4; ++ch) acc[ch] += w * ts.colour[i][ch];
                 wsum += w;
             }
-            pixel_output(acc, wsum, bg, out + 4 * ((size_t)y * W + x));
+            pixel_output(acc, wsum, bg, out + 4 * ((size_t)y * W + x), o.premultiplied);
         }
 }
 

@@ -25,6 +25,9 @@ struct RenderOptions {
     bool brute_force = false;   // test every item of every draw (a check of the tiles)
     bool has_background = false;
     double background[4] = {0, 0, 0, 0};  // straight RGBA
+    // The image as premultiplied RGBA instead of straight (for layers that Python
+    // composites: clip paths, masks, filters); the backward pass then takes dL/d(that).
+    bool premultiplied = false;
 };
 
 // The options as both passes use them: at least one sample, and the filter radius settled

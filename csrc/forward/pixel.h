@@ -66,13 +66,17 @@ VF_HD void sample_forward(const SceneView& sc, const TileView& bins, int tile, V
 }
 
 // A pixel's filtered premultiplied colour (acc / wsum), the background under it, written
-// as straight RGBA.
-VF_HD void pixel_output(const double acc[4], double wsum, const double bg[4], float* px) {
+// as straight RGBA (or premultiplied, where the options ask for it).
+VF_HD void pixel_output(const double acc[4], double wsum, const double bg[4], float* px, bool premultiplied = false) {
     double k = wsum > 0 ? 1 / wsum : 0, c[4];
     for (int i = 0; i < 4; ++i) c[i] = acc[i] * k;
     double rest = 1 - c[3];
     for (int i = 0; i < 4; ++i) c[i] += rest * bg[i];
     double a = c[3];
+    if (premultiplied) {
+        for (int i = 0; i < 4; ++i) px[i] = (float)vclamp(c[i], 0.0, 1.0);
+        return;
+    }
     for (int i = 0; i < 3; ++i) px[i] = a > 0 ? (float)vclamp(c[i] / a, 0.0, 1.0) : 0.0f;
     px[3] = (float)vclamp(a, 0.0, 1.0);
 }
@@ -98,7 +102,7 @@ VF_HD void pixel_forward(const SceneView& sc, const TileView& bins, const Render
         for (int i = 0; i < 4; ++i) acc[i] += w * c[i];
         wsum += w;
     }
-    pixel_output(acc, wsum, bg, px);
+    pixel_output(acc, wsum, bg, px, o.premultiplied);
 }
 
 }  // namespace vf

@@ -122,7 +122,7 @@ const char* filter_name(int filter) { return filter >= 0 && filter < 5 ? FILTER_
 // vecfit._core.RenderOptions(...): the options of every pass, checked once here.
 RenderOptions make_options(int width, int height, int samples, const std::string& mode, const std::string& filter,
                            double filter_radius, uint64_t seed, int threads, py::object background,
-                           int interior_samples, bool brute_force) {
+                           int interior_samples, bool brute_force, bool premultiplied) {
     if (width <= 0 || height <= 0) throw std::invalid_argument("width and height must be positive");
     if (samples <= 0) throw std::invalid_argument("samples must be positive");
     if (interior_samples < 0) throw std::invalid_argument("interior_samples must be >= 0");
@@ -137,6 +137,7 @@ RenderOptions make_options(int width, int height, int samples, const std::string
     o.threads = threads;
     o.interior_samples = interior_samples;
     o.brute_force = brute_force;
+    o.premultiplied = premultiplied;
     if (!background.is_none()) {
         auto bg = background.cast<std::vector<double>>();
         if (bg.size() != 4) throw std::invalid_argument("background must be 4 numbers (RGBA)");
@@ -231,7 +232,7 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
 // The scene at n points (pixel space, [n, 2]) in the analytical mode with kernel radius
 // filter_radius: [n, 4] straight RGBA (pydiffvg's eval_positions).
 RenderOptions points_options(double filter_radius, int threads) {
-    return make_options(1, 1, 1, "analytic", "tent", filter_radius, 0, threads, py::none(), 0, false);
+    return make_options(1, 1, 1, "analytic", "tent", filter_radius, 0, threads, py::none(), 0, false, false);
 }
 
 const double* points_of(const Array<double>& positions, int& n) {
@@ -354,11 +355,12 @@ PYBIND11_MODULE(_core, m) {
                               "The options of every pass: size, N x N samples, mode ('mc' or 'analytic'), pixel "
                               "filter and radius, seed, threads (0: all), background (RGBA or None), the interior "
                               "samples the Monte Carlo backward pass revisits (0: all), brute_force (every draw at "
-                              "every sample: a check of the tiles)")
+                              "every sample: a check of the tiles), premultiplied (the image premultiplied, not "
+                              "straight)")
         .def(py::init(&make_options), py::kw_only(), py::arg("width"), py::arg("height"), py::arg("samples") = 2,
              py::arg("mode") = "mc", py::arg("filter") = "box", py::arg("filter_radius") = 0.5, py::arg("seed") = 0,
              py::arg("threads") = 0, py::arg("background") = py::none(), py::arg("interior_samples") = 0,
-             py::arg("brute_force") = false)
+             py::arg("brute_force") = false, py::arg("premultiplied") = false)
         .def_readonly("width", &RenderOptions::width)
         .def_readonly("height", &RenderOptions::height)
         .def_readonly("samples", &RenderOptions::samples)
@@ -369,6 +371,7 @@ PYBIND11_MODULE(_core, m) {
         .def_readonly("threads", &RenderOptions::threads)
         .def_readonly("interior_samples", &RenderOptions::interior_samples)
         .def_readonly("brute_force", &RenderOptions::brute_force)
+        .def_readonly("premultiplied", &RenderOptions::premultiplied)
         .def_property_readonly("background", [](const RenderOptions& o) -> py::object {
             if (!o.has_background) return py::none();
             return py::make_tuple(o.background[0], o.background[1], o.background[2], o.background[3]);

@@ -11,8 +11,10 @@ and retarget, and renders under 7 px on a side; hundreds to thousands of tiny sh
 (below a pixel, off the canvas, radii near 0) refined against small targets; one path of
 3,000 to 60,000 segments rendered at 64 px in either mode (20 s: a hang); dashed strokes
 (valid and hostile stroke-dasharray and stroke-dashoffset on every kind of shape, rendered
-or refined). Clip paths, masks and filters are not drawn yet: their families come when
-they are. The cases run in a worker
+or refined). Clip paths, masks and filters (issue 27): references to themselves, to each
+other in a loop, to nothing; masks and clips nested up to 1,000 deep; huge, zero and
+negative deviations, regions of zero area, offsets past the canvas, unknown steps;
+rendered, refined and listed by info. The cases run in a worker
 process that imports vecfit once and calls the command line's main in-process (click's
 runner): starting a Python that imports torch costs 1-2 s a case. The worker is killed
 and restarted after a signal or a time-out, which are recorded as failures.
@@ -407,6 +409,52 @@ def long_path_svg(rng: random.Random) -> bytes:
     return (f'<svg {NS} width="200" height="200">{defs}<path d="{" ".join(out)} Z" {fill} {stroke}/></svg>').encode()
 
 
+def effects_svg(rng: random.Random) -> bytes:
+    """Clip paths, masks and filters at their edges: loops, missing references, deep
+    nesting, extreme deviations and regions, and ordinary ones on groups and shapes."""
+    defs, body = [], []
+    depth = rng.choice([1, 3, 40, 1000])
+    kind = rng.choice(["clipPath", "mask"])
+    for i in range(depth):  # a chain: each one's content (or the element itself) uses the next
+        ref = f"url(#e{i + 1})" if i + 1 < depth else rng.choice(["url(#e0)", "url(#gone)", "none"])
+        attr = "clip-path" if kind == "clipPath" else "mask"
+        on_self = rng.random() < 0.5
+        child = (f'<rect x="{rng.uniform(-20, 60):.1f}" y="{rng.uniform(-20, 60):.1f}" width="{rng.uniform(0, 80):.1f}" '
+                 f'height="{rng.uniform(0, 80):.1f}" fill="{rng.choice(["white", "#777", "url(#g)"])}"'
+                 + ("" if on_self else f' {attr}="{ref}"') + "/>")
+        units = rng.choice(["", ' clipPathUnits="objectBoundingBox"', ' maskUnits="userSpaceOnUse"',
+                            ' maskContentUnits="objectBoundingBox"', ' transform="scale(0)"'])
+        defs.append(f'<{kind} id="e{i}"{units}' + (f' {attr}="{ref}"' if on_self else "") + f">{child}</{kind}>")
+    std = rng.choice(["0", "-3", "2", "1e6", "1e30", "3 0", "nan", "1e-9"])
+    region = rng.choice(['', ' width="0"', ' height="-5"', ' x="1e30"', ' filterUnits="userSpaceOnUse" '
+                         'x="0" y="0" width="1e9" height="1e9"', ' primitiveUnits="objectBoundingBox"'])
+    steps = [f'<feGaussianBlur stdDeviation="{std}" result="b"/>',
+             f'<feOffset dx="{rng.choice(["5", "-1e9", "0.5"])}" dy="3"/>',
+             '<feFlood flood-color="red" flood-opacity="0.5"/>', '<feComposite in="SourceGraphic" in2="b" operator='
+             f'"{rng.choice(["over", "in", "arithmetic", "bogus"])}" k2="1" k3="1"/>',
+             '<feMerge><feMergeNode in="b"/><feMergeNode in="nowhere"/></feMerge>',
+             f'<feDropShadow stdDeviation="{std}"/>', '<feColorMatrix type="saturate" values="0"/>',
+             '<feBlend mode="multiply" in2="SourceAlpha"/>', '<feTurbulence baseFrequency="0.1"/>']
+    defs.append(f'<filter id="f"{region}>{"".join(rng.sample(steps, rng.randint(0, 4)))}</filter>')
+    defs.append('<linearGradient id="g"><stop offset="0" stop-color="white"/><stop offset="1" '
+                'stop-color="black"/></linearGradient>')
+    for _ in range(rng.randint(1, 6)):
+        effect = rng.choice(['clip-path="url(#e0)"', 'mask="url(#e0)"', 'filter="url(#f)"', 'filter="url(#nope)"',
+                             'clip-path="url(#e0)" filter="url(#f)"', 'style="mask: url(#e0)"', ""])
+        shape = rng.choice([f'<circle cx="{rng.uniform(0, 64):.1f}" cy="{rng.uniform(0, 64):.1f}" r="{rng.uniform(0, 30):.1f}"',
+                            '<path d="M 5 5 C 60 0 0 60 60 60 Z" stroke="#036" stroke-width="3"',
+                            '<rect width="64" height="64" fill="#8a4"'])
+        if rng.random() < 0.4:
+            body.append(f'<g {effect} opacity="0.8">{shape} fill="#c33"/>{shape}/></g>')
+        else:
+            body.append(f'{shape} {effect}/>')
+    nested = rng.random() < 0.2
+    inner = "".join(body)
+    if nested:
+        inner = f'<svg x="8" y="8" width="40" height="40" viewBox="0 0 64 64">{inner}</svg>'
+    return f'<svg {NS} width="64" height="64"><defs>{"".join(defs)}</defs>{inner}</svg>'.encode()
+
+
 # ------------------------------------------------------------------------------ cases
 
 @dataclass
@@ -470,7 +518,27 @@ def make_case(seed: int, index: int, seeds: list[Path] | None = None) -> Case:
                 "--samples", "1", "--threads", "1", "--mode", rng.choice(["mc", "analytic"])]
         return Case(index, "tiny", "refine", args, {"target.png": buf.getvalue(), "init.svg": tiny_shapes_svg(rng)},
                     timeout=60, outputs=["out.svg", "out.report.json", "out.compare.png"])
-    if roll < 0.22:  # one very long path at 64 px (a hang: 20 s)
+    if roll < 0.28:  # clip paths, masks and filters: rendered in either mode, listed, refined
+        svg = effects_svg(rng)
+        command = rng.choice(["render", "render", "info", "refine"])
+        if command == "info":
+            return Case(index, "effects", "info", ["info", "in.svg"], {"in.svg": svg})
+        if command == "refine":
+            import io
+
+            import numpy as np
+            from PIL import Image
+            buf = io.BytesIO()
+            Image.fromarray((np.random.default_rng(index).random((32, 32, 3)) * 255).astype(np.uint8)).save(buf, "PNG")
+            args = ["refine", "target.png", "in.svg", "-o", "out.svg", "--iterations", "2", "-q", "--samples", "1",
+                    "--threads", "1", "--mode", rng.choice(["mc", "analytic"])]
+            return Case(index, "effects", "refine", args, {"target.png": buf.getvalue(), "in.svg": svg},
+                        timeout=60, outputs=["out.svg", "out.report.json", "out.compare.png"])
+        mode = rng.choice(["mc", "analytic"])
+        return Case(index, "effects", "render", ["render", "in.svg", "-o", "out.png", "--width", "64", "--mode", mode,
+                                                 "--samples", "1", "--threads", "1"],
+                    {"in.svg": svg}, timeout=20, outputs=["out.png"])
+    if roll < 0.31:  # one very long path at 64 px (a hang: 20 s)
         mode = rng.choice(["mc", "analytic"])
         return Case(index, "longpath", "render", ["render", "in.svg", "-o", "out.png", "--width", "64", "--mode", mode,
                                                   "--samples", "1", "--threads", "1"],

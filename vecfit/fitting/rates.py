@@ -9,7 +9,7 @@ import numpy as np
 import torch
 
 from vecfit.scene.geometry import local_bbox_size
-from vecfit.scene.placement import shape_matrices
+from vecfit.scene.placement import canvas_matrix, group_matrices, shape_matrices
 from vecfit.scene import LinearGradient, RadialGradient, Scene
 
 from .adam import ParameterKind
@@ -27,10 +27,11 @@ def shape_pixel_scales(scene: Scene, width: int, height: int) -> np.ndarray:
     return torch.sqrt(torch.abs(det)).numpy().astype(np.float64)
 
 
-def learning_rate_scales(scene: Scene, width: int, height: int) -> dict[int, float]:
-    """Units of each length tensor per pixel of the rendered image, keyed by id(tensor)."""
+def learning_rate_scales(scene: Scene, width: int, height: int, out: dict | None = None) -> dict[int, float]:
+    """Units of each length tensor per pixel of the rendered image, keyed by id(tensor);
+    those of clip paths' and masks' shapes too, through the element that uses them."""
     pixels_per_unit = shape_pixel_scales(scene, width, height)
-    out: dict[int, float] = {}
+    out = {} if out is None else out
 
     def put(t, ppu):
         if t is not None and id(t) not in out and ppu > 0 and math.isfinite(ppu):
@@ -48,7 +49,27 @@ def learning_rate_scales(scene: Scene, width: int, height: int) -> dict[int, flo
                     gppu *= local_bbox_size(g) or 0.0
                 for name in ("start", "end", "center", "focal", "radius"):
                     put(getattr(paint, name, None), gppu)
+    _effect_scales(scene, width, height, out)
     return out
+
+
+def _effect_scales(scene: Scene, width: int, height: int, out: dict) -> None:
+    """The scales of what clip paths and masks draw: their content is placed by the
+    element that uses it (a clip path used by several takes the first's)."""
+    with torch.no_grad():
+        canvas = canvas_matrix(scene, width, height)
+        groups = group_matrices(scene, canvas)
+        shapes = shape_matrices(scene, width, height)
+        owners = [(g, groups[i]) for i, g in enumerate(scene.groups)]
+        owners += [(s, shapes[i]) for i, s in enumerate(scene.shapes)]
+        for owner, matrix in owners:
+            for effect in (owner.clip, owner.mask):
+                while effect is not None:
+                    content = effect.content
+                    placed = Scene(width=width, height=height, shapes=content.shapes, groups=content.groups,
+                                   view=matrix @ content.view.float())
+                    learning_rate_scales(placed, width, height, out)
+                    effect = getattr(effect, "clip", None) or getattr(effect, "mask", None)
 
 
 def parameter_kinds(scene: Scene, lr: dict, width: int, height: int, fixed_alpha: bool = False,

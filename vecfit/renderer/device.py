@@ -71,4 +71,6 @@ def build_summary() -> str:
         f"CPU threads: {info['hardware_threads']}",
         info["cuda"],
         f"device auto resolves to: {device_name(resolve('auto'))}",
+        "clip paths, masks, filters, blend modes: each layer's passes on the chosen device; "
+        "layers composited, filtered and blended on the CPU (torch)",
     ])

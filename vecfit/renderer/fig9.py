@@ -11,7 +11,7 @@ import copy
 import torch
 
 from vecfit.renderer.raster import render
-from vecfit.scene import Circle, Ellipse, Path, Rect, Scene
+from vecfit.scene import Circle, ClipPath, Ellipse, Path, Rect, Scene
 
 
 def weighting(seed: int, height: int, width: int, border: float = 4.0) -> torch.Tensor:
@@ -25,9 +25,11 @@ def weighting(seed: int, height: int, width: int, border: float = 4.0) -> torch.
     return (w * ry[None, :, None] * rx[None, None, :]).permute(1, 2, 0)
 
 
-def shifted(scene: Scene, dx: torch.Tensor, keep=None) -> Scene:
+def shifted(scene: Scene, dx: torch.Tensor, keep=None, _copies=None) -> Scene:
     """A copy of the scene whose every geometry point (in its shape's own space) is moved
-    by (dx, 0). keep(i, shape) -> False drops shape i (for bisecting by shape)."""
+    by (dx, 0), those of its clip paths and masks included. keep(i, shape) -> False drops
+    shape i (for bisecting by shape)."""
+    copies = {} if _copies is None else _copies  # id(clip or mask) -> its moved copy
     out = copy.copy(scene)
     step = torch.stack([dx, torch.zeros_like(dx)])
     shapes = []
@@ -43,9 +45,26 @@ def shifted(scene: Scene, dx: torch.Tensor, keep=None) -> Scene:
         elif isinstance(g, (Circle, Ellipse)):
             g.center = g.center.detach() + step
         s.geometry = g
+        s.clip, s.mask = _shifted_effect(s.clip, dx, copies), _shifted_effect(s.mask, dx, copies)
         shapes.append(s)
     out.shapes = shapes
+    out.groups = [copy.copy(g) for g in scene.groups]
+    for g in out.groups:
+        g.clip, g.mask = _shifted_effect(g.clip, dx, copies), _shifted_effect(g.mask, dx, copies)
     return out
+
+
+def _shifted_effect(effect, dx, copies):
+    if effect is None:
+        return None
+    if id(effect) not in copies:
+        moved = copies[id(effect)] = copy.copy(effect)
+        moved.content = shifted(effect.content, dx, None, copies)
+        if isinstance(effect, ClipPath):
+            moved.clip = _shifted_effect(effect.clip, dx, copies)
+        else:
+            moved.mask = _shifted_effect(effect.mask, dx, copies)
+    return copies[id(effect)]
 
 
 def weighted(image: torch.Tensor, W: torch.Tensor) -> torch.Tensor:

@@ -19,7 +19,8 @@ class RenderOptions:
     filter and filter_radius: the pixel filter (box always covers exactly the pixel);
     seed; threads (0: all cores); background: None or straight RGBA; interior_samples:
     of the N x N, those the Monte Carlo backward pass revisits (0: all); brute_force:
-    every draw tested at every sample (a check of the tiles, for tests)."""
+    every draw tested at every sample (a check of the tiles, for tests); premultiplied:
+    the image as premultiplied RGBA (the layers of renderer/layers.py)."""
     width: int
     height: int
     samples: int = 2
@@ -31,6 +32,7 @@ class RenderOptions:
     background: tuple | None = None
     interior_samples: int = 0
     brute_force: bool = False
+    premultiplied: bool = False
 
     def __post_init__(self):
         check_options(self.samples, self.mode, self.filter, self.filter_radius)
@@ -44,7 +46,8 @@ class RenderOptions:
             width=int(self.width), height=int(self.height), samples=int(self.samples), mode=self.mode,
             filter=self.filter, filter_radius=float(self.filter_radius), seed=int(self.seed),
             threads=int(self.threads or 0), background=None if bg is None else [float(v) for v in bg],
-            interior_samples=int(self.interior_samples), brute_force=bool(self.brute_force))
+            interior_samples=int(self.interior_samples), brute_force=bool(self.brute_force),
+            premultiplied=bool(self.premultiplied))
 
 
 def check_options(samples, mode: str, filter: str, filter_radius: float) -> None:

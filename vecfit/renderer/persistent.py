@@ -163,6 +163,8 @@ class PersistentPack:
     def build(cls, scene: Scene, width: int, height: int, kinds: list[FlatTensors]) -> "PersistentPack | None":
         """The pack of ``scene`` at width x height whose floats follow the values in
         ``kinds`` (side by side, in order), or None where they are not affine in them."""
+        if scene.has_effects():  # drawn in layers (renderer/layers.py), several packs a render
+            return None
         kinds = list(kinds)
         if any(s.stroke is not None and dash_pattern(s.dash_array) is not None for s in scene.shapes):
             return None  # dashes: the segments and draws change as the points move

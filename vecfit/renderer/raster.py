@@ -112,7 +112,7 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
            samples: int = 2, mode: str = "mc", filter: str = "box", filter_radius: float = 0.5,
            seed: int = 0, background=None, threads: int | None = None, boundary_samples: float = 2.0,
            interior_samples: int = 0, device: str = "cpu", packed: tuple | None = None,
-           _brute_force: bool = False, _gpu_lists: bool = False) -> torch.Tensor:
+           _brute_force: bool = False, _gpu_lists: bool = False, _premultiplied: bool = False) -> torch.Tensor:
     """Render ``scene`` into an [H, W, 4] float tensor of straight RGBA.
 
     samples: N means N x N stratified samples per pixel (jittered in "mc" mode, at the
@@ -137,13 +137,23 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     then follow those arrays, and the scene gives only its size.
 
     (_brute_force and _gpu_lists are for tests: every draw tested at every sample, and the
-    CPU backward pass run first with a GPU thread's list sizes, see backward_fallbacks.)
+    CPU backward pass run first with a GPU thread's list sizes, see backward_fallbacks.
+    _premultiplied: the image as premultiplied RGBA, for the layers of layers.py.)
     """
     width, height = output_size(scene, width, height)
+    if packed is None and scene.has_effects():  # clip paths, masks, filters: in layers
+        from .layers import render_layered
+
+        def draw(sub: Scene, number: int) -> torch.Tensor:
+            layer_seed = (int(seed) + 1_000_003 * number) % (1 << 62)
+            return render(sub, samples=samples, mode=mode, filter=filter, filter_radius=filter_radius, seed=layer_seed,
+                          threads=threads, boundary_samples=boundary_samples, interior_samples=interior_samples,
+                          device=device, _brute_force=_brute_force, _gpu_lists=_gpu_lists, _premultiplied=True)
+        return render_layered(scene, width, height, draw, background_rgba(background))
     options = RenderOptions(width, height, samples=int(samples), mode=mode, filter=filter,
                             filter_radius=float(filter_radius), seed=int(seed), threads=int(threads or 0),
                             background=background_rgba(background), interior_samples=int(interior_samples),
-                            brute_force=bool(_brute_force))
+                            brute_force=bool(_brute_force), premultiplied=bool(_premultiplied))
     if packed is None:
         structure, floats = packed_for_core(scene, width, height)
     else:

@@ -2,8 +2,10 @@
 reader and writer, which both speak it. ``model`` holds the types, ``geometry`` a shape's
 own-space geometry, ``placement`` where shapes land on a canvas, ``summary`` what
 `vecfit info` lists."""
-from .model import (CUBIC, LINE, QUADRATIC, Circle, Ellipse, Geometry, Group, LinearGradient, Paint, Path,
-                    RadialGradient, Rect, Scene, Shape, Solid, as_tensor, identity)
+from .model import (BLEND_MODES, CUBIC, LINE, QUADRATIC, Circle, ClipPath, Ellipse, Filter, FilterStep,
+                    Geometry, Group, LinearGradient, Mask, Paint, Path, RadialGradient, Rect, Scene, Shape,
+                    Solid, as_tensor, identity)
 
-__all__ = ["CUBIC", "LINE", "QUADRATIC", "Circle", "Ellipse", "Geometry", "Group", "LinearGradient", "Paint",
-           "Path", "RadialGradient", "Rect", "Scene", "Shape", "Solid", "as_tensor", "identity"]
+__all__ = ["BLEND_MODES", "CUBIC", "LINE", "QUADRATIC", "Circle", "ClipPath", "Ellipse", "Filter", "FilterStep",
+           "Geometry", "Group", "LinearGradient", "Mask", "Paint", "Path", "RadialGradient", "Rect", "Scene",
+           "Shape", "Solid", "as_tensor", "identity"]

@@ -6,8 +6,8 @@ from collections import Counter
 import numpy as np
 import torch
 
-from .model import (CUBIC, LINE, QUADRATIC, Circle, Ellipse, LinearGradient, Path,
-                                   RadialGradient, Rect, Scene, Solid)
+from .model import (CUBIC, LINE, QUADRATIC, Circle, ClipPath, Ellipse, LinearGradient, Mask, Path,
+                    RadialGradient, Rect, Scene, Solid)
 
 _GEOMETRY = ((Path, "path"), (Rect, "rect"), (Circle, "circle"), (Ellipse, "ellipse"))
 _PAINTS = ((Solid, "solid"), (LinearGradient, "linear"), (RadialGradient, "radial"))
@@ -75,6 +75,26 @@ def _opacity(scene: Scene) -> str:
             f"shapes with opacity < 1: {shapes}")
 
 
+def _effects(scene: Scene) -> list[str]:
+    """Clip paths, masks and filters: how many of each, what uses them, and what they hold."""
+    owners = [*scene.shapes, *scene.groups]
+    lines = []
+    for attr, label in (("clip", "clip paths"), ("mask", "masks"), ("filter", "filters")):
+        used = [getattr(o, attr) for o in owners if getattr(o, attr) is not None]
+        distinct = {id(e): e for e in used}.values()
+        if not distinct:
+            continue
+        names = ", ".join(str(e.source) for e in list(distinct)[:_SHOWN] if e.source is not None)
+        if attr == "filter":
+            steps = Counter(step.kind for e in distinct for step in e.steps)
+            detail = ", ".join(f"{n} {k}" for k, n in sorted(steps.items())) or "no steps"
+        else:
+            detail = f"{sum(len(e.content.shapes) for e in distinct)} shapes drawn in them"
+        lines.append(f"{label}: {len(distinct)} on {len(used)} shapes and groups ({detail})"
+                     + (f": {names}" if names else ""))
+    return lines
+
+
 def _skipped(scene: Scene) -> list[str]:
     if not scene.skipped:
         return ["skipped: nothing"]
@@ -88,7 +108,8 @@ def _skipped(scene: Scene) -> list[str]:
 
 def summarize(scene: Scene) -> str:
     """Counts of shapes by geometry, segments by degree, paints by kind, groups and
-    opacity layers, the canvas and view, and what the reader skipped."""
+    opacity layers, clip paths, masks and filters, the canvas and view, and what the
+    reader skipped."""
     kinds = Counter(_kind(s.geometry, _GEOMETRY) for s in scene.shapes)
     unpainted = sum(1 for s in scene.shapes if s.fill is None and s.stroke is None)
     lines = _canvas(scene)
@@ -97,5 +118,6 @@ def summarize(scene: Scene) -> str:
     lines.append(_segments(scene))
     lines += _paints(scene)
     lines.append(_opacity(scene))
+    lines += _effects(scene)
     lines += _skipped(scene)
     return "\n".join(lines)

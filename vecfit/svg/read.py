@@ -22,10 +22,11 @@ import torch
 
 from vecfit import limits
 from vecfit.errors import SvgError
-from vecfit.scene import Group, Scene, Shape
+from vecfit.scene import BLEND_MODES, ClipPath, Filter, Group, Mask, Rect, Scene, Shape
 from vecfit.scene.dashes import dash_count, dash_pattern, outline_path
 
-from .paints import BLACK, Paints, parse_opacity, parse_paint
+from .effects import func_iri, parse_filter, region, units_of
+from .paints import BLACK, Paints, parse_opacity, parse_paint, solid
 from .color import parse_color
 from .document import SvgDocument
 from .dom import href_id, is_svg, local_name
@@ -55,6 +56,9 @@ MAX_ELEMENTS = limits.MAX_ELEMENTS
 MAX_SEGMENTS = limits.MAX_SEGMENTS
 # Elements nested in each other (Python's recursion would fail around 300).
 MAX_NESTING = 200
+# Clip paths and masks whose content uses clip paths or masks, ... (each level is a
+# layer of every render).
+MAX_EFFECT_NESTING = 16
 
 
 def load_svg(path) -> Scene:
@@ -120,6 +124,13 @@ class Reader:
         self.paints = Paints(self.ids, document.computed, self.viewport, self.skips.add)
         self.shapes: list[Shape] = []
         self.groups: list[Group] = []
+        # Clip paths, masks and filters read so far (by element: one object per element,
+        # shared by every reference), those being read (a reference to one of them is a
+        # loop), and whether a clip path's content is being read.
+        self._effects: dict[tuple[str, int], object] = {}
+        self._reading: tuple[int, ...] = ()
+        self._in_clip = False
+        self._loops = _looping_references(self.root, self.ids, document.computed)
 
     # --------------------------------------------------------------- document
 
@@ -162,8 +173,9 @@ class Reader:
             transform = parse_transform(self.root.get("transform"))
             opacity = parse_opacity(style.get("opacity"))
             if not _singular(transform):
-                if opacity < 1 or transform is not None:
-                    group = self._group(transform, opacity, -1, self.root)
+                effects = self._layer_effects(self.root, style)
+                if opacity < 1 or transform is not None or effects != NO_EFFECTS:
+                    group = self._group(transform, opacity, -1, self.root, effects)
                 self._children(self.root, style, group, ())
         lim = Limiter()
         view = lim.tensor(self.view)
@@ -198,40 +210,147 @@ class Reader:
         transform = parse_transform(element.get("transform"))
         if _singular(transform):
             return  # SVG: a non-invertible transform draws nothing
-        self._note_layer_effects(element, style)
+        if self._in_clip and tag not in SHAPES and tag != "use":
+            return  # a clip path draws only shapes, directly or through <use>
+        effects = self._layer_effects(element, style)
         if tag in CONTAINERS:
-            g = self._group(transform, parse_opacity(style.get("opacity")), group, element)
+            g = self._group(transform, parse_opacity(style.get("opacity")), group, element, effects)
             self._children(element, style, g, stack, depth)
         elif tag == "switch":
-            g = self._group(transform, parse_opacity(style.get("opacity")), group, element)
+            g = self._group(transform, parse_opacity(style.get("opacity")), group, element, effects)
             child = _switch_choice(element)
             if child is not None:
                 self._element(child, style, g, stack, depth + 1)
         elif tag == "use":
-            self._use(element, style, transform, group, stack, depth)
+            self._use(element, style, transform, group, stack, depth, effects)
         elif tag == "svg":
-            self._nested_svg(element, element, style, transform, group, stack, depth)
+            self._nested_svg(element, element, style, transform, group, stack, depth, effects)
         else:
-            self._shape(tag, element, style, transform, group)
+            self._shape(tag, element, style, transform, group, effects)
 
-    def _note_layer_effects(self, element, style):
-        for prop in ("clip-path", "mask", "filter"):
-            value = (style.get(prop) or "none").strip()
-            if value != "none":
-                self.skips.add(prop, _name(element))
+    # ---------------------------------------------------- clip paths, masks, filters
 
-    def _group(self, transform, opacity, parent, element) -> int:
+    def _layer_effects(self, element, style) -> tuple:
+        """(clip, mask, filter, blend mode, isolated) of an element. A reference that leads
+        nowhere (or back to the clip path or mask being read) is left out with a warning,
+        as resvg does; a filter reference that leads nowhere gives a filter without steps:
+        SVG draws the element as nothing."""
+        name = _name(element)
+        clip = self._reference(style, "clip-path", "clipPath", name, self._clip_path, element)
+        if self._in_clip:
+            return clip, None, None, "normal", False  # a clip path's shapes take none of the rest
+        blend = (style.get("mix-blend-mode") or "normal").strip()
+        if blend not in BLEND_MODES:
+            self.skips.add("mix-blend-mode", f"{name} ({blend[:20]})")
+            blend = "normal"
+        isolate = (style.get("isolation") or "").strip() == "isolate"
+        mask = self._reference(style, "mask", "mask", name, self._mask, element)
+        value = (style.get("filter") or "none").strip()
+        filt = None
+        if value != "none":
+            ref = func_iri(value)
+            target = self.ids.get(ref) if ref else None
+            if ref is None:
+                self.skips.add("filter", f"{name} ({value[:40]})")
+            elif target is None or local_name(target.tag) != "filter":
+                self.skips.add("filter reference", f"{name} (no <filter> #{ref})")
+                filt = _NO_FILTER
+            else:
+                key = ("filter", id(target))
+                if key not in self._effects:
+                    self._effects[key] = parse_filter(target, self.ids, self.document.computed, self.viewport,
+                                                      self.skips.add, name)
+                filt = self._effects[key]
+        return clip, mask, filt, blend, isolate
+
+    def _reference(self, style, prop: str, tag: str, name: str, build, element=None):
+        value = (style.get(prop) or "none").strip()
+        if value == "none":
+            return None
+        if element is not None and (id(element), prop) in self._loops:
+            self.skips.add(prop, f"{name} ({value[:40]} leads back to itself)")
+            return None
+        ref = func_iri(value)
+        if ref is None:
+            self.skips.add(prop, f"{name} ({value[:40]})")  # CSS shapes and other forms
+            return None
+        target = self.ids.get(ref)
+        if target is None or not is_svg(target) or local_name(target.tag) != tag:
+            self.skips.add(prop, f"{name} (no <{tag}> #{ref})")
+            return None
+        if id(target) in self._reading:
+            self.skips.add(prop, f"{name} (#{ref} refers back to itself)")
+            return None
+        if len(self._reading) >= MAX_EFFECT_NESTING:
+            self.skips.add(prop, f"{name} (nested more than {MAX_EFFECT_NESTING} deep)")
+            return None
+        key = (tag, id(target))
+        if key not in self._effects:
+            self._reading += (id(target),)
+            try:
+                self._effects[key] = build(target)
+            finally:
+                self._reading = self._reading[:-1]
+        return self._effects[key]
+
+    def _content(self, element, clip: bool) -> Scene:
+        """What a <clipPath> or <mask> draws, as a Scene of its own (in the user space of
+        the element that references it)."""
+        saved = self.shapes, self.groups, self._in_clip
+        self.shapes, self.groups, self._in_clip = [], [], clip
+        try:
+            self._children(element, self.document.computed(element), -1, ())
+            return Scene(width=self.width, height=self.height, shapes=self.shapes, groups=self.groups)
+        finally:
+            self.shapes, self.groups, self._in_clip = saved
+
+    def _clip_path(self, element) -> ClipPath:
+        transform = parse_transform(element.get("transform"))
+        content = self._content(element, clip=True)
+        if _singular(transform):
+            content.shapes, content.groups = [], []  # draws nothing: lets nothing through
+        elif transform is not None:
+            content.view = torch.tensor(transform, dtype=torch.float32)
+        clip = ClipPath(content=content, units=units_of(element, "clipPathUnits", "userSpaceOnUse"),
+                        source=self.document.handle_of(element))
+        clip.clip = self._reference(self.document.computed(element), "clip-path", "clipPath", _name(element),
+                                    self._clip_path, element)
+        return clip
+
+    def _mask(self, element) -> Mask:
+        style = self.document.computed(element)
+        units = units_of(element, "maskUnits", "objectBoundingBox")
+        kind = "alpha" if (style.get("mask-type") or "").strip() == "alpha" else "luminance"
+        mask = Mask(content=self._content(element, clip=False), kind=kind, units=units,
+                    content_units=units_of(element, "maskContentUnits", "userSpaceOnUse"),
+                    region=region(element, units, self.viewport), source=self.document.handle_of(element))
+        mask.mask = self._reference(style, "mask", "mask", _name(element), self._mask, element)
+        return mask
+
+    def _viewport_clip(self, width: float, height: float, inverse_view) -> ClipPath:
+        """The clip of a nested <svg> or <symbol> instance to its viewport (overflow
+        hidden): a rect 0, 0, width, height before the viewBox's mapping."""
+        rect = Shape(geometry=Rect(p_min=torch.zeros(2), p_max=torch.tensor([float(width), float(height)])),
+                     fill=solid(BLACK))
+        view = torch.eye(3) if inverse_view is None else torch.tensor(inverse_view, dtype=torch.float32)
+        return ClipPath(content=Scene(width=self.width, height=self.height, shapes=[rect], view=view))
+
+    def _group(self, transform, opacity, parent, element, effects=None) -> int:
         lim = Limiter()
         m = torch.eye(3) if transform is None else lim.tensor(transform)
         if lim.clamped:
             self.skips.add("out-of-range numbers", _name(element))
-        self.groups.append(Group(transform=m, opacity=torch.tensor(float(opacity)),
-                                 parent=parent, source=self.document.handle_of(element)))
+        if self._in_clip:
+            opacity = 1.0  # a clip path's content has no opacity
+        clip, mask, filt, blend, isolate = effects or NO_EFFECTS
+        self.groups.append(Group(transform=m, opacity=torch.tensor(float(opacity)), parent=parent,
+                                 source=self.document.handle_of(element), clip=clip, mask=mask, filter=filt,
+                                 blend=blend, isolate=isolate))
         return len(self.groups) - 1
 
     # ------------------------------------------------------------- references
 
-    def _use(self, element, style, transform, group, stack, depth):
+    def _use(self, element, style, transform, group, stack, depth, effects):
         name = _name(element)
         ref = href_id(element)
         target = self.ids.get(ref) if ref else None
@@ -241,10 +360,12 @@ class Reader:
         if id(target) in stack or any(e is element for e in target.iter()):
             self.skips.add("use", f"{name} (recursive)")
             return
+        if self._in_clip and local_name(target.tag) not in SHAPES:
+            return  # in a clip path, a <use> draws a shape or nothing
         x = parse_length(element.get("x"), self.viewport[0]) or 0.0
         y = parse_length(element.get("y"), self.viewport[1]) or 0.0
         m = (transform if transform is not None else np.eye(3)) @ translate(x, y)
-        g = self._group(m, parse_opacity(style.get("opacity")), group, element)
+        g = self._group(m, parse_opacity(style.get("opacity")), group, element, effects)
         stack = stack + (id(target),)
         tag = local_name(target.tag)
         if tag in ("symbol", "svg"):
@@ -255,7 +376,7 @@ class Reader:
         else:
             self._element(target, style, g, stack, depth + 1)
 
-    def _nested_svg(self, element, sizer, style, transform, group, stack, depth):
+    def _nested_svg(self, element, sizer, style, transform, group, stack, depth, effects=None):
         """A nested <svg> or an instanced <symbol>: a group mapping its viewBox onto its
         viewport (width and height from ``sizer``, the element or the <use>)."""
         vw, vh = self.viewport
@@ -268,18 +389,23 @@ class Reader:
             return
         m = (transform if transform is not None else np.eye(3)) @ translate(x, y)
         vb = parse_viewbox(element.get("viewBox"))
+        inverse_view = None
         if vb is not None:
             if vb[2] <= 0 or vb[3] <= 0:
                 return
-            m = m @ view_transform(vb, w, h, element.get("preserveAspectRatio"))
-        if (style.get("overflow") or "hidden").strip() in ("hidden", "scroll"):
-            self.skips.add("svg viewport clipping", _name(element))
-        g = self._group(m, parse_opacity(style.get("opacity")), group, element)
+            view = view_transform(vb, w, h, element.get("preserveAspectRatio"))
+            m = m @ view
+            inverse_view = np.linalg.inv(view)
+        clip, mask, filt, blend, isolate = effects or NO_EFFECTS
+        if (style.get("overflow") or "hidden").strip() in ("hidden", "scroll") and not self._in_clip:
+            viewport = self._viewport_clip(w, h, inverse_view)
+            viewport.clip, clip = clip, viewport
+        g = self._group(m, parse_opacity(style.get("opacity")), group, element, (clip, mask, filt, blend, isolate))
         self._children(element, style, g, stack, depth)
 
     # ----------------------------------------------------------------- shapes
 
-    def _shape(self, tag, element, style, transform, group):
+    def _shape(self, tag, element, style, transform, group, effects=None):
         name = _name(element)
         lim = Limiter()
         reader = ShapeReader(self.viewport, lim, max_segments=MAX_SEGMENTS - self._segments)
@@ -298,6 +424,10 @@ class Reader:
         width = 1.0 if width is None else width
         if width <= 0:
             stroke = None  # SVG: zero or negative width draws no stroke
+        rule_property = "fill-rule"
+        if self._in_clip:  # a clip path's shapes are filled, opaque, with their clip-rule
+            fill, stroke, rule_property = solid(BLACK), None, "clip-rule"
+            style = {k: v for k, v in style.items() if k not in ("opacity", "fill-opacity")}
         # A shape with neither paint is kept: it draws nothing, but the Scene stays one
         # shape per drawable element (counts, write-back).
         self._note_shape_effects(tag, style, name, stroked=stroke is not None)
@@ -305,7 +435,7 @@ class Reader:
         shape = Shape(
             geometry=geometry, fill=fill, stroke=stroke,
             stroke_width=lim.tensor(width),
-            fill_rule="evenodd" if (style.get("fill-rule") or "").strip() == "evenodd" else "nonzero",
+            fill_rule="evenodd" if (style.get(rule_property) or "").strip() == "evenodd" else "nonzero",
             linecap=_choice(style.get("stroke-linecap"), CAPS, "butt"),
             linejoin=JOINS.get((style.get("stroke-linejoin") or "").strip(), "miter"),
             miter_limit=_miter_limit(style.get("stroke-miterlimit")),
@@ -314,7 +444,8 @@ class Reader:
             stroke_opacity=torch.tensor(parse_opacity(style.get("stroke-opacity"))),
             transform=torch.eye(3) if transform is None else lim.tensor(transform),
             group=group, source=self.document.handle_of(element),
-            dash_array=dash_array, dash_offset=dash_offset)
+            dash_array=dash_array, dash_offset=dash_offset,
+            **dict(zip(("clip", "mask", "filter", "blend"), (effects or NO_EFFECTS)[:4])))
         if lim.clamped:
             self.skips.add("out-of-range numbers", name)
         self.shapes.append(shape)
@@ -351,6 +482,44 @@ class Reader:
     def _diagonal(self) -> float:
         vw, vh = self.viewport
         return math.sqrt((vw * vw + vh * vh) / 2)
+
+
+# (clip, mask, filter, blend mode, isolated) of an element without them.
+NO_EFFECTS = (None, None, None, "normal", False)
+# A filter reference that leads nowhere: SVG (and resvg) then draws the element as nothing.
+_NO_FILTER = Filter(steps=[])
+
+
+def _looping_references(root, ids, computed) -> set[tuple[int, str]]:
+    """(element, property) of the references that make clip paths or masks loop, found
+    as resvg finds them (so that which one of a loop is cut is resvg's choice): for each
+    <clipPath> or <mask> in document order, the first element in it (itself included)
+    whose reference leads back to it, directly or through one other."""
+    cut: set[tuple[int, str]] = set()
+
+    def target(element, prop):
+        if (id(element), prop) in cut:
+            return None
+        ref = func_iri((computed(element).get(prop) or "").strip())
+        return ids.get(ref) if ref else None
+
+    for tag, prop in (("clipPath", "clip-path"), ("mask", "mask")):
+        holders = [e for e in root.iter() if isinstance(e.tag, str) and local_name(e.tag) == tag]
+        found = True
+        while found:
+            found = False
+            for node in holders:
+                for child in node.iter():
+                    link = target(child, prop)
+                    culprit = child if link is node else next(
+                        (e for e in (link.iter() if link is not None else ()) if target(e, prop) is node), None)
+                    if culprit is not None:
+                        cut.add((id(culprit), prop))
+                        found = True
+                        break
+                if found:
+                    break
+    return cut
 
 
 def _choice(text, allowed, default):

@@ -17,10 +17,11 @@ INHERITED = frozenset({
     "fill", "fill-opacity", "fill-rule", "stroke", "stroke-width", "stroke-opacity",
     "stroke-linecap", "stroke-linejoin", "stroke-miterlimit", "stroke-dasharray",
     "stroke-dashoffset", "color", "visibility", "marker-start", "marker-mid", "marker-end",
+    "clip-rule", "color-interpolation-filters",
 })
 NOT_INHERITED = frozenset({
     "opacity", "display", "stop-color", "stop-opacity", "clip-path", "mask", "filter",
-    "overflow",
+    "overflow", "mask-type", "flood-color", "flood-opacity", "mix-blend-mode", "isolation",
 })
 PROPERTIES = INHERITED | NOT_INHERITED
 

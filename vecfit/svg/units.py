@@ -88,6 +88,8 @@ def parse_transform(text) -> np.ndarray | None:
     """
     if text is None or not text.strip():
         return None
+    if not _valid_transform_list(text):
+        return None  # as resvg: a list with any error is no transform at all
     try:
         m = svgelements.Matrix(text)
     except Exception:  # svgelements raises assorted errors on malformed lists
@@ -96,6 +98,30 @@ def parse_transform(text) -> np.ndarray | None:
     if not np.isfinite(out).all():
         return None
     return out
+
+
+_TRANSFORM_ARITY = {"matrix": (6,), "translate": (1, 2), "scale": (1, 2), "rotate": (1, 3), "skewX": (1,),
+                    "skewY": (1,)}
+_WSP = r"[ \t\r\n\f]"
+_COMMA_WSP = rf"(?:{_WSP}+,?{_WSP}*|,{_WSP}*)"
+_TRANSFORM_ITEM = re.compile(rf"{_WSP}*([A-Za-z]+){_WSP}*\({_WSP}*((?:{NUMBER}(?:{_COMMA_WSP}(?={NUMBER}|[-+.\d]))?)*)"
+                             rf"{_WSP}*\)(?:{_WSP}*,?{_WSP}*)")
+
+
+def _valid_transform_list(text: str) -> bool:
+    """Whether ``text`` is a transform list by SVG's grammar: known functions with their
+    numbers of arguments, separated by commas or whitespace (svgelements reads more: it
+    takes "translate(0,5, 0,5)" and "scale(2,,2)", where browsers and resvg take none)."""
+    pos = 0
+    while pos < len(text):
+        m = _TRANSFORM_ITEM.match(text, pos)
+        if m is None or m.end() == pos:
+            return not text[pos:].strip(" \t\r\n\f")
+        numbers = _NUMBER_RE.findall(m.group(2))
+        if m.group(1) not in _TRANSFORM_ARITY or len(numbers) not in _TRANSFORM_ARITY[m.group(1)]:
+            return False
+        pos = m.end()
+    return True
 
 
 def translate(x: float, y: float) -> np.ndarray:

@@ -200,9 +200,11 @@ def svg_bytes(scene: Scene, document, *, full: bool = False, background=None,
     elif document.original is None:
         scene_of(document)
     original = document.original
-    if (len(original.shapes) != len(scene.shapes) or len(original.groups) != len(scene.groups)
-            or any(a.source != b.source for a, b in zip(original.shapes, scene.shapes))
-            or any(a.source != b.source for a, b in zip(original.groups, scene.groups))):
+    shapes, groups = _written(scene)
+    shapes_before, groups_before = _written(original)
+    if (len(shapes_before) != len(shapes) or len(groups_before) != len(groups)
+            or any(a.source != b.source for a, b in zip(shapes_before, shapes))
+            or any(a.source != b.source for a, b in zip(groups_before, groups))):
         raise VecfitError(f"{document.name}: the scene was not read from this file "
                           f"(its shapes and groups do not match)")
 
@@ -210,7 +212,7 @@ def svg_bytes(scene: Scene, document, *, full: bool = False, background=None,
     writer = _Writer(doc, document.viewport, full)
 
     done: set = set()
-    for shape, orig in zip(scene.shapes, original.shapes):
+    for shape, orig in zip(shapes, shapes_before):
         if shape.source in done:
             continue  # <use> instances of an element already written
         if writer.shape(shape, orig):
@@ -220,18 +222,18 @@ def svg_bytes(scene: Scene, document, *, full: bool = False, background=None,
         warnings.warn(f"SVG has no per-point stroke widths: {len(writer.averaged)} path(s) ({names}) "
                       f"written with the mean of their widths as stroke-width", VecfitWarning, stacklevel=3)
     done = set()
-    for group, orig in zip(scene.groups, original.groups):
+    for group, orig in zip(groups, groups_before):
         if group.source in done:
             continue
         if writer.group(group, orig):
             done.add(group.source)
     gradients_before = {}
-    for s in original.shapes:
+    for s in shapes_before:
         for p in (s.fill, s.stroke):
             if isinstance(p, (LinearGradient, RadialGradient)):
                 gradients_before.setdefault(p.source, p)
     written = set()
-    for s in scene.shapes:
+    for s in shapes:
         for p in (s.fill, s.stroke):
             if isinstance(p, (LinearGradient, RadialGradient)) and p.source not in written:
                 before = gradients_before.get(p.source)
@@ -244,6 +246,16 @@ def svg_bytes(scene: Scene, document, *, full: bool = False, background=None,
     if background is not None:
         _add_background(doc.root, background)
     return doc.serialize()
+
+
+def _written(scene: Scene) -> tuple[list, list]:
+    """The shapes and groups whose elements the writer updates: the drawing's, then those
+    of its clip paths and masks (optimised clip geometry goes back into the clip path)."""
+    shapes, groups = list(scene.shapes), list(scene.groups)
+    for content, _ in scene.effect_contents():
+        shapes += content.shapes
+        groups += content.groups
+    return shapes, groups
 
 
 def _set_canvas(root, size, before) -> None:

@@ -428,7 +428,8 @@ def test_use_style_inheritance_comes_from_the_use_not_the_original_parent():
 
 
 def test_use_of_symbol_and_nested_svg(tmp_path):
-    with pytest.warns(VecfitWarning, match="svg viewport clipping"):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
         scene = load_svg(write(tmp_path, """
             <defs><symbol id="sym" viewBox="0 0 10 10"><circle id="sc" cx="5" cy="5" r="5"/></symbol></defs>
             <use id="u" href="#sym" x="50" y="50" width="20" height="20"/>
@@ -437,6 +438,12 @@ def test_use_of_symbol_and_nested_svg(tmp_path):
     circle = by_source(scene, "sc")
     assert apply(to_canvas(scene, circle), (5, 5)) == [60, 60]
     assert apply(to_canvas(scene, by_source(scene, "nr")), (100, 100)) == [60, 60]
+    # Both viewports clip (overflow: hidden): a rect of the viewport's size, in the
+    # space before the viewBox's mapping.
+    nested = scene.groups[scene.shapes[-1].group]
+    rect = nested.clip.content.shapes[0].geometry
+    assert rect.p_max.tolist() == [50, 50]
+    assert apply(nested.clip.content.view, (50, 50)) == [100, 100]
 
 
 def test_recursive_and_broken_uses_are_skipped(tmp_path):
@@ -694,11 +701,15 @@ def test_skipped_content_warns_once_per_kind(tmp_path):
     messages = [str(w.message) for w in record]
     assert len(messages) == len(set(messages)) == 5
     assert scene.skipped == {"text": ["t1", "text", "t3"], "image": ["i1", "i2"],
-                             "filter": ["f1", "f2"], "stroke-dasharray": ["f1"], "clip-path": ["f2"]}
+                             "filter reference": ["f1 (no <filter> #f)", "f2 (no <filter> #f)"],
+                             "stroke-dasharray": ["f1"], "clip-path": ["f2 (no <clipPath> #c)"]}
     assert "more dashes than the limit" in next(m for m in messages if "stroke-dasharray" in m)
     text_warning = next(m for m in messages if "text" in m)
     assert str(path) in text_warning and "t1" in text_warning and "t3" in text_warning
-    assert len(scene.shapes) == 3  # filtered and clipped shapes are drawn without the effect
+    # As browsers do: a clip path that is not there clips nothing, a filter that is not
+    # there draws nothing (the shapes stay in the Scene, one per element).
+    assert len(scene.shapes) == 3
+    assert scene.shapes[0].filter.steps == [] and scene.shapes[1].clip is None
 
 
 # ======================================================================== dashes
