@@ -394,6 +394,8 @@ class Reader:
             if vb[2] <= 0 or vb[3] <= 0:
                 return
             view = view_transform(vb, w, h, element.get("preserveAspectRatio"))
+            if not np.isfinite(view).all() or _singular(view):
+                return  # (a viewBox of inf or 1e-300: as a non-invertible transform, nothing)
             m = m @ view
             inverse_view = np.linalg.inv(view)
         clip, mask, filt, blend, isolate = effects or NO_EFFECTS
