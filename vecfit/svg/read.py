@@ -330,9 +330,10 @@ class Reader:
     def _viewport_clip(self, width: float, height: float, inverse_view) -> ClipPath:
         """The clip of a nested <svg> or <symbol> instance to its viewport (overflow
         hidden): a rect 0, 0, width, height before the viewBox's mapping."""
-        rect = Shape(geometry=Rect(p_min=torch.zeros(2), p_max=torch.tensor([float(width), float(height)])),
+        lim = Limiter()  # (a viewport of 1e400 px, a viewBox of 1e-300: clamped, as numbers are)
+        rect = Shape(geometry=Rect(p_min=torch.zeros(2), p_max=lim.tensor(np.array([width, height]))),
                      fill=solid(BLACK))
-        view = torch.eye(3) if inverse_view is None else torch.tensor(inverse_view, dtype=torch.float32)
+        view = torch.eye(3) if inverse_view is None else lim.tensor(np.asarray(inverse_view))
         return ClipPath(content=Scene(width=self.width, height=self.height, shapes=[rect], view=view))
 
     def _group(self, transform, opacity, parent, element, effects=None) -> int:
