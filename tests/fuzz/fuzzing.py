@@ -443,11 +443,11 @@ def effects_svg(rng: random.Random) -> bytes:
                              'clip-path="url(#e0)" filter="url(#f)"', 'style="mask: url(#e0)"', ""])
         shape = rng.choice([f'<circle cx="{rng.uniform(0, 64):.1f}" cy="{rng.uniform(0, 64):.1f}" r="{rng.uniform(0, 30):.1f}"',
                             '<path d="M 5 5 C 60 0 0 60 60 60 Z" stroke="#036" stroke-width="3"',
-                            '<rect width="64" height="64" fill="#8a4"'])
+                            '<rect width="64" height="64"'])
         if rng.random() < 0.4:
-            body.append(f'<g {effect} opacity="0.8">{shape} fill="#c33"/>{shape}/></g>')
+            body.append(f'<g {effect} opacity="0.8">{shape} fill="#c33"/>{shape} fill="#8a4"/></g>')
         else:
-            body.append(f'{shape} {effect}/>')
+            body.append(f'{shape} fill="#8a4" {effect}/>')
     nested = rng.random() < 0.2
     inner = "".join(body)
     if nested:
@@ -543,7 +543,7 @@ def make_case(seed: int, index: int, seeds: list[Path] | None = None) -> Case:
         return Case(index, "longpath", "render", ["render", "in.svg", "-o", "out.png", "--width", "64", "--mode", mode,
                                                   "--samples", "1", "--threads", "1"],
                     {"in.svg": long_path_svg(rng)}, timeout=20, outputs=["out.png"])
-    if roll < 0.26:  # dashed strokes, rendered, or refined (the dashes follow the points)
+    if roll < 0.35:  # dashed strokes, rendered, or refined (the dashes follow the points)
         svg = dashed_svg(rng)
         mode = rng.choice(["mc", "analytic"])
         if rng.random() < 0.7:
