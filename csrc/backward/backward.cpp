@@ -11,6 +11,7 @@
 #include "common/cancel.h"
 #include "common/phase_clock.h"
 #include "common/thread_pool.h"
+#include "scene/field.h"
 #include "scene/draw_runs.h"
 
 namespace vf {
@@ -80,6 +81,16 @@ void pixel_adjoints(const RenderOptions& o, const float* image, const float* d_i
             gp[3] -= gb;
         }
     });
+}
+
+// Whether any pixel of [x0, x1) x [y0, y1) has a non-zero adjoint.
+bool any_adjoint(const double* gpix, int W, int x0, int y0, int x1, int y1) {
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+            const double* gp = gpix + 4 * ((size_t)y * W + x);
+            if (gp[0] != 0 || gp[1] != 0 || gp[2] != 0 || gp[3] != 0) return true;
+        }
+    return false;
 }
 
 // The boundary pieces of every draw, each with its number of samples (density per pixel
@@ -208,16 +219,29 @@ bool render_backward(const PreparedScene& prepared, const SceneArrays& a, const 
             return {{hits.data(), (int)hits.size()}, {{ops.data(), (int)ops.size()}}, {g_hits.data(), (int)g_hits.size()}};
         }
     };
+    const bool fields = o.mode == MODE_ANALYTIC && !o.brute_force;
     std::optional<PhaseTimer> timer(PHASE_BACKWARD_INTERIOR);
     ThreadPool::instance().parallel_for(lanes, lanes, [&](int lane, int) {
         const GradView g = grads[lane].view();
         LaneLists lists(sizes);
         SampleScratch w = lists.scratch();
+        SampleGrid grid;
+        TileFields tile_fields;
         for (int tile = lane; tile < n_tiles; tile += lanes) {
             int tx = tile % bins.nx, ty = tile / bins.nx;
-            for (int y = ty * TILE; y < std::min(H, (ty + 1) * TILE) && !cancelled(); ++y)
-                for (int x = tx * TILE; x < std::min(W, (tx + 1) * TILE); ++x)
-                    pixel_backward(sc, bins, plan.options, plan.gpix.data() + 4 * ((size_t)y * W + x), x, y, w, g);
+            const int x0 = tx * TILE, x1 = std::min(W, x0 + TILE), y0 = ty * TILE, y1 = std::min(H, y0 + TILE);
+            // The analytical mode: the tile's long fill entries ahead, segment by segment
+            // (scene/field.h), where some pixel of the tile has a gradient.
+            FieldView view;
+            if (fields && bins.count(tile) > 0 && !cancelled() && any_adjoint(plan.gpix.data(), W, x0, y0, x1, y1)) {
+                grid.build(bins, tile, W, H, plan.options.samples, plan.options.filter_radius);
+                tile_fields.compute(sc, bins, tile, grid, plan.options.filter_radius, true);
+                view = tile_fields.view();
+            }
+            for (int y = y0; y < y1 && !cancelled(); ++y)
+                for (int x = x0; x < x1; ++x)
+                    pixel_backward(sc, bins, plan.options, plan.gpix.data() + 4 * ((size_t)y * W + x), x, y, w, g,
+                                   view.slot ? &view : nullptr);
         }
         if (w.overflow()) overflowed[lane] = 1;  // (the flags stay set once raised)
     });

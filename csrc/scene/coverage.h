@@ -431,52 +431,57 @@ VF_HD bool curve_farther(const PreparedSegment& s, Vec2 p, double limit) {
     return true;
 }
 
+// One segment of fill_distance: segment k of fill draw d (its index among the draw's
+// items) measured from p, lowering `best` (and filling `arg`) where it is closer. (A curve
+// is measured only where it may come within the distance so far, curve_farther: a long
+// path's cost follows the pixels near each segment, not those in its box.) The per-tile
+// fields (scene/field.h) call this too, so that both give the same distances and args.
+VF_HD void fill_distance_step(const SceneView& sc, const PreparedDraw& d, int k, Vec2 p, double& best,
+                              SdfArg* arg) {
+    const PreparedSegment& s = sc.fill_items[d.first_item + k];
+    double d2 = distance2(s.box, p);  // (on an edge, with arg: look for a second one)
+    if (d2 >= best * best && !(arg && best < ON_EDGE && d2 < ON_EDGE * ON_EDGE)) return;
+    if (s.seg.degree > 1 && curve_farther(s, p, arg && best < ON_EDGE ? ON_EDGE : best)) return;
+    Closest c;
+    if (s.seg.degree == 1) {
+        Vec2 a = s.seg.p[0], e = s.seg.p[1] - a;
+        double l2 = dot(e, e);
+        c.t = l2 > 0 ? vclamp(dot(p - a, e) / l2, 0.0, 1.0) : 0.0;
+        c.dist = distance(a + c.t * e, p);
+    } else {
+        c = seg_closest(s.seg, p);
+    }
+    if (arg && c.dist < ON_EDGE && best < ON_EDGE) {  // a vertex: keep both segments
+        int keep = c.dist < best ? arg->item : d.first_item + k;
+        double keep_t = c.dist < best ? arg->t : c.t;  // (stored as a float)
+        if (c.dist < best) {
+            best = c.dist;
+            arg->item = d.first_item + k;
+            arg->t = c.t;
+            arg->closest = seg_eval(s.seg, c.t);
+        }
+        arg->item2 = keep;
+        arg->t2 = (float)keep_t;
+        return;
+    }
+    if (c.dist < best) {
+        best = c.dist;
+        if (arg) {
+            arg->item2 = -1;
+            arg->kind = SdfArg::SEGMENT;
+            arg->item = d.first_item + k;
+            arg->t = c.t;
+            arg->closest = seg_eval(s.seg, c.t);
+        }
+    }
+}
+
 // Distance from p to the closest fill segment among items, or `limit` if none is closer.
-// (A curve is measured only where it may come within the distance so far, curve_farther:
-// a long path's cost follows the pixels near each segment, not those in its box.)
 template <class Items>
 VF_HD double fill_distance(const SceneView& sc, const PreparedDraw& d, const Items& items, Vec2 p, double limit,
                      SdfArg* arg = nullptr) {
-    const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
     double best = limit;
-    for (int i = 0; i < items.size(); ++i) {
-        const PreparedSegment& s = segs[items[i]];
-        double d2 = distance2(s.box, p);  // (on an edge, with arg: look for a second one)
-        if (d2 >= best * best && !(arg && best < ON_EDGE && d2 < ON_EDGE * ON_EDGE)) continue;
-        if (s.seg.degree > 1 && curve_farther(s, p, arg && best < ON_EDGE ? ON_EDGE : best)) continue;
-        Closest c;
-        if (s.seg.degree == 1) {
-            Vec2 a = s.seg.p[0], e = s.seg.p[1] - a;
-            double l2 = dot(e, e);
-            c.t = l2 > 0 ? vclamp(dot(p - a, e) / l2, 0.0, 1.0) : 0.0;
-            c.dist = distance(a + c.t * e, p);
-        } else {
-            c = seg_closest(s.seg, p);
-        }
-        if (arg && c.dist < ON_EDGE && best < ON_EDGE) {  // a vertex: keep both segments
-            int keep = c.dist < best ? arg->item : d.first_item + items[i];
-            double keep_t = c.dist < best ? arg->t : c.t;  // (stored as a float)
-            if (c.dist < best) {
-                best = c.dist;
-                arg->item = d.first_item + items[i];
-                arg->t = c.t;
-                arg->closest = seg_eval(s.seg, c.t);
-            }
-            arg->item2 = keep;
-            arg->t2 = (float)keep_t;
-            continue;
-        }
-        if (c.dist < best) {
-            best = c.dist;
-            if (arg) {
-                arg->item2 = -1;
-                arg->kind = SdfArg::SEGMENT;
-                arg->item = d.first_item + items[i];
-                arg->t = c.t;
-                arg->closest = seg_eval(s.seg, c.t);
-            }
-        }
-    }
+    for (int i = 0; i < items.size(); ++i) fill_distance_step(sc, d, items[i], p, best, arg);
     return best;
 }
 

@@ -67,6 +67,27 @@ struct TileBins {
     Box region(int tile) const { return view().region(tile); }
 };
 
+// Index of sample s (of spp per pixel) of pixel (x, y) among its tile's samples: pixel by
+// pixel, in rows, then the pixel's own order.
+VF_HD int tile_sample(int x, int y, int width, int spp, int s) {
+    int x0 = x / TILE * TILE, y0 = y / TILE * TILE, w = vmin(width - x0, TILE);
+    return ((y - y0) * w + (x - x0)) * spp + s;
+}
+
+// Signed distances of some of a tile's fill entries at every sample of the tile, computed
+// ahead segment by segment (scene/field.h, the CPU's analytical passes): what entry_sdf
+// gives there, and its SdfArg. The GPU and the other passes have none (a null view).
+struct FieldView {
+    const int* slot = nullptr;    // per entry of the tile (its place in the tile's list): its field, or -1
+    const double* sd = nullptr;   // [slot * n + sample]
+    const SdfArg* arg = nullptr;  // the same layout, or null (forward pass)
+    int n = 0;                    // samples in the tile
+    int tile = -1;                // the tile
+    VF_HD bool has(int k) const { return slot && slot[k] >= 0; }
+    VF_HD double sd_at(int k, int sample) const { return sd[(size_t)slot[k] * n + sample]; }
+    VF_HD const SdfArg& arg_at(int k, int sample) const { return arg[(size_t)slot[k] * n + sample]; }
+};
+
 // margin: how far (pixels) outside a tile its samples and their prefilter reach.
 // With every_tile, a draw gets an entry in every tile its bounds reach (no culling of
 // tiles it cannot cover): the brute-force check of the tiles uses that. threads: how
