@@ -85,10 +85,8 @@ VF_HD void draw_covers_pair(const SceneView& sc, const TileView& bins, int draw,
         const LocalItem& li = items[i];
         wa += ray_crossings(segs[li.item], a, region.x1);
         wb += ray_crossings(segs[li.item], b, region.x1);
-        for (int c = 0; c < li.n_cross; ++c) {
-            if (li.cross_y[c] <= a.y) wa += li.cross_dir[c];
-            if (li.cross_y[c] <= b.y) wb += li.cross_dir[c];
-        }
+        wa += bins.leg_crossings(li, a.y);
+        wb += bins.leg_crossings(li, b.y);
     }
     in_a = ra && winding_inside(wa, d.fill_rule);
     in_b = rb && winding_inside(wb, d.fill_rule);

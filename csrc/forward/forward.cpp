@@ -126,9 +126,12 @@ void tile_forward(const SceneView& sc, const TileView& bins, const RenderOptions
                 if (r0 <= r1)
                     for (int a = ts.row_begin[r0]; a < ts.row_begin[r1 + 1]; ++a)
                         ts.winding[a] += ray_crossings(seg, ts.p[ts.active[a]], region.x1);
-                for (int j = 0; j < item.n_cross; ++j)  // the vertical leg: every sample at or below
-                    for (int a = 0; a < n_active; ++a)
-                        if (item.cross_y[j] <= ts.p[ts.active[a]].y) ts.winding[a] += item.cross_dir[j];
+                if (item.cross >= 0) {  // the vertical leg: every sample at or below
+                    const LegCrossings& c = bins.crossings[item.cross];
+                    for (int j = 0; j < c.n; ++j)
+                        for (int a = 0; a < n_active; ++a)
+                            if (c.y[j] <= ts.p[ts.active[a]].y) ts.winding[a] += c.dir[j];
+                }
             }
         }
         int kept = 0;

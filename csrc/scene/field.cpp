@@ -68,9 +68,9 @@ void SampleGrid::build(const TileView& bins, int tile, int width, int height, in
         for (size_t col = 0; col < cols; ++col)
             index[row * cols + col] =
                 ((row_pixel[row] - y0) * (x1 - x0) + (pixel[col] - x0)) * N * N + row_sub[row] * N + sub[col];
-    auto spacing = [](const std::vector<double>& v, double& v0, double& step) {
+    auto spacing = [](const std::vector<double>& v, double& v0, double& inv_step) {
         v0 = v.front();
-        step = v.size() > 1 && v.back() > v.front() ? (v.back() - v.front()) / (double)(v.size() - 1) : 1.0;
+        inv_step = v.size() > 1 && v.back() > v.front() ? (double)(v.size() - 1) / (v.back() - v.front()) : 1.0;
     };
     spacing(col_x, col0_, col_step_);
     spacing(row_y, row0_, row_step_);
@@ -144,24 +144,31 @@ void TileFields::scan(const SceneView& sc, const TileView& bins, int tile, const
     };
     Vec2 pts[MAX_CAPSULES + 1];
     for (int li = 0; li < e.count; ++li) {
+        if (li + 8 < e.count) __builtin_prefetch(&segs[items[li + 8].item].box);  // (a tile's segments are scattered)
         const LocalItem& item = items[li];
-        for (int c = 0; c < item.n_cross; ++c) row_add_[g.first_row(item.cross_y[c])] += item.cross_dir[c];
+        if (item.cross >= 0) {
+            const LegCrossings& c = bins.crossings[item.cross];
+            for (int k = 0; k < c.n; ++k) row_add_[g.first_row(c.y[k])] += c.dir[k];
+        }
         const PreparedSegment& s = segs[item.item];
         // (winding: some sample row within its heights has samples left of it, within the region)
         const bool wind = s.box.x0 <= x_max && s.box.x1 > area.x0 && s.box.y1 >= area.y0 && s.box.y0 <= area.y1;
         if (!wind && box_distance2(s.box, area) >= r2) continue;
+        double ax[4], ay[4];
+        s.power_basis(ax, ay);
         for (int k = 0; k + 1 < s.n_split; ++k) {
             const double ya = s.split_y[k], yb = s.split_y[k + 1];
             const int dir = ya < yb ? 1 : -1;
-            const double* sy = s.sub_y[k];
+            double sy[PreparedSegment::SUB + 1];
+            for (int j = 0; j <= s.n_sub; ++j) sy[j] = s.sub_y(k, j);
             bool monotone = true;  // the cuts, to rounding (else ray_crossings takes the whole piece)
             for (int j = 0; j < s.n_sub; ++j) monotone &= dir > 0 ? sy[j] <= sy[j + 1] : sy[j] >= sy[j + 1];
             if (!monotone) {  // rare: each row's crossing solved on the whole piece
                 if (ya == yb || s.piece_x0[k] > x_max) continue;
                 for (int row = g.first_row(vmin(ya, yb)); row < g.first_row(vmax(ya, yb)); ++row) {
                     const double y = g.row_y[row];
-                    double t = monotone_root(s.ay, y, s.split[k], s.split[k + 1], ya - y, yb - y);
-                    double x = ((s.ax[3] * t + s.ax[2]) * t + s.ax[1]) * t + s.ax[0];
+                    double t = monotone_root(ay, y, s.split[k], s.split[k + 1], ya - y, yb - y);
+                    double x = ((ax[3] * t + ax[2]) * t + ax[1]) * t + ax[0];
                     if (x <= x_max) cross(row, x, dir);
                 }
             }
@@ -176,25 +183,9 @@ void TileFields::scan(const SceneView& sc, const TileView& bins, int tile, const
                 // capsules: chords at even steps of t, and how far the curve strays from them
                 const double len = (sub.x1 - sub.x0) + (sub.y1 - sub.y0);
                 const int n = s.seg.degree == 1 ? 1 : clamp_to_int(std::ceil(len / PIECE), 1, MAX_CAPSULES);
-                double stray = 0;
-                if (s.seg.degree > 1) {
-                    double m = 0;
-                    for (double t : {ta, tb}) {
-                        Vec2 b2{2 * s.ax[2] + 6 * s.ax[3] * t, 2 * s.ay[2] + 6 * s.ay[3] * t};
-                        m = vmax(m, length(b2));
-                    }
-                    double dt = (tb - ta) / n;
-                    stray = dt * dt / 8 * m * (1 + 1e-9);
-                }
                 const double slack = 1e-12 * (scale + std::fabs(sub.x0) + std::fabs(sub.x1) + std::fabs(sub.y0) +
                                               std::fabs(sub.y1));
-                const double h = stray + slack;
-                for (int i = 0; i <= n; ++i) {
-                    double t = i == 0 ? ta : i == n ? tb : ta + (tb - ta) * i / n;
-                    double x = ((s.ax[3] * t + s.ax[2]) * t + s.ax[1]) * t + s.ax[0];
-                    double y = i == 0 ? y0 : i == n ? y1 : ((s.ay[3] * t + s.ay[2]) * t + s.ay[1]) * t + s.ay[0];
-                    pts[i] = {x, y};
-                }
+                const double h = sub_piece_capsules(s, ax, ay, k, j, n, pts) + slack;
                 if (near)
                     for (int i = 0; i < n; ++i) {
                         Piece pc;
@@ -237,8 +228,8 @@ void TileFields::scan(const SceneView& sc, const TileView& bins, int tile, const
                         }
                     }
                     if (!known) {
-                        double t = monotone_root(s.ay, y, ta, tb, y0 - y, y1 - y);
-                        double x = ((s.ax[3] * t + s.ax[2]) * t + s.ax[1]) * t + s.ax[0];
+                        double t = monotone_root(ay, y, ta, tb, y0 - y, y1 - y);
+                        double x = ((ax[3] * t + ax[2]) * t + ax[1]) * t + ax[0];
                         if (x > x_max) continue;
                         T = x;
                     }

@@ -55,9 +55,9 @@ struct SampleGrid {
     int after_row(double y) const { return after(row_y, y, row0_, row_step_); }
 
   private:
-    double col0_ = 0, col_step_ = 1, row0_ = 0, row_step_ = 1;
-    static int guess(const std::vector<double>& v, double x, double v0, double step) {
-        double k = std::floor((x - v0) / step);
+    double col0_ = 0, col_step_ = 1, row0_ = 0, row_step_ = 1;  // (steps stored inverted)
+    static int guess(const std::vector<double>& v, double x, double v0, double inv_step) {
+        double k = (x - v0) * inv_step;
         return k < 0 ? 0 : k >= (double)v.size() ? (int)v.size() : (int)k;
     }
     static int first(const std::vector<double>& v, double x, double v0, double step) {

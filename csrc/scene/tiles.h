@@ -26,11 +26,17 @@ namespace vf {
 
 constexpr int TILE = 8;
 
+// A fill segment's crossings of a tile's vertical leg (x = region.x1): heights and directions.
+struct LegCrossings {
+    double y[3] = {0, 0, 0};
+    int8_t dir[3] = {0, 0, 0};
+    int8_t n = 0;
+};
+
 struct LocalItem {
     int32_t item = 0;             // index into the draw's fill or stroke items
-    int32_t n_cross = 0;          // crossings of the vertical leg (fills)
-    double cross_y[3] = {0, 0, 0};
-    int8_t cross_dir[3] = {0, 0, 0};
+    int32_t cross = -1;           // fills: its crossings of the vertical leg (index into the
+                                  // bins' crossings), -1 where it has none (most items)
 };
 
 struct TileEntry {
@@ -48,6 +54,16 @@ struct TileView {
     Span<int> start;
     Span<TileEntry> entries;
     Span<LocalItem> items;
+    Span<LegCrossings> crossings;
+    // The vertical leg's crossings of an item at heights up to y (see tile_winding).
+    VF_HD int leg_crossings(const LocalItem& li, double y) const {
+        if (li.cross < 0) return 0;
+        const LegCrossings& c = crossings[li.cross];
+        int w = 0;
+        for (int k = 0; k < c.n; ++k)
+            if (c.y[k] <= y) w += c.dir[k];  // heights are already > region.y0
+        return w;
+    }
     VF_HD const TileEntry* begin(int tile) const { return entries.data() + start[tile]; }
     VF_HD int count(int tile) const { return start[tile + 1] - start[tile]; }
     VF_HD Box region(int tile) const {  // pixel-space area the tile's samples and prefilter reach
@@ -63,7 +79,10 @@ struct TileBins {
     std::vector<int> start;       // [nx * ny + 1] offsets into entries
     std::vector<TileEntry> entries;
     std::vector<LocalItem> items;
-    TileView view() const { return {nx, ny, margin, span_of(start), span_of(entries), span_of(items)}; }
+    std::vector<LegCrossings> crossings;
+    TileView view() const {
+        return {nx, ny, margin, span_of(start), span_of(entries), span_of(items), span_of(crossings)};
+    }
     Box region(int tile) const { return view().region(tile); }
 };
 
@@ -103,9 +122,7 @@ VF_HD int tile_winding(const SceneView& sc, const TileView& bins, const TileEntr
     int w = e.winding;
     for (int i = 0; i < e.count; ++i) {
         const LocalItem& li = items[i];
-        w += ray_crossings(segs[li.item], p, region.x1);
-        for (int c = 0; c < li.n_cross; ++c)
-            if (li.cross_y[c] <= p.y) w += li.cross_dir[c];  // heights are already > region.y0
+        w += ray_crossings(segs[li.item], p, region.x1) + bins.leg_crossings(li, p.y);
     }
     return w;
 }
