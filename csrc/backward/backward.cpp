@@ -11,6 +11,7 @@
 #include "common/cancel.h"
 #include "common/phase_clock.h"
 #include "common/thread_pool.h"
+#include "scene/field.h"
 #include "scene/draw_runs.h"
 
 namespace vf {
@@ -87,6 +88,16 @@ void pixel_adjoints(const RenderOptions& o, const float* image, const float* d_i
     });
 }
 
+// Whether any pixel of [x0, x1) x [y0, y1) has a non-zero adjoint.
+bool any_adjoint(const double* gpix, int W, int x0, int y0, int x1, int y1) {
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+            const double* gp = gpix + 4 * ((size_t)y * W + x);
+            if (gp[0] != 0 || gp[1] != 0 || gp[2] != 0 || gp[3] != 0) return true;
+        }
+    return false;
+}
+
 // The boundary pieces of every draw, each with its number of samples (density per pixel
 // of length). A segment's length is its control polygon's, which exceeds its arc length
 // most where the speed along it varies most, i.e. where samples uniform in t are noisiest:
@@ -96,22 +107,138 @@ void pixel_adjoints(const RenderOptions& o, const float* image, const float* d_i
 // the canvas at most a few times: 4 (W + H) pixels of length): a segment 1e9 pixels long
 // would otherwise ask for billions of samples, nearly all off the canvas. The cap keeps the
 // estimate unbiased (each sample is weighted by length / count), only noisier there.
-std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_, int width, int height, int threads) {
+//
+// A piece none of whose samples can lie where boundary_sample uses one (within R of the
+// canvas) gets no samples, certainly (its bounds below miss that area): a stroke 10^7 px
+// wide drew a thousand samples on each offset curve and join of every item, millions of
+// pixels away, and threw them out one by one. (Its count is 0, not the piece dropped: the
+// other pieces' random numbers, keyed by their place in the list, stay the same.)
+std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_, int width, int height, double R,
+                                   int threads) {
     const double cap = std::ceil(density_ * 4.0 * ((double)width + height));
     auto count = [&](double len) { return clamp_to_int(std::ceil(std::min(density_ * len, cap)), 1, 1 << 30); };
+    // Where samples count, a little grown (for rounding), in pixel space.
+    const Box canvas = grown(Box{-R, -R, width + R, height + R}, 1.0);
+    auto reaches = [&](const Box& pixel_box) { return valid(pixel_box) && overlaps(pixel_box, canvas); };
+    // A stroke-space box in pixel space (its corners through the metric's inverse).
+    auto pixel_box = [&](const PreparedDraw& d, const Box& b) {
+        if (d.metric_identity) return b;
+        Box out;
+        for (Vec2 c : {Vec2{b.x0, b.y0}, Vec2{b.x1, b.y0}, Vec2{b.x0, b.y1}, Vec2{b.x1, b.y1}}) expand(out, d.metric_inv * c);
+        return out;
+    };
+    // Whether the segment a-b (stroke space) passes through that area (Liang-Barsky clipping
+    // in pixel space).
+    auto segment_reaches = [&](const PreparedDraw& d, Vec2 a, Vec2 b) {
+        if (!d.metric_identity) {
+            a = d.metric_inv * a;
+            b = d.metric_inv * b;
+        }
+        double t0 = 0, t1 = 1;
+        const double dx = b.x - a.x, dy = b.y - a.y;
+        auto clip = [&](double p, double q) {  // p t <= q
+            if (p == 0) return q >= 0;
+            double r = q / p;
+            if (p < 0) t0 = std::max(t0, r);
+            else t1 = std::min(t1, r);
+            return t0 <= t1;
+        };
+        return clip(-dx, a.x - canvas.x0) && clip(dx, canvas.x1 - a.x) && clip(-dy, a.y - canvas.y0) &&
+               clip(dy, canvas.y1 - a.y);
+    };
+    // An offset curve of a stroke item (side +1 or -1) lies within (its curve's box) +
+    // hw (its normals' box): the normals turn within the cone of the hodograph's control
+    // vectors, where that cone is narrower than a right angle each way (else, any way).
+    auto offset_reaches = [&](const PreparedDraw& d, const StrokeSegment& s, int side) {
+        const Segment& c = s.seg;
+        const double hw = d.varying ? s.hw_max : d.half_width;
+        Box curve;
+        for (int i = 0; i <= c.degree; ++i) expand(curve, c.p[i]);
+        Box normals{-1, -1, 1, 1};
+        Vec2 axis{0, 0};
+        for (int i = 0; i < c.degree; ++i) {
+            Vec2 h = c.p[i + 1] - c.p[i];
+            double l = length(h);
+            if (l > 0) axis = axis + (1 / l) * h;
+        }
+        double la = length(axis);
+        if (la > 0) {
+            axis = (1 / la) * axis;
+            double cos_min = 1;
+            for (int i = 0; i < c.degree; ++i) {
+                Vec2 h = c.p[i + 1] - c.p[i];
+                double l = length(h);
+                if (l > 0) cos_min = std::min(cos_min, dot(h, axis) / l);
+            }
+            if (cos_min > 0.1) {  // every tangent within acos(cos_min) of the axis
+                Vec2 n = side * perp(axis);
+                double half = std::acos(std::min(1.0, cos_min)) + 1e-6, a = std::atan2(n.y, n.x);
+                double lo = a - half, hi = a + half;
+                Box arc;
+                expand(arc, {std::cos(lo), std::sin(lo)});
+                expand(arc, {std::cos(hi), std::sin(hi)});
+                for (int q = -4; q <= 4; ++q)  // the axis directions within the arc
+                    if (q * M_PI / 2 > lo && q * M_PI / 2 < hi) expand(arc, {std::cos(q * M_PI / 2), std::sin(q * M_PI / 2)});
+                normals = arc;
+            }
+        }
+        if (d.varying) {  // (the width runs from 0 up)
+            expand(normals, {0, 0});
+        }
+        Box b{curve.x0 + hw * normals.x0, curve.y0 + hw * normals.y0, curve.x1 + hw * normals.x1,
+              curve.y1 + hw * normals.y1};
+        return reaches(pixel_box(d, grown(b, 1e-6 * (1 + hw))));
+    };
+    // The outline an end piece samples (see BoundarySampler::outline): a disk's circle,
+    // a join polygon's outer edges, a square cap's three outer edges, a butt end's line.
+    auto end_reaches = [&](const PreparedDraw& d, const StrokeSegment& s, int side) {
+        const StrokeEnd& e = side == 0 ? s.start : s.end;
+        const double hw = e.hw, pad = 1e-6 * (1 + hw);
+        // (the outline is built again from the whole segments' frames: the same to rounding)
+        auto edge = [&](Vec2 a, Vec2 b) {
+            Vec2 u = b - a;
+            double l = length(u);
+            Vec2 g = l > 0 ? (pad / l) * u : Vec2{pad, 0};
+            return segment_reaches(d, a - g - perp(g), b + g - perp(g)) ||
+                   segment_reaches(d, a - g + perp(g), b + g + perp(g)) || segment_reaches(d, a, b);
+        };
+        if (e.kind == StrokeEnd::DISK) {
+            double far = 0;  // the canvas inside the disk: the circle misses it
+            for (Vec2 c : {Vec2{canvas.x0, canvas.y0}, Vec2{canvas.x1, canvas.y0}, Vec2{canvas.x0, canvas.y1},
+                           Vec2{canvas.x1, canvas.y1}})
+                far = std::max(far, distance(to_stroke_space(d, c), e.center));
+            if (hw - pad > far) return false;
+            return reaches(pixel_box(d, grown(Box{e.center.x, e.center.y, e.center.x, e.center.y}, hw + pad)));
+        }
+        if (e.kind == StrokeEnd::POLYGON) {
+            for (int i = 1; i + 1 < e.n_poly; ++i)
+                if (edge(e.poly[i], e.poly[i + 1])) return true;
+            return false;
+        }
+        if (e.kind == StrokeEnd::SQUARE) {
+            Vec2 u = perp(e.axis), a = e.center + hw * u, b = e.center + hw * e.axis + hw * u,
+                 c = e.center + hw * e.axis - hw * u, f = e.center - hw * u;
+            return edge(a, b) || edge(b, c) || edge(c, f);
+        }
+        Vec2 at = side == 0 ? s.seg.p[0] : seg_end(s.seg);  // a butt end: the end normal line
+        Vec2 n = perp(seg_end_tangent(s.seg, side == 1));
+        return edge(at - hw * n, at + hw * n);
+    };
     auto draw_pieces = [&](int di, std::vector<Piece>& out) {
         const PreparedDraw& d = sc_.draws[di];
         if (!valid(d.box)) return;
         if (d.is_ellipse) {
             double r = std::max(d.ellipse.r0, d.ellipse.r1) + (d.kind == DRAW_STROKE ? d.half_width : 0);
             double len = 2 * M_PI * r * (d.kind == DRAW_STROKE ? d.metric_scale : 1.0);
-            if (d.kind == DRAW_FILL) out.push_back({Piece::ELLIPSE, di, 0, 0, count(len)});
-            else for (int s = -1; s <= 1; s += 2) out.push_back({Piece::ELLIPSE, di, 0, s, count(len)});
+            int n = reaches(d.box) ? count(len) : 0;
+            if (d.kind == DRAW_FILL) out.push_back({Piece::ELLIPSE, di, 0, 0, n});
+            else for (int s = -1; s <= 1; s += 2) out.push_back({Piece::ELLIPSE, di, 0, s, n});
             return;
         }
         for (int k = 0; k < d.n_items; ++k) {
             if (d.kind == DRAW_FILL) {
-                out.push_back({Piece::FILL_SEGMENT, di, k, 0, count(polygon_length(sc_.fill_items[d.first_item + k].seg))});
+                const PreparedSegment& seg = sc_.fill_items[d.first_item + k];
+                out.push_back({Piece::FILL_SEGMENT, di, k, 0, reaches(seg.box) ? count(polygon_length(seg.seg)) : 0});
             } else {
                 // Offset curves are about as long as the curve plus hw times its turning.
                 const StrokeSegment& s = sc_.stroke_items[d.first_item + k];
@@ -122,13 +249,14 @@ std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_, int wi
                 if (d.varying)
                     for (int i = 0; i < s.seg.degree; ++i) vary += std::fabs(s.hw[i + 1] - s.hw[i]);
                 double len = (polygon_length(s.seg) + hw * turn + vary) * d.metric_scale;
-                for (int side = -1; side <= 1; side += 2) out.push_back({Piece::OFFSET, di, k, side, count(len)});
+                for (int side = -1; side <= 1; side += 2)
+                    out.push_back({Piece::OFFSET, di, k, side, offset_reaches(d, s, side) ? count(len) : 0});
                 // Caps and joins only where there are some (pieces of one curve meet smoothly).
                 auto end_len = [&](double h) { return (2 * M_PI * h + 4 * h * d.miter_limit) * d.metric_scale; };
                 if (s.start.kind != StrokeEnd::NONE || s.butt_start)
-                    out.push_back({Piece::END, di, k, 0, count(end_len(s.start.hw))});
+                    out.push_back({Piece::END, di, k, 0, end_reaches(d, s, 0) ? count(end_len(s.start.hw)) : 0});
                 if (s.end.kind != StrokeEnd::NONE || s.butt_end)
-                    out.push_back({Piece::END, di, k, 1, count(end_len(s.end.hw))});
+                    out.push_back({Piece::END, di, k, 1, end_reaches(d, s, 1) ? count(end_len(s.end.hw)) : 0});
             }
         }
     };
@@ -164,7 +292,7 @@ BackwardPlan plan_backward(const PreparedScene& prepared, const RenderOptions& o
                           o.threads);
     pixel_adjoints(o, image, d_image, plan.gpix);
     const SceneView sc = prepared.view();
-    if (o.mode == MODE_MC) plan.pieces = boundary_pieces(sc, boundary_density, o.width, o.height, o.threads);
+    if (o.mode == MODE_MC) plan.pieces = boundary_pieces(sc, boundary_density, o.width, o.height, R, o.threads);
     BoundaryContext& bc = plan.boundary;
     bc.width = o.width;
     bc.height = o.height;
@@ -213,16 +341,29 @@ bool render_backward(const PreparedScene& prepared, const SceneArrays& a, const 
             return {{hits.data(), (int)hits.size()}, {{ops.data(), (int)ops.size()}}, {g_hits.data(), (int)g_hits.size()}};
         }
     };
+    const bool fields = o.mode == MODE_ANALYTIC && !o.brute_force;
     std::optional<PhaseTimer> timer(PHASE_BACKWARD_INTERIOR);
     ThreadPool::instance().parallel_for(lanes, lanes, [&](int lane, int) {
         const GradView g = grads[lane].view();
         LaneLists lists(sizes);
         SampleScratch w = lists.scratch();
+        SampleGrid grid;
+        TileFields tile_fields;
         for (int tile = lane; tile < n_tiles; tile += lanes) {
             int tx = tile % bins.nx, ty = tile / bins.nx;
-            for (int y = ty * TILE; y < std::min(H, (ty + 1) * TILE) && !cancelled(); ++y)
-                for (int x = tx * TILE; x < std::min(W, (tx + 1) * TILE); ++x)
-                    pixel_backward(sc, bins, plan.options, plan.gpix.data() + 4 * ((size_t)y * W + x), x, y, w, g);
+            const int x0 = tx * TILE, x1 = std::min(W, x0 + TILE), y0 = ty * TILE, y1 = std::min(H, y0 + TILE);
+            // The analytical mode: the tile's long fill entries ahead, segment by segment
+            // (scene/field.h), where some pixel of the tile has a gradient.
+            FieldView view;
+            if (fields && bins.count(tile) > 0 && !cancelled() && any_adjoint(plan.gpix.data(), W, x0, y0, x1, y1)) {
+                grid.build(bins, tile, W, H, plan.options.samples, plan.options.filter_radius);
+                tile_fields.compute(sc, bins, tile, grid, plan.options.filter_radius, true);
+                view = tile_fields.view();
+            }
+            for (int y = y0; y < y1 && !cancelled(); ++y)
+                for (int x = x0; x < x1; ++x)
+                    pixel_backward(sc, bins, plan.options, plan.gpix.data() + 4 * ((size_t)y * W + x), x, y, w, g,
+                                   view.slot ? &view : nullptr);
         }
         if (w.overflow()) overflowed[lane] = 1;  // (the flags stay set once raised)
     });

@@ -32,7 +32,7 @@ VF_HD bool width_free(const SceneView& sc, int32_t k) { return k >= 0 && (size_t
 
 // Pixel-space control-point indices of a stroke item (its straightened form uses the ends).
 VF_HD void stroke_item_indices(const SceneView& sc, const StrokeSegment& s, int32_t idx[4]) {
-    const PreparedSegment& src = sc.segments[s.source];
+    const SegmentSource& src = sc.segments[s.source];
     for (int i = 0; i < 4; ++i) idx[i] = -1;
     if (s.seg.degree == src.seg.degree) {
         for (int i = 0; i <= s.seg.degree; ++i) idx[i] = src.point_index[i];

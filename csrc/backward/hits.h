@@ -85,10 +85,8 @@ VF_HD void draw_covers_pair(const SceneView& sc, const TileView& bins, int draw,
         const LocalItem& li = items[i];
         wa += ray_crossings(segs[li.item], a, region.x1);
         wb += ray_crossings(segs[li.item], b, region.x1);
-        for (int c = 0; c < li.n_cross; ++c) {
-            if (li.cross_y[c] <= a.y) wa += li.cross_dir[c];
-            if (li.cross_y[c] <= b.y) wb += li.cross_dir[c];
-        }
+        wa += bins.leg_crossings(li, a.y);
+        wb += bins.leg_crossings(li, b.y);
     }
     in_a = ra && winding_inside(wa, d.fill_rule);
     in_b = rb && winding_inside(wb, d.fill_rule);
@@ -134,11 +132,15 @@ VF_HD int collect_hits(const SceneView& sc, const TileView& bins, Vec2 p, int fo
 }
 
 // Analytical prefilter: the draws reaching p, front to back, with fractional coverage.
-VF_HD void collect_hits_analytic(const SceneView& sc, const TileView& bins, Vec2 p, double r, Buffer<Hit>& hits) {
+// fields: the signed distances of some entries at the tile's samples, p being sample
+// `sample` of them (see FieldView), or null.
+VF_HD void collect_hits_analytic(const SceneView& sc, const TileView& bins, Vec2 p, double r, Buffer<Hit>& hits,
+                                 const FieldView* fields = nullptr, int sample = 0) {
     hits.clear();
     int tile = tile_of(bins, p);
     Box region = bins.region(tile);
     const TileEntry* es = bins.begin(tile);
+    if (fields && fields->tile != tile) fields = nullptr;  // (a sample beyond its pixel's tile)
     for (int k = bins.count(tile) - 1; k >= 0; --k) {
         const TileEntry& e = es[k];
         const PreparedDraw& d = sc.draws[e.draw];
@@ -146,7 +148,12 @@ VF_HD void collect_hits_analytic(const SceneView& sc, const TileView& bins, Vec2
         if (p.x < near.x0 || p.x > near.x1 || p.y < near.y0 || p.y > near.y1) continue;
         Hit h;
         h.draw = e.draw;
-        h.sd = entry_sdf(sc, bins, e, region, p, r, &h.arg);
+        if (fields && fields->has(k)) {
+            h.sd = fields->sd_at(k, sample);
+            h.arg = fields->arg_at(k, sample);
+        } else {
+            h.sd = entry_sdf(sc, bins, e, region, p, r, &h.arg);
+        }
         if (h.arg.kind == SdfArg::SEGMENT && std::fabs(h.sd) < ON_EDGE) {
             if (h.arg.item2 < 0) h.arg.side = entry_inside_side(sc, bins, e, region, h.arg);
             else {  // on a vertex: each segment's side, probed a little into the segment (at

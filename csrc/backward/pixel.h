@@ -54,10 +54,11 @@ struct SampleScratch {
 // may have lost the POP of a PUSH it kept, which composite_backward cannot walk back, so
 // nothing is added and the pass is to be redone with longer lists.
 VF_HD bool sample_backward(const SceneView& sc, const TileView& bins, Vec2 p, const RenderOptions& o,
-                           const double g_c[4], SampleScratch& w, const GradView& g) {
+                           const double g_c[4], SampleScratch& w, const GradView& g,
+                           const FieldView* fields = nullptr, int sample = 0) {
     const double R = o.filter_radius;
     const bool analytic = o.mode == MODE_ANALYTIC;
-    if (analytic) collect_hits_analytic(sc, bins, p, R, w.hits);
+    if (analytic) collect_hits_analytic(sc, bins, p, R, w.hits, fields, sample);
     else collect_hits(sc, bins, p, -1, w.hits);
     if (w.hits.empty()) return true;
     double c[4];
@@ -84,7 +85,7 @@ VF_HD bool sample_backward(const SceneView& sc, const TileView& bins, Vec2 p, co
 // (filter radius settled); gp: dL/d(the pixel's premultiplied colour), background
 // excluded (see pixel_adjoints in backward.cpp).
 VF_HD void pixel_backward(const SceneView& sc, const TileView& bins, const RenderOptions& o, const double* gp,
-                          int x, int y, SampleScratch& w, const GradView& g) {
+                          int x, int y, SampleScratch& w, const GradView& g, const FieldView* fields = nullptr) {
     if (gp[0] == 0 && gp[1] == 0 && gp[2] == 0 && gp[3] == 0) return;
     const int N = o.samples;
     const double R = o.filter_radius;
@@ -113,7 +114,9 @@ VF_HD void pixel_backward(const SceneView& sc, const TileView& bins, const Rende
         if (wt <= 0) continue;
         double g_c[4];  // the sample's share of the pixel's adjoint
         for (int i = 0; i < 4; ++i) g_c[i] = wt * gp[i];
-        if (!sample_backward(sc, bins, {x + 0.5 + dx, y + 0.5 + dy}, o, g_c, w, g)) return;
+        if (!sample_backward(sc, bins, {x + 0.5 + dx, y + 0.5 + dy}, o, g_c, w, g, fields,
+                             fields ? tile_sample(x, y, o.width, all, s) : 0))
+            return;
     }
 }
 

@@ -114,10 +114,12 @@ bool render_backward(const PreparedScene& scene, const SceneArrays& arrays, cons
         BoundarySampler pass{sc, options.seed};
         const int threads = 128;
         long long blocks = (first.back() + threads - 1) / threads;
-        boundary_kernel<<<(unsigned)blocks, threads>>>(sc, bins, pass, up.put(plan.pieces).data(),
-                                                       up.put(first).data(), (int)plan.pieces.size(), bc,
-                                                       grads.view, overflow);
-        check(cudaGetLastError(), "boundary_kernel launch");
+        if (blocks > 0) {  // (none where every piece lies off the canvas)
+            boundary_kernel<<<(unsigned)blocks, threads>>>(sc, bins, pass, up.put(plan.pieces).data(),
+                                                           up.put(first).data(), (int)plan.pieces.size(), bc,
+                                                           grads.view, overflow);
+            check(cudaGetLastError(), "boundary_kernel launch");
+        }
     }
     check(cudaDeviceSynchronize(), "the backward kernels");
     int overflowed = 0;

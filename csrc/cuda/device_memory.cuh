@@ -66,7 +66,7 @@ inline SceneView upload_scene(Uploads& up, const PreparedScene& sc) {
 }
 
 inline TileView upload_bins(Uploads& up, const TileBins& b) {
-    return {b.nx, b.ny, b.margin, up.put(b.start), up.put(b.entries), up.put(b.items)};
+    return {b.nx, b.ny, b.margin, up.put(b.start), up.put(b.entries), up.put(b.items), up.put(b.crossings)};
 }
 
 // Per-thread stack the root finder's recursion needs on top of a kernel's own frame (which

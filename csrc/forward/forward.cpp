@@ -9,6 +9,7 @@
 #include "common/thread_pool.h"
 #include "forward/forward.h"
 #include "forward/pixel.h"
+#include "scene/field.h"
 
 namespace vf {
 
@@ -125,9 +126,12 @@ void tile_forward(const SceneView& sc, const TileView& bins, const RenderOptions
                 if (r0 <= r1)
                     for (int a = ts.row_begin[r0]; a < ts.row_begin[r1 + 1]; ++a)
                         ts.winding[a] += ray_crossings(seg, ts.p[ts.active[a]], region.x1);
-                for (int j = 0; j < item.n_cross; ++j)  // the vertical leg: every sample at or below
-                    for (int a = 0; a < n_active; ++a)
-                        if (item.cross_y[j] <= ts.p[ts.active[a]].y) ts.winding[a] += item.cross_dir[j];
+                if (item.cross >= 0) {  // the vertical leg: every sample at or below
+                    const LegCrossings& c = bins.crossings[item.cross];
+                    for (int j = 0; j < c.n; ++j)
+                        for (int a = 0; a < n_active; ++a)
+                            if (c.y[j] <= ts.p[ts.active[a]].y) ts.winding[a] += c.dir[j];
+                }
             }
         }
         int kept = 0;
@@ -177,16 +181,27 @@ void render_forward(const PreparedScene& prepared, const RenderOptions& o, float
     const bool by_entry = s.mode == MODE_MC && !s.brute_force && sc.layer_parent.size() <= 1 && s.samples <= 64;
     const int threads = std::max(1, o.threads > 0 ? o.threads : ThreadPool::hardware_threads());
     std::vector<TileSamples> scratch(threads);
+    // The analytical mode: a tile's long fill entries ahead, segment by segment (scene/field.h).
+    const bool fields = s.mode == MODE_ANALYTIC && !s.brute_force;
+    std::vector<SampleGrid> grids(fields ? threads : 0);
+    std::vector<TileFields> tile_fields(fields ? threads : 0);
     PhaseTimer timer(PHASE_FORWARD);
     ThreadPool::instance().parallel_for(bins.nx * bins.ny, threads, [&](int tile, int worker) {
         if (by_entry) {
             if (!cancelled()) tile_forward(sc, bins, s, plan.background, tile, out, scratch[worker]);
             return;
         }
+        FieldView view;
+        if (fields && bins.count(tile) > 0 && !cancelled()) {
+            grids[worker].build(bins, tile, W, H, s.samples, s.filter_radius);
+            tile_fields[worker].compute(sc, bins, tile, grids[worker], s.filter_radius, false);
+            view = tile_fields[worker].view();
+        }
         int tx = tile % bins.nx, ty = tile / bins.nx;
         for (int y = ty * TILE; y < std::min(H, (ty + 1) * TILE) && !cancelled(); ++y)
             for (int x = tx * TILE; x < std::min(W, (tx + 1) * TILE); ++x)
-                pixel_forward(sc, bins, s, plan.background, x, y, out + 4 * ((size_t)y * W + x));
+                pixel_forward(sc, bins, s, plan.background, x, y, out + 4 * ((size_t)y * W + x),
+                              view.slot ? &view : nullptr);
     });
 }
 

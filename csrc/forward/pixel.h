@@ -41,9 +41,11 @@ VF_HD double entry_coverage(const SceneView& sc, const TileView& bins, const Til
     return kernel_coverage((inside ? -dist : dist) / r);
 }
 
-// Premultiplied colour of the scene at pixel-space point p, from the tile's entries.
+// Premultiplied colour of the scene at pixel-space point p, from the tile's entries; `fields`
+// (if given) holds the signed distances of some entries at the tile's samples, p being
+// sample `sample` of them (see FieldView).
 VF_HD void sample_forward(const SceneView& sc, const TileView& bins, int tile, Vec2 p, const RenderOptions& o,
-                          double out[4]) {
+                          double out[4], const FieldView* fields = nullptr, int sample = 0) {
     FrontToBackCompositor comp(sc);
     const TileEntry* entries = bins.begin(tile);
     Box region = bins.region(tile);
@@ -53,7 +55,8 @@ VF_HD void sample_forward(const SceneView& sc, const TileView& bins, int tile, V
         if (p.x < d.box.x0 - o.filter_radius || p.x > d.box.x1 + o.filter_radius ||
             p.y < d.box.y0 - o.filter_radius || p.y > d.box.y1 + o.filter_radius)
             continue;
-        double coverage = entry_coverage(sc, bins, e, region, p, o);
+        double coverage = fields && fields->has(k) ? kernel_coverage(fields->sd_at(k, sample) / o.filter_radius)
+                                                   : entry_coverage(sc, bins, e, region, p, o);
         if (coverage <= 0) continue;
         double c[4];
         paint_color(sc, sc.paints[d.paint], p, c);
@@ -82,9 +85,10 @@ VF_HD void pixel_output(const double acc[4], double wsum, const double bg[4], fl
 }
 
 // One output pixel: its samples filtered, the background under them, as straight RGBA.
-// o is the plan's options (filter radius settled); bg the premultiplied background.
+// o is the plan's options (filter radius settled); bg the premultiplied background;
+// fields: the tile's precomputed entries, or null (see sample_forward).
 VF_HD void pixel_forward(const SceneView& sc, const TileView& bins, const RenderOptions& o, const double bg[4], int x,
-                         int y, float* px) {
+                         int y, float* px, const FieldView* fields = nullptr) {
     const int N = o.samples;
     const double R = o.filter_radius;
     int tile = (y / TILE) * bins.nx + x / TILE;
@@ -98,7 +102,9 @@ VF_HD void pixel_forward(const SceneView& sc, const TileView& bins, const Render
         double w = filter_weight(o.filter, R, dx, dy);
         if (w <= 0) continue;
         double c[4] = {0, 0, 0, 0};
-        if (any) sample_forward(sc, bins, tile, {x + 0.5 + dx, y + 0.5 + dy}, o, c);
+        if (any)
+            sample_forward(sc, bins, tile, {x + 0.5 + dx, y + 0.5 + dy}, o, c, fields,
+                           fields ? tile_sample(x, y, o.width, N * N, s) : 0);
         for (int i = 0; i < 4; ++i) acc[i] += w * c[i];
         wsum += w;
     }

@@ -229,6 +229,26 @@ py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_i
     return grads_dict(g);
 }
 
+// Bytes the core holds for the scene at these options, by part: the prepared scene and the
+// forward pass's tiles (benchmarks/memory.py says where a render's memory goes).
+py::dict footprint(const py::dict& scene, const RenderOptions& options) {
+    SceneInput in = scene_input(scene);
+    SceneArrays a = in.arrays();
+    py::gil_scoped_release release;
+    std::shared_ptr<const PreparedScene> sc = prepare_timed(a);
+    ForwardPlan plan = plan_forward(*sc, options);
+    auto bytes = [](const auto& v) { return (double)v.capacity() * sizeof(v[0]); };
+    py::gil_scoped_acquire acquire;
+    py::dict r;
+    r["segments"] = bytes(sc->segments);
+    r["fill_items"] = bytes(sc->fill_items);
+    r["stroke_items"] = bytes(sc->stroke_items);
+    r["draws"] = bytes(sc->draws) + bytes(sc->paints) + bytes(sc->point_hw);
+    r["tile_entries"] = bytes(plan.bins.entries) + bytes(plan.bins.start);
+    r["tile_items"] = bytes(plan.bins.items) + bytes(plan.bins.crossings);
+    return r;
+}
+
 // The scene at n points (pixel space, [n, 2]) in the analytical mode with kernel radius
 // filter_radius: [n, 4] straight RGBA (pydiffvg's eval_positions).
 RenderOptions points_options(double filter_radius, int threads) {
@@ -403,6 +423,8 @@ PYBIND11_MODULE(_core, m) {
     m.def("filter_radius_grad", &filter_radius_grad,
           "dL/d(filter radius) in Monte Carlo mode, given dL/d(premultiplied colour) per pixel",
           py::arg("scene"), py::arg("g"), py::arg("options"));
+    m.def("footprint", &footprint, "Bytes the core holds for a scene at these options, by part",
+          py::arg("scene"), py::arg("options"));
     m.def("layout", &layout,
           "The scene arrays' layout: enums (shape_kinds, draw_kinds, fill_rules, caps, joins, paint_kinds) "
           "and each table's row width (columns)");

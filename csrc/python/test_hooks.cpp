@@ -15,6 +15,7 @@
 #include "common/ellipse.h"
 #include "common/roots.h"
 #include "scene/coverage.h"
+#include "scene/field.h"
 #include "scene/scene.h"
 
 namespace py = pybind11;
@@ -37,6 +38,14 @@ Segment segment_from(const Array<double>& pts) {
 }  // namespace
 
 void register_test_hooks(py::module_& m) {
+    m.def("field_min_items", [](int n) {
+        // The fewest segments a tile's fill entry lists for the analytical passes to compute
+        // it a tile at a time (scene/field.h); returns the previous value. 0: every entry.
+        int old = field_min_items_ref();
+        field_min_items_ref() = n;
+        return old;
+    }, py::arg("n"));
+
     m.def("boundary_pixels", [](std::pair<double, double> p, std::pair<double, double> n, double R, int W, int H) {
         // The pixels a Monte Carlo boundary sample at p (outward normal n) counts for.
         Vec2 pp{p.first, p.second};

@@ -90,13 +90,14 @@ VF_HD int ray_crossings(const PreparedSegment& s, Vec2 p, double x_max = 1e300) 
             continue;
         }
         // The sub-piece at height p.y (on the piece's half-open range, as above).
-        const double* sy = s.sub_y[k];
         int j = 0;
-        if (dir > 0) while (j + 1 < s.n_sub && sy[j + 1] <= p.y) ++j;
-        else while (j + 1 < s.n_sub && p.y < sy[j + 1]) ++j;
-        double fa = sy[j] - p.y, fb = sy[j + 1] - p.y;
+        if (dir > 0) while (j + 1 < s.n_sub && s.sub_y(k, j + 1) <= p.y) ++j;
+        else while (j + 1 < s.n_sub && p.y < s.sub_y(k, j + 1)) ++j;
+        double fa = s.sub_y(k, j) - p.y, fb = s.sub_y(k, j + 1) - p.y;
+        double ax[4], ay[4];
         if ((fa < 0) == (fb < 0) && fa != 0 && fb != 0) {  // cuts not monotone to rounding: the whole piece
-            if (monotone_crossing_within(s.ax, s.ay, p.y, s.split[k], s.split[k + 1], ya - p.y, yb - p.y, p.x, x_max))
+            s.power_basis(ax, ay);
+            if (monotone_crossing_within(ax, ay, p.y, s.split[k], s.split[k + 1], ya - p.y, yb - p.y, p.x, x_max))
                 w += dir;
             continue;
         }
@@ -105,7 +106,8 @@ VF_HD int ray_crossings(const PreparedSegment& s, Vec2 p, double x_max = 1e300) 
             w += dir;
             continue;
         }
-        if (monotone_crossing_within(s.ax, s.ay, p.y, s.sub_t(k, j), s.sub_t(k, j + 1), fa, fb, p.x, x_max)) w += dir;
+        s.power_basis(ax, ay);
+        if (monotone_crossing_within(ax, ay, p.y, s.sub_t(k, j), s.sub_t(k, j + 1), fa, fb, p.x, x_max)) w += dir;
     }
     return w;
 }
@@ -399,6 +401,33 @@ VF_HD int draw_winding_all(const SceneView& sc, const PreparedDraw& d, Vec2 p) {
     return w;
 }
 
+// Sub-piece j of y-monotone piece k cut into n capsules of equal parameter length (n <=
+// 64): pts[0..n] on the curve (power basis ax, ay; the ends' heights are the piece's cuts,
+// sub_y), and, returned, how far the curve strays from each chord at most: dt^2 / 8 times
+// the most |B''| on the sub-piece (B'' is linear in t, so that is at an end), with a
+// margin for rounding. Tile lists (scene/tiles.cpp) and the per-tile fields
+// (scene/field.cpp) bound a curve's parts by these.
+VF_HD double sub_piece_capsules(const PreparedSegment& s, const double* ax, const double* ay, int k, int j, int n,
+                                Vec2* pts) {
+    const double ta = s.sub_t(k, j), tb = s.sub_t(k, j + 1);
+    for (int i = 0; i <= n; ++i) {
+        double t = i == 0 ? ta : i == n ? tb : ta + (tb - ta) * i / n;
+        double x = ((ax[3] * t + ax[2]) * t + ax[1]) * t + ax[0];
+        double y = i == 0 ? s.sub_y(k, j) : i == n ? s.sub_y(k, j + 1) : ((ay[3] * t + ay[2]) * t + ay[1]) * t + ay[0];
+        pts[i] = {x, y};
+    }
+    double m = 0;
+    if (s.seg.degree > 1)
+        for (int e = 0; e < 2; ++e) {
+            double t = e == 0 ? ta : tb;
+            Vec2 b2{2 * ax[2] + 6 * ax[3] * t, 2 * ay[2] + 6 * ay[3] * t};
+            m = vmax(m, length(b2));
+        }
+    const double dt = (tb - ta) / n;
+    const double scale = 1 + vmax(vmax(std::fabs(s.box.x0), std::fabs(s.box.x1)), vmax(std::fabs(s.box.y0), std::fabs(s.box.y1)));
+    return dt * dt / 8 * m * (1 + 1e-9) + 1e-12 * scale;
+}
+
 // Whether the curve lies `limit` or farther from p, for certain: its sub-pieces' boxes (see
 // PreparedSegment::sub_y; exact ranges), then the halves of those that come closer, by de
 // Casteljau, each bounded by its control points' box, down to DEPTH levels. A curve's
@@ -409,7 +438,7 @@ VF_HD bool curve_farther(const PreparedSegment& s, Vec2 p, double limit) {
     const double l2 = limit * limit;
     for (int k = 0; k + 1 < s.n_split; ++k)
         for (int j = 0; j < s.n_sub; ++j) {
-            double ya = s.sub_y[k][j], yb = s.sub_y[k][j + 1];
+            double ya = s.sub_y(k, j), yb = s.sub_y(k, j + 1);
             if (distance2(Box{s.sub_x0[k][j], vmin(ya, yb), s.sub_x1[k][j], vmax(ya, yb)}, p) >= l2) continue;
             Segment stack[DEPTH + 1];
             int level[DEPTH + 1], n = 0;
@@ -431,52 +460,57 @@ VF_HD bool curve_farther(const PreparedSegment& s, Vec2 p, double limit) {
     return true;
 }
 
+// One segment of fill_distance: segment k of fill draw d (its index among the draw's
+// items) measured from p, lowering `best` (and filling `arg`) where it is closer. (A curve
+// is measured only where it may come within the distance so far, curve_farther: a long
+// path's cost follows the pixels near each segment, not those in its box.) The per-tile
+// fields (scene/field.h) call this too, so that both give the same distances and args.
+VF_HD void fill_distance_step(const SceneView& sc, const PreparedDraw& d, int k, Vec2 p, double& best,
+                              SdfArg* arg) {
+    const PreparedSegment& s = sc.fill_items[d.first_item + k];
+    double d2 = distance2(s.box, p);  // (on an edge, with arg: look for a second one)
+    if (d2 >= best * best && !(arg && best < ON_EDGE && d2 < ON_EDGE * ON_EDGE)) return;
+    if (s.seg.degree > 1 && curve_farther(s, p, arg && best < ON_EDGE ? ON_EDGE : best)) return;
+    Closest c;
+    if (s.seg.degree == 1) {
+        Vec2 a = s.seg.p[0], e = s.seg.p[1] - a;
+        double l2 = dot(e, e);
+        c.t = l2 > 0 ? vclamp(dot(p - a, e) / l2, 0.0, 1.0) : 0.0;
+        c.dist = distance(a + c.t * e, p);
+    } else {
+        c = seg_closest(s.seg, p);
+    }
+    if (arg && c.dist < ON_EDGE && best < ON_EDGE) {  // a vertex: keep both segments
+        int keep = c.dist < best ? arg->item : d.first_item + k;
+        double keep_t = c.dist < best ? arg->t : c.t;  // (stored as a float)
+        if (c.dist < best) {
+            best = c.dist;
+            arg->item = d.first_item + k;
+            arg->t = c.t;
+            arg->closest = seg_eval(s.seg, c.t);
+        }
+        arg->item2 = keep;
+        arg->t2 = (float)keep_t;
+        return;
+    }
+    if (c.dist < best) {
+        best = c.dist;
+        if (arg) {
+            arg->item2 = -1;
+            arg->kind = SdfArg::SEGMENT;
+            arg->item = d.first_item + k;
+            arg->t = c.t;
+            arg->closest = seg_eval(s.seg, c.t);
+        }
+    }
+}
+
 // Distance from p to the closest fill segment among items, or `limit` if none is closer.
-// (A curve is measured only where it may come within the distance so far, curve_farther:
-// a long path's cost follows the pixels near each segment, not those in its box.)
 template <class Items>
 VF_HD double fill_distance(const SceneView& sc, const PreparedDraw& d, const Items& items, Vec2 p, double limit,
                      SdfArg* arg = nullptr) {
-    const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
     double best = limit;
-    for (int i = 0; i < items.size(); ++i) {
-        const PreparedSegment& s = segs[items[i]];
-        double d2 = distance2(s.box, p);  // (on an edge, with arg: look for a second one)
-        if (d2 >= best * best && !(arg && best < ON_EDGE && d2 < ON_EDGE * ON_EDGE)) continue;
-        if (s.seg.degree > 1 && curve_farther(s, p, arg && best < ON_EDGE ? ON_EDGE : best)) continue;
-        Closest c;
-        if (s.seg.degree == 1) {
-            Vec2 a = s.seg.p[0], e = s.seg.p[1] - a;
-            double l2 = dot(e, e);
-            c.t = l2 > 0 ? vclamp(dot(p - a, e) / l2, 0.0, 1.0) : 0.0;
-            c.dist = distance(a + c.t * e, p);
-        } else {
-            c = seg_closest(s.seg, p);
-        }
-        if (arg && c.dist < ON_EDGE && best < ON_EDGE) {  // a vertex: keep both segments
-            int keep = c.dist < best ? arg->item : d.first_item + items[i];
-            double keep_t = c.dist < best ? arg->t : c.t;  // (stored as a float)
-            if (c.dist < best) {
-                best = c.dist;
-                arg->item = d.first_item + items[i];
-                arg->t = c.t;
-                arg->closest = seg_eval(s.seg, c.t);
-            }
-            arg->item2 = keep;
-            arg->t2 = (float)keep_t;
-            continue;
-        }
-        if (c.dist < best) {
-            best = c.dist;
-            if (arg) {
-                arg->item2 = -1;
-                arg->kind = SdfArg::SEGMENT;
-                arg->item = d.first_item + items[i];
-                arg->t = c.t;
-                arg->closest = seg_eval(s.seg, c.t);
-            }
-        }
-    }
+    for (int i = 0; i < items.size(); ++i) fill_distance_step(sc, d, items[i], p, best, arg);
     return best;
 }
 

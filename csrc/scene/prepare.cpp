@@ -2,6 +2,7 @@
 // y-monotone pieces for ray crossings, stroke pieces (joins and caps), paints (from the
 // paints table), layers.
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -20,6 +21,20 @@ bool finite(double v) { return std::isfinite(v); }
 
 }  // namespace
 
+namespace {
+
+// A double range's ends as floats, rounded outwards.
+float float_below(double v) {
+    float f = (float)v;
+    return (double)f > v ? std::nextafter(f, -INFINITY) : f;
+}
+float float_above(double v) {
+    float f = (float)v;
+    return (double)f < v ? std::nextafter(f, INFINITY) : f;
+}
+
+}  // namespace
+
 PreparedSegment prepare_segment(const Segment& s, const int32_t* idx) {
     PreparedSegment ps;
     ps.seg = s;
@@ -33,22 +48,21 @@ PreparedSegment prepare_segment(const Segment& s, const int32_t* idx) {
         if (ty[i] > ps.split[ps.n_split - 1]) ps.split[ps.n_split++] = ty[i];
     ps.split[ps.n_split++] = 1;
     for (int i = 0; i < ps.n_split; ++i) ps.split_y[i] = seg_eval(s, ps.split[i]).y;
-    seg_axis_poly(s, 0, ps.ax);
-    seg_axis_poly(s, 1, ps.ay);
+    double ax[4], ay[4];
+    ps.power_basis(ax, ay);
     for (int k = 0; k + 1 < ps.n_split; ++k) {
         Box b = seg_bbox(s, ps.split[k], ps.split[k + 1], tx, nx, nullptr, 0);  // (no y-extrema inside)
-        ps.piece_x0[k] = b.x0;
-        ps.piece_x1[k] = b.x1;
+        ps.piece_x0[k] = float_below(b.x0);
+        ps.piece_x1[k] = float_above(b.x1);
         ps.n_sub = s.degree == 1 ? 1 : PreparedSegment::SUB;
-        for (int j = 0; j <= ps.n_sub; ++j) {
+        for (int j = 1; j < ps.n_sub; ++j) {
             double t = ps.sub_t(k, j);
             // the ends are the piece's own values, the cuts those monotone_crossing_within sees
-            ps.sub_y[k][j] = j == 0 ? ps.split_y[k] : j == ps.n_sub ? ps.split_y[k + 1] :
-                             ((ps.ay[3] * t + ps.ay[2]) * t + ps.ay[1]) * t + ps.ay[0];
+            ps.sub_cut[k][j - 1] = ((ay[3] * t + ay[2]) * t + ay[1]) * t + ay[0];
         }
         // x ranges from the power basis (cheaper than de Casteljau; this runs on every
         // call), widened as seg_bbox widens boxes so that rounding cannot shrink them.
-        auto X = [&](double t) { return ((ps.ax[3] * t + ps.ax[2]) * t + ps.ax[1]) * t + ps.ax[0]; };
+        auto X = [&](double t) { return ((ax[3] * t + ax[2]) * t + ax[1]) * t + ax[0]; };
         double grow = 1e-9 * (1 + vmax(vmax(std::fabs(ps.box.x0), std::fabs(ps.box.x1)),
                                        vmax(std::fabs(ps.box.y0), std::fabs(ps.box.y1))));
         double x_next = X(ps.sub_t(k, 0));
@@ -62,8 +76,8 @@ PreparedSegment prepare_segment(const Segment& s, const int32_t* idx) {
                     lo = vmin(lo, x);
                     hi = vmax(hi, x);
                 }
-            ps.sub_x0[k][j] = lo - grow;
-            ps.sub_x1[k][j] = hi + grow;
+            ps.sub_x0[k][j] = float_below(lo - grow);
+            ps.sub_x1[k][j] = float_above(hi + grow);
         }
     }
     return ps;
@@ -165,7 +179,7 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
     // Vertex widths at an item's start and end: the width of the point there.
     auto start_index = [&](const StrokeSegment& ss) { return sc.segments[ss.source].point_index[0]; };
     auto end_index = [&](const StrokeSegment& ss) {
-        const PreparedSegment& src = sc.segments[ss.source];
+        const SegmentSource& src = sc.segments[ss.source];
         return src.point_index[src.seg.degree];
     };
     auto set_width = [&](StrokeEnd& e, int32_t k) {
@@ -269,18 +283,27 @@ PreparedScene prepare_scene(const SceneArrays& a) {
         if (!(finite(pts[i].x) && finite(pts[i].y))) check(false, "non-finite point " + std::to_string(i));
     }
 
-    sc.segments.reserve(a.n_segments);
+    // The segments checked and read once (control points in doubles); kept as sources only
+    // where some draw strokes a path (fills prepare their own, below).
+    std::vector<SegmentSource> sources(a.n_segments);
     for (int g = 0; g < a.n_segments; ++g) {
         const int32_t* row = a.segments + SEGMENT_COLS * g;
-        Segment s;
-        s.degree = row[0];
-        check(s.degree >= 1 && s.degree <= 3, "segment degree must be 1, 2 or 3");
-        for (int i = 0; i <= s.degree; ++i) {
+        SegmentSource& src = sources[g];
+        src.seg.degree = row[0];
+        check(src.seg.degree >= 1 && src.seg.degree <= 3, "segment degree must be 1, 2 or 3");
+        for (int i = 0; i <= src.seg.degree; ++i) {
             int32_t k = row[1 + i];
             check(k >= 0 && k < a.n_points, "segment point index out of range");
-            s.p[i] = pts[k];
+            src.seg.p[i] = pts[k];
         }
-        sc.segments.push_back(prepare_segment(s, row + 1));
+        for (int i = 0; i < 4; ++i) src.point_index[i] = row[1 + i];
+    }
+    std::vector<Vec2>().swap(pts);
+    bool strokes = false;
+    for (int di = 0; di < a.n_draws; ++di) {
+        const int32_t* row = a.draws + DRAW_COLS * di;
+        strokes |= row[1] == DRAW_STROKE && row[0] >= 0 && row[0] < a.n_shapes &&
+                   a.shapes[SHAPE_COLS * row[0]] == SHAPE_PATH;
     }
 
     sc.stop_offsets.assign(a.stop_offsets, a.stop_offsets + a.n_stops);
@@ -313,7 +336,22 @@ PreparedScene prepare_scene(const SceneArrays& a) {
         check(sc.layer_depth[l] < MAX_LAYER_DEPTH, "groups with opacity nested too deeply");
     }
 
-    sc.fill_items.reserve(a.n_segments + a.n_subpaths);  // (at most: every segment, a closing line each)
+    if (strokes) sc.segments = std::move(sources);  // (the stroke items refer to them)
+    const std::vector<SegmentSource>& segs = strokes ? sc.segments : sources;
+    // (every fill draw's segments and closing lines: counted first, so that the vector is
+    // allocated once at its size)
+    size_t n_fill = 0;
+    for (int di = 0; di < a.n_draws; ++di) {
+        const int32_t* row = a.draws + DRAW_COLS * di;
+        if (row[1] != DRAW_FILL || row[0] < 0 || row[0] >= a.n_shapes) continue;
+        const int32_t* shape = a.shapes + SHAPE_COLS * row[0];
+        if (shape[0] != SHAPE_PATH || shape[1] < 0 || shape[2] < 0 || shape[1] + shape[2] > a.n_subpaths) continue;
+        for (int b = shape[1]; b < shape[1] + shape[2]; ++b) {
+            const int32_t* sp = a.subpaths + SUBPATH_COLS * b;
+            if (sp[0] >= 0 && sp[1] >= 0 && sp[1] <= a.n_segments - sp[0]) n_fill += (size_t)sp[1] + 1;
+        }
+    }
+    sc.fill_items.reserve(n_fill);
     for (int di = 0; di < a.n_draws; ++di) {
         const int32_t* row = a.draws + DRAW_COLS * di;
         const float* f = a.draw_params + DRAW_FCOLS * di;
@@ -371,10 +409,11 @@ PreparedScene prepare_scene(const SceneArrays& a) {
                 check(first >= 0 && count >= 0 && first + count <= a.n_segments, "subpath segments out of range");
                 if (count == 0) continue;
                 if (d.kind == DRAW_FILL) {
-                    for (int g = first; g < first + count; ++g) sc.fill_items.push_back(sc.segments[g]);
+                    for (int g = first; g < first + count; ++g)
+                        sc.fill_items.push_back(prepare_segment(segs[g].seg, segs[g].point_index));
                     if (!closed) {  // filling closes an open subpath with a straight line
-                        const PreparedSegment& last = sc.segments[first + count - 1];
-                        const PreparedSegment& head = sc.segments[first];
+                        const SegmentSource& last = segs[first + count - 1];
+                        const SegmentSource& head = segs[first];
                         Segment line;
                         line.degree = 1;
                         line.p[0] = seg_end(last.seg);

@@ -57,27 +57,44 @@ struct SceneArrays {
     const float* layer_opacity = nullptr;                      // [L]
 };
 
+// A path segment as its strokes are built from it: its control points (pixel space) and
+// where they came from (for gradients).
+struct SegmentSource {
+    Segment seg;
+    int32_t point_index[4] = {-1, -1, -1, -1};
+};
+
 // A segment ready for sampling, with where its control points came from (for gradients).
+// (384 bytes: ranges are floats rounded outwards, the power basis is computed where a
+// root needs it; a path of 300,000 segments holds one of these per segment.)
 struct PreparedSegment {
     Segment seg;
     int32_t point_index[4] = {-1, -1, -1, -1};
     Box box;
     double split[4];        // 0, y-extrema in (0,1) ascending, 1: y-monotone pieces
     double split_y[4];      // y at each split
-    double piece_x0[3], piece_x1[3];  // x range of each piece (of the curve, see seg_bbox)
-    double ax[4], ay[4];    // power-basis coefficients of x(t) and y(t)
+    float piece_x0[3], piece_x1[3];  // x range of each piece (of the curve, see seg_bbox)
     int n_split = 2;
     // Each y-monotone piece cut into n_sub sub-pieces of equal parameter length (curves;
-    // lines keep one; see sub_t), with their y (from ax, ay) and x ranges: a ray crossing
-    // is decided by the one sub-piece at the ray's height, whose x range is a few times
+    // lines keep one; see sub_t), with their y (sub_y) and x ranges: a ray crossing is
+    // decided by the one sub-piece at the ray's height, whose x range is a few times
     // narrower than the piece's (no root to solve for most samples) and whose parameter
     // range brackets the root tightly (ray_crossings).
     static constexpr int SUB = 4;
     int n_sub = 1;
-    double sub_y[3][SUB + 1];
-    double sub_x0[3][SUB], sub_x1[3][SUB];
+    double sub_cut[3][SUB - 1];  // y at the cuts inside each piece
+    float sub_x0[3][SUB], sub_x1[3][SUB];
     VF_HD double sub_t(int k, int j) const {
         return j == n_sub ? split[k + 1] : split[k] + (split[k + 1] - split[k]) * j / n_sub;
+    }
+    // y at cut j of piece k: its ends (j = 0, n_sub) are the piece's own.
+    VF_HD double sub_y(int k, int j) const {
+        return j == 0 ? split_y[k] : j == n_sub ? split_y[k + 1] : sub_cut[k][j - 1];
+    }
+    // Power-basis coefficients of x(t) and y(t), for roots.
+    VF_HD void power_basis(double* ax, double* ay) const {
+        seg_axis_poly(seg, 0, ax);
+        seg_axis_poly(seg, 1, ay);
     }
 };
 
@@ -99,7 +116,7 @@ struct StrokeEnd {
 // starts an open subpath.
 struct StrokeSegment {
     Segment seg;           // in stroke space
-    int32_t source = -1;   // index into PreparedScene::segments
+    int32_t source = -1;   // index into PreparedScene::segments (its path segment)
     int32_t next = -1;     // the stroke item after the join at this item's end (index into stroke_items)
     double t0 = 0, t1 = 1; // the part of the source segment this item is (curves are split
                            // into short pieces: tighter bounds, fewer roots to find)
@@ -150,7 +167,9 @@ struct PreparedPaint {
 };
 
 struct PreparedScene {
-    std::vector<PreparedSegment> segments;   // every path segment, pixel space
+    // Every path segment (pixel space) where some draw strokes a path (the stroke items
+    // refer to them, StrokeSegment::source); else empty. Fills keep their own, prepared.
+    std::vector<SegmentSource> segments;
     std::vector<double> point_hw;            // per-point half widths (as given: clamp at 0 to use), or empty
     std::vector<PreparedSegment> fill_items; // per fill draw: its segments and closing lines
     std::vector<StrokeSegment> stroke_items; // per stroke draw
@@ -167,7 +186,7 @@ struct PreparedScene {
 // The prepared scene as the per-sample code reads it: views of its arrays, in host memory
 // (PreparedScene::view) or in device memory (a CUDA build's copy).
 struct SceneView {
-    Span<PreparedSegment> segments;
+    Span<SegmentSource> segments;
     Span<double> point_hw;
     Span<PreparedSegment> fill_items;
     Span<StrokeSegment> stroke_items;

@@ -50,8 +50,10 @@ int vertical_crossings(const PreparedSegment& ps, double X, double y_low, double
         if (xa <= X && X < xb) dir = 1;
         else if (xb <= X && X < xa) dir = -1;
         else continue;
-        double t = monotone_root(ps.ax, X, ts[k], ts[k + 1], xa - X, xb - X);
-        double y = ((ps.ay[3] * t + ps.ay[2]) * t + ps.ay[1]) * t + ps.ay[0];
+        double ax[4], ay[4];
+        ps.power_basis(ax, ay);
+        double t = monotone_root(ax, X, ts[k], ts[k + 1], xa - X, xb - X);
+        double y = ((ay[3] * t + ay[2]) * t + ay[1]) * t + ay[0];
         if (y > y_low && y <= y_high && count < 3) {
             ys[count] = y;
             dirs[count] = (int8_t)dir;
@@ -105,7 +107,7 @@ struct DrawScratch {
 // and emits an entry per tile that the draw can affect.
 void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_index, const TileRange& range,
                    const TileBins& bins, bool every_tile, std::vector<Pending>& pending,
-                   std::vector<LocalItem>& items, DrawScratch& scratch) {
+                   std::vector<LocalItem>& items, std::vector<LegCrossings>& crossings, DrawScratch& scratch) {
     const bool fill = d.kind == DRAW_FILL;
     const int w = range.width(), h = range.y1 - range.y0 + 1;
     auto item_box = [&](int k) -> const Box& {
@@ -151,19 +153,39 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
                 for (int tx = r.x0; tx <= r.x1; ++tx) visit((ty - range.y0) * w + (tx - range.x0));
             return;
         }
+        auto visit_range = [&](const TileRange& sr) {
+            for (int ty = sr.y0; ty <= sr.y1; ++ty)
+                for (int tx = sr.x0; tx <= sr.x1; ++tx) {
+                    int cell = (ty - range.y0) * w + (tx - range.x0);
+                    if (stamp[cell] != k) {
+                        stamp[cell] = k;
+                        visit(cell);
+                    }
+                }
+        };
+        double ax[4], ay[4];
+        seg->power_basis(ax, ay);
+        Vec2 pts[65];
         for (int i = 0; i + 1 < seg->n_split; ++i)
             for (int j = 0; j < seg->n_sub; ++j) {
-                double ya = seg->sub_y[i][j], yb = seg->sub_y[i][j + 1];
-                TileRange sr = tiles_of(Box{seg->sub_x0[i][j], std::min(ya, yb), seg->sub_x1[i][j], std::max(ya, yb)},
-                                        bins.margin, r);
-                for (int ty = sr.y0; ty <= sr.y1; ++ty)
-                    for (int tx = sr.x0; tx <= sr.x1; ++tx) {
-                        int cell = (ty - range.y0) * w + (tx - range.x0);
-                        if (stamp[cell] != k) {
-                            stamp[cell] = k;
-                            visit(cell);
-                        }
-                    }
+                double ya = seg->sub_y(i, j), yb = seg->sub_y(i, j + 1);
+                Box sub{seg->sub_x0[i][j], std::min(ya, yb), seg->sub_x1[i][j], std::max(ya, yb)};
+                TileRange sr = tiles_of(sub, bins.margin, r);
+                if (sr.empty()) continue;
+                if (sr.width() * (sr.y1 - sr.y0 + 1) <= 2) {
+                    visit_range(sr);
+                    continue;
+                }
+                // A sub-piece's box can hold many tiles its curve never comes near (a curve
+                // across the canvas): capsules of about half a tile.
+                int n = clamp_to_int(std::ceil(((sub.x1 - sub.x0) + (sub.y1 - sub.y0)) / (0.5 * TILE)), 1, 64);
+                double h = sub_piece_capsules(*seg, ax, ay, i, j, n, pts);
+                for (int c = 0; c < n; ++c) {
+                    Box b;
+                    expand(b, pts[c]);
+                    expand(b, pts[c + 1]);
+                    visit_range(tiles_of(grown(b, h), bins.margin, sr));
+                }
             }
     };
     for (int k = 0; k < d.n_items; ++k)
@@ -188,6 +210,8 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
         for (int r = 0; r < h; ++r) row_crossings[r].clear();
         for (int k = 0; k < d.n_items; ++k) {
             const PreparedSegment& s = sc.fill_items[d.first_item + k];
+            double ax[4], ay[4];
+            s.power_basis(ax, ay);
             int r0 = clamp_to_int(std::ceil((s.box.y0 + bins.margin) / TILE), range.y0, range.y1 + 1);
             int r1 = clamp_to_int(std::floor((s.box.y1 + bins.margin) / TILE), range.y0 - 1, range.y1);
             for (int ty = r0; ty <= r1; ++ty) {
@@ -198,14 +222,17 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
                     if (ya <= y && y < yb) dir = 1;
                     else if (yb <= y && y < ya) dir = -1;
                     else continue;
-                    double t = monotone_root(s.ay, y, s.split[j], s.split[j + 1], ya - y, yb - y);
-                    double x = ((s.ax[3] * t + s.ax[2]) * t + s.ax[1]) * t + s.ax[0];
+                    double t = monotone_root(ay, y, s.split[j], s.split[j + 1], ya - y, yb - y);
+                    double x = ((ax[3] * t + ax[2]) * t + ax[1]) * t + ax[0];
                     row_crossings[ty - range.y0].push_back({x, dir});
                 }
             }
         }
     }
 
+    // (room for the draw's items at once: one long path's are most of the bins)
+    const size_t needed = items.size() + (size_t)start[w * h];
+    if (needed > items.capacity()) items.reserve(std::max(needed, 2 * items.capacity()));
     for (int ty = range.y0; ty <= range.y1; ++ty) {
         std::vector<std::pair<double, int>>* row = fill ? &row_crossings[ty - range.y0] : nullptr;
         if (row) std::sort(row->begin(), row->end());
@@ -232,8 +259,13 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
                 li.item = local[i];
                 if (fill) {
                     const PreparedSegment& s = sc.fill_items[d.first_item + li.item];
+                    LegCrossings c;
                     if (s.box.x0 <= region.x1 && region.x1 <= s.box.x1)
-                        li.n_cross = vertical_crossings(s, region.x1, region.y0, region.y1, li.cross_y, li.cross_dir);
+                        c.n = (int8_t)vertical_crossings(s, region.x1, region.y0, region.y1, c.y, c.dir);
+                    if (c.n > 0) {
+                        li.cross = (int)crossings.size();
+                        crossings.push_back(c);
+                    }
                 }
                 items.push_back(li);
             }
@@ -248,6 +280,7 @@ struct DrawRun {
     int begin = 0, end = 0;
     std::vector<Pending> pending;
     std::vector<LocalItem> items;
+    std::vector<LegCrossings> crossings;
 };
 
 void bin_run(const PreparedScene& sc, const TileBins& bins, const TileRange& all, bool every_tile, DrawRun& run,
@@ -260,7 +293,7 @@ void bin_run(const PreparedScene& sc, const TileBins& bins, const TileRange& all
             for (int ty = range.y0; ty <= range.y1; ++ty)
                 for (int tx = range.x0; tx <= range.x1; ++tx) run.pending.push_back({ty * bins.nx + tx, TileEntry{i, 0, 0, 0}});
         } else {
-            bin_path_draw(sc, d, i, range, bins, every_tile, run.pending, run.items, scratch);
+            bin_path_draw(sc, d, i, range, bins, every_tile, run.pending, run.items, run.crossings, scratch);
         }
     }
 }
@@ -290,13 +323,30 @@ TileBins bin_draws(const PreparedScene& sc, int width, int height, double margin
 
     // The runs joined: their items in order, and a stable counting sort of their entries
     // by tile (which keeps each tile's entries in paint order), the two side by side.
-    std::vector<size_t> item_offset(n_runs + 1, 0);
-    for (int r = 0; r < n_runs; ++r) item_offset[r + 1] = item_offset[r] + runs[r].items.size();
-    bins.items.resize(item_offset[n_runs]);
+    std::vector<size_t> item_offset(n_runs + 1, 0), cross_offset(n_runs + 1, 0);
+    for (int r = 0; r < n_runs; ++r) {
+        item_offset[r + 1] = item_offset[r] + runs[r].items.size();
+        cross_offset[r + 1] = cross_offset[r] + runs[r].crossings.size();
+    }
     const int n_tiles = bins.nx * bins.ny;
     auto join_items = [&] {
-        for (int r = 0; r < n_runs; ++r)
-            std::copy(runs[r].items.begin(), runs[r].items.end(), bins.items.begin() + item_offset[r]);
+        if (n_runs == 1) {  // (one run, the common case for one long path: no copies)
+            bins.items = std::move(runs[0].items);
+            bins.crossings = std::move(runs[0].crossings);
+            return;
+        }
+        bins.items.resize(item_offset[n_runs]);
+        bins.crossings.resize(cross_offset[n_runs]);
+        for (int r = 0; r < n_runs; ++r) {
+            LocalItem* out = bins.items.data() + item_offset[r];
+            for (size_t i = 0; i < runs[r].items.size(); ++i) {
+                out[i] = runs[r].items[i];
+                if (out[i].cross >= 0) out[i].cross += (int)cross_offset[r];
+            }
+            std::vector<LocalItem>().swap(runs[r].items);
+            std::copy(runs[r].crossings.begin(), runs[r].crossings.end(), bins.crossings.begin() + cross_offset[r]);
+            std::vector<LegCrossings>().swap(runs[r].crossings);
+        }
     };
     auto sort_entries = [&] {
         bins.start.assign(n_tiles + 1, 0);

@@ -26,11 +26,17 @@ namespace vf {
 
 constexpr int TILE = 8;
 
+// A fill segment's crossings of a tile's vertical leg (x = region.x1): heights and directions.
+struct LegCrossings {
+    double y[3] = {0, 0, 0};
+    int8_t dir[3] = {0, 0, 0};
+    int8_t n = 0;
+};
+
 struct LocalItem {
     int32_t item = 0;             // index into the draw's fill or stroke items
-    int32_t n_cross = 0;          // crossings of the vertical leg (fills)
-    double cross_y[3] = {0, 0, 0};
-    int8_t cross_dir[3] = {0, 0, 0};
+    int32_t cross = -1;           // fills: its crossings of the vertical leg (index into the
+                                  // bins' crossings), -1 where it has none (most items)
 };
 
 struct TileEntry {
@@ -48,6 +54,16 @@ struct TileView {
     Span<int> start;
     Span<TileEntry> entries;
     Span<LocalItem> items;
+    Span<LegCrossings> crossings;
+    // The vertical leg's crossings of an item at heights up to y (see tile_winding).
+    VF_HD int leg_crossings(const LocalItem& li, double y) const {
+        if (li.cross < 0) return 0;
+        const LegCrossings& c = crossings[li.cross];
+        int w = 0;
+        for (int k = 0; k < c.n; ++k)
+            if (c.y[k] <= y) w += c.dir[k];  // heights are already > region.y0
+        return w;
+    }
     VF_HD const TileEntry* begin(int tile) const { return entries.data() + start[tile]; }
     VF_HD int count(int tile) const { return start[tile + 1] - start[tile]; }
     VF_HD Box region(int tile) const {  // pixel-space area the tile's samples and prefilter reach
@@ -63,8 +79,32 @@ struct TileBins {
     std::vector<int> start;       // [nx * ny + 1] offsets into entries
     std::vector<TileEntry> entries;
     std::vector<LocalItem> items;
-    TileView view() const { return {nx, ny, margin, span_of(start), span_of(entries), span_of(items)}; }
+    std::vector<LegCrossings> crossings;
+    TileView view() const {
+        return {nx, ny, margin, span_of(start), span_of(entries), span_of(items), span_of(crossings)};
+    }
     Box region(int tile) const { return view().region(tile); }
+};
+
+// Index of sample s (of spp per pixel) of pixel (x, y) among its tile's samples: pixel by
+// pixel, in rows, then the pixel's own order.
+VF_HD int tile_sample(int x, int y, int width, int spp, int s) {
+    int x0 = x / TILE * TILE, y0 = y / TILE * TILE, w = vmin(width - x0, TILE);
+    return ((y - y0) * w + (x - x0)) * spp + s;
+}
+
+// Signed distances of some of a tile's fill entries at every sample of the tile, computed
+// ahead segment by segment (scene/field.h, the CPU's analytical passes): what entry_sdf
+// gives there, and its SdfArg. The GPU and the other passes have none (a null view).
+struct FieldView {
+    const int* slot = nullptr;    // per entry of the tile (its place in the tile's list): its field, or -1
+    const double* sd = nullptr;   // [slot * n + sample]
+    const SdfArg* arg = nullptr;  // the same layout, or null (forward pass)
+    int n = 0;                    // samples in the tile
+    int tile = -1;                // the tile
+    VF_HD bool has(int k) const { return slot && slot[k] >= 0; }
+    VF_HD double sd_at(int k, int sample) const { return sd[(size_t)slot[k] * n + sample]; }
+    VF_HD const SdfArg& arg_at(int k, int sample) const { return arg[(size_t)slot[k] * n + sample]; }
 };
 
 // margin: how far (pixels) outside a tile its samples and their prefilter reach.
@@ -82,9 +122,7 @@ VF_HD int tile_winding(const SceneView& sc, const TileView& bins, const TileEntr
     int w = e.winding;
     for (int i = 0; i < e.count; ++i) {
         const LocalItem& li = items[i];
-        w += ray_crossings(segs[li.item], p, region.x1);
-        for (int c = 0; c < li.n_cross; ++c)
-            if (li.cross_y[c] <= p.y) w += li.cross_dir[c];  // heights are already > region.y0
+        w += ray_crossings(segs[li.item], p, region.x1) + bins.leg_crossings(li, p.y);
     }
     return w;
 }

@@ -1,9 +1,11 @@
 """Long paths (issue 28): the tile lists follow the pixels a segment reaches (a curve of a
 fill is listed only in the tiles its sub-pieces' boxes reach; a stroke wide against a tile
 lists no items in the tiles that lie inside one of its pieces), and the analytical
-distance measures a curve only near its sub-pieces. None of it may change an image: each
+distance measures a curve only near its sub-pieces; the analytical passes compute a tile's
+long fill entries segment by segment (scene/field.h). None of it may change an image: each
 scene here is rendered through the tiles and brute force (every item of every draw at
-every sample), in both modes. Timings are in benchmarks/long_paths.py."""
+every sample), in both modes, and the analytical mode with every entry a tile at a time
+and none. Timings are in benchmarks/long_paths.py."""
 from __future__ import annotations
 
 import random
@@ -12,6 +14,7 @@ import pytest
 import torch
 
 import vecfit
+from vecfit import _core
 from helpers import quiet_load
 
 NS = 'xmlns="http://www.w3.org/2000/svg"'
@@ -86,3 +89,42 @@ def test_wide_stroke_gradients_unchanged_inside(tmp_path, mode):
         grads.append(torch.cat([t.grad.reshape(-1) for t in pts]))
     assert torch.isfinite(grads[0]).all() and grads[0].abs().sum() > 0
     assert torch.allclose(grads[0], grads[1], rtol=1e-5, atol=1e-5)
+
+
+FIELD_SCENES = {
+    **{k: SCENES[k] for k in ("cubics-across", "walk-mixed")},
+    "stroke-1e7": SCENES["stroke-1e7"].replace('stroke="green"', 'stroke="green" stroke-opacity="0.5"'),
+    # a rect's corners and edges on pixel centres (samples on edges and vertices: the args'
+    # second segment), a self-crossing star (nonzero), curves meeting at their ends
+    "edges": '<path d="M 8.5 8.5 H 40.5 V 40.5 H 8.5 Z M 20 4 L 36 60 L 4 24 L 60 24 L 12 60 Z" fill="#a50"/>'
+             f'<path d="{walk(60, 64, 16, "QC", 7)} Z" fill="#05a" fill-opacity="0.6"/>',
+}
+
+
+@pytest.mark.parametrize("name", list(FIELD_SCENES))
+@pytest.mark.parametrize("samples,filt", [(1, "box"), (2, "box"), (3, "tent")])
+def test_fields_match_per_sample(tmp_path, name, samples, filt):
+    """The analytical passes with every fill entry computed a tile at a time give the
+    per-sample images and gradients, bit for bit."""
+    svg = tmp_path / f"{name}.svg"
+    svg.write_text(f'<svg {NS} width="64" height="64">{GRADIENT}{FIELD_SCENES[name]}</svg>')
+    results = []
+    old = _core.field_min_items(0)
+    try:
+        for threshold in (0, 1 << 30):
+            _core.field_min_items(threshold)
+            scene = quiet_load(svg)
+            pts = scene.parameters()["points"]
+            for t in pts:
+                t.requires_grad_(True)
+            image = vecfit.render(scene, 48, 48, samples=samples, mode="analytic", filter=filt,
+                                  filter_radius=1.0, threads=2)
+            weights = torch.rand(image.shape, generator=torch.Generator().manual_seed(5))
+            (image * weights).sum().backward()
+            results.append((image.detach(), torch.cat([t.grad.reshape(-1) for t in pts])))
+    finally:
+        _core.field_min_items(old)
+    (fi, fg), (si, sg) = results
+    assert fi[..., 3].sum() > 0 and sg.abs().sum() > 0
+    assert torch.equal(fi, si), float((fi - si).abs().max())
+    assert torch.equal(fg, sg), float((fg - sg).abs().max())

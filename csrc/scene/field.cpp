@@ -1,0 +1,313 @@
+// The analytical prefilter's long fill entries, a tile at a time (field.h): winding numbers
+// by rows of samples, distances by pieces of curve and the samples near each.
+#include "scene/field.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vf {
+
+int& field_min_items_ref() {
+    // Measured on tiger and boston (2x2, both passes): entries this long cost about the
+    // same either way; below, the per-tile set-up costs more than it saves.
+    static int n = 16;
+    return n;
+}
+
+namespace {
+
+// About how long a capsule is (pixels), and the most a sub-piece is cut into: a capsule a
+// pixel long lies within about 1 / (8 x radius of curvature) of its curve, which sets
+// aside nearly every curve that is not the closest.
+constexpr double PIECE = 1.0;
+
+double box_distance2(const Box& a, const Box& b) {
+    double dx = vmax(vmax(a.x0 - b.x1, b.x0 - a.x1), 0.0);
+    double dy = vmax(vmax(a.y0 - b.y1, b.y0 - a.y1), 0.0);
+    return dx * dx + dy * dy;
+}
+
+}  // namespace
+
+void SampleGrid::build(const TileView& bins, int tile, int width, int height, int samples, double R) {
+    N = samples;
+    const int tx = tile % bins.nx, ty = tile / bins.nx;
+    x0 = tx * TILE;
+    y0 = ty * TILE;
+    x1 = std::min(width, x0 + TILE);
+    y1 = std::min(height, y0 + TILE);
+    struct Line {
+        double v;
+        int pixel, sub;
+    };
+    std::vector<Line> lines;
+    std::vector<int> pixel, sub, row_pixel, row_sub;
+    auto axis = [&](int a0, int a1, std::vector<double>& pos, std::vector<int>& pixel, std::vector<int>& sub) {
+        lines.clear();
+        for (int a = a0; a < a1; ++a)
+            for (int i = 0; i < N; ++i) {
+                double f = (i + 0.5) / N;  // the strata centres of pixel_forward and pixel_backward,
+                double d = R * (2 * f - 1);  // computed as they compute them
+                lines.push_back({a + 0.5 + d, a, i});
+            }
+        std::stable_sort(lines.begin(), lines.end(), [](const Line& a, const Line& b) { return a.v < b.v; });
+        pos.resize(lines.size());
+        pixel.resize(lines.size());
+        sub.resize(lines.size());
+        for (size_t k = 0; k < lines.size(); ++k) {
+            pos[k] = lines[k].v;
+            pixel[k] = lines[k].pixel;
+            sub[k] = lines[k].sub;
+        }
+    };
+    axis(x0, x1, col_x, pixel, sub);
+    axis(y0, y1, row_y, row_pixel, row_sub);
+    const size_t cols = col_x.size();
+    index.resize(cols * row_y.size());
+    for (size_t row = 0; row < row_y.size(); ++row)
+        for (size_t col = 0; col < cols; ++col)
+            index[row * cols + col] =
+                ((row_pixel[row] - y0) * (x1 - x0) + (pixel[col] - x0)) * N * N + row_sub[row] * N + sub[col];
+    auto spacing = [](const std::vector<double>& v, double& v0, double& inv_step) {
+        v0 = v.front();
+        inv_step = v.size() > 1 && v.back() > v.front() ? (double)(v.size() - 1) / (v.back() - v.front()) : 1.0;
+    };
+    spacing(col_x, col0_, col_step_);
+    spacing(row_y, row0_, row_step_);
+}
+
+void TileFields::compute(const SceneView& sc, const TileView& bins, int tile, const SampleGrid& grid, double r,
+                         bool args) {
+    const int count = bins.count(tile);
+    const TileEntry* es = bins.begin(tile);
+    const int min_items = field_min_items_ref();
+    n_ = grid.count();
+    args_ = args;
+    tile_ = tile;
+    slot_.assign(count, -1);
+    int slots = 0;
+    for (int k = 0; k < count; ++k) {
+        const PreparedDraw& d = sc.draws[es[k].draw];
+        if (d.kind == DRAW_FILL && !d.is_ellipse && es[k].count >= min_items) slot_[k] = slots++;
+    }
+    slots_ = slots;
+    if (slots == 0) return;
+    sd_.resize((size_t)slots * n_);
+    if (args) arg_.assign((size_t)slots * n_, SdfArg{});
+    for (int k = 0; k < count; ++k)
+        if (slot_[k] >= 0)
+            compute_entry(sc, bins, tile, es[k], grid, r, args, sd_.data() + (size_t)slot_[k] * n_,
+                          args ? arg_.data() + (size_t)slot_[k] * n_ : nullptr);
+}
+
+FieldView TileFields::view() const {
+    FieldView v;
+    if (slots_ == 0) return v;
+    v.slot = slot_.data();
+    v.sd = sd_.data();
+    v.arg = args_ ? arg_.data() : nullptr;
+    v.n = n_;
+    v.tile = tile_;
+    return v;
+}
+
+// One pass over the entry's segments, each y-monotone sub-piece (PreparedSegment::sub_y)
+// cut into capsules: chords of the curve with how far it strays from them (a curve's
+// distance from its chord over dt of its parameter is at most dt^2 / 8 max |B''|). Into
+// pieces_: the capsules within r of the samples, for the distances. Into row_add_ and
+// leg_: the winding numbers' crossings, along tile_winding's path (e.winding, the vertical
+// leg's crossings at or above a row, then each crossing of a sample's row between the
+// sample and the region's right edge): a row crossing a sub-piece meets it in one
+// capsule, whose x range (or, finer, its chord's x at the row, give or take the capsule's
+// width) usually holds no sample; only where one does is the crossing solved for.
+void TileFields::scan(const SceneView& sc, const TileView& bins, int tile, const TileEntry& e, const SampleGrid& g,
+                      double r) {
+    const Box region = bins.region(tile);
+    const double x_max = region.x1;
+    const int rows = (int)g.row_y.size(), cols = (int)g.col_x.size();
+    const Box area{g.col_x.front(), g.row_y.front(), g.col_x.back(), g.row_y.back()};
+    const double r2 = r * r;
+    const double scale = 1 + std::fabs(area.x0) + std::fabs(area.x1) + std::fabs(area.y0) + std::fabs(area.y1);
+    row_add_.assign(rows + 1, 0);
+    leg_.assign((size_t)rows * (cols + 1), 0);
+    pieces_.clear();
+    const PreparedDraw& d = sc.draws[e.draw];
+    const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
+    const LocalItem* items = bins.items.data() + e.first;
+    // The samples of a row left of x = T cross the segment there (direction dir).
+    auto cross = [&](int row, double T, int dir) {
+        int n_left = g.first_col(T);
+        if (n_left == 0) return;
+        int* leg = leg_.data() + (size_t)row * (cols + 1);
+        leg[0] += dir;
+        leg[n_left] -= dir;
+    };
+    Vec2 pts[MAX_CAPSULES + 1];
+    for (int li = 0; li < e.count; ++li) {
+        if (li + 8 < e.count) __builtin_prefetch(&segs[items[li + 8].item].box);  // (a tile's segments are scattered)
+        const LocalItem& item = items[li];
+        if (item.cross >= 0) {
+            const LegCrossings& c = bins.crossings[item.cross];
+            for (int k = 0; k < c.n; ++k) row_add_[g.first_row(c.y[k])] += c.dir[k];
+        }
+        const PreparedSegment& s = segs[item.item];
+        // (winding: some sample row within its heights has samples left of it, within the region)
+        const bool wind = s.box.x0 <= x_max && s.box.x1 > area.x0 && s.box.y1 >= area.y0 && s.box.y0 <= area.y1;
+        if (!wind && box_distance2(s.box, area) >= r2) continue;
+        double ax[4], ay[4];
+        s.power_basis(ax, ay);
+        for (int k = 0; k + 1 < s.n_split; ++k) {
+            const double ya = s.split_y[k], yb = s.split_y[k + 1];
+            const int dir = ya < yb ? 1 : -1;
+            double sy[PreparedSegment::SUB + 1];
+            for (int j = 0; j <= s.n_sub; ++j) sy[j] = s.sub_y(k, j);
+            bool monotone = true;  // the cuts, to rounding (else ray_crossings takes the whole piece)
+            for (int j = 0; j < s.n_sub; ++j) monotone &= dir > 0 ? sy[j] <= sy[j + 1] : sy[j] >= sy[j + 1];
+            if (!monotone) {  // rare: each row's crossing solved on the whole piece
+                if (ya == yb || s.piece_x0[k] > x_max) continue;
+                for (int row = g.first_row(vmin(ya, yb)); row < g.first_row(vmax(ya, yb)); ++row) {
+                    const double y = g.row_y[row];
+                    double t = monotone_root(ay, y, s.split[k], s.split[k + 1], ya - y, yb - y);
+                    double x = ((ax[3] * t + ax[2]) * t + ax[1]) * t + ax[0];
+                    if (x <= x_max) cross(row, x, dir);
+                }
+            }
+            for (int j = 0; j < s.n_sub; ++j) {
+                const double y0 = sy[j], y1 = sy[j + 1], ta = s.sub_t(k, j), tb = s.sub_t(k, j + 1);
+                const Box sub{s.sub_x0[k][j], vmin(y0, y1), s.sub_x1[k][j], vmax(y0, y1)};
+                const bool near = box_distance2(sub, area) < r2;
+                // rows on the sub-piece's half-open range of heights, as ray_crossings picks it
+                const int r_lo = monotone ? g.first_row(sub.y0) : 0, r_hi = monotone ? g.first_row(sub.y1) : 0;
+                const bool rows_here = r_lo < r_hi && sub.x0 <= x_max && sub.x1 > area.x0;
+                if (!near && !rows_here) continue;
+                // capsules: chords at even steps of t, and how far the curve strays from them
+                const double len = (sub.x1 - sub.x0) + (sub.y1 - sub.y0);
+                const int n = s.seg.degree == 1 ? 1 : clamp_to_int(std::ceil(len / PIECE), 1, MAX_CAPSULES);
+                const double slack = 1e-12 * (scale + std::fabs(sub.x0) + std::fabs(sub.x1) + std::fabs(sub.y0) +
+                                              std::fabs(sub.y1));
+                const double h = sub_piece_capsules(s, ax, ay, k, j, n, pts) + slack;
+                if (near)
+                    for (int i = 0; i < n; ++i) {
+                        Piece pc;
+                        pc.li = li;
+                        pc.a = pts[i];
+                        pc.v = pts[i + 1] - pts[i];
+                        double l2 = dot(pc.v, pc.v);
+                        pc.inv2 = l2 > 0 ? 1 / l2 : 0;
+                        pc.h = h;
+                        pc.box = Box{};
+                        expand(pc.box, pts[i]);
+                        expand(pc.box, pts[i + 1]);
+                        pc.box = grown(pc.box, h);
+                        if (box_distance2(pc.box, area) < r2) pieces_.push_back(pc);
+                    }
+                if (!rows_here) continue;
+                int i = dir > 0 ? 0 : n - 1;  // the capsule at the row's height (rows go up in y)
+                for (int row = r_lo; row < r_hi; ++row) {
+                    const double y = g.row_y[row];
+                    if (dir > 0) while (i + 1 < n && pts[i + 1].y <= y) ++i;
+                    else while (i > 0 && pts[i].y <= y) --i;
+                    const Vec2 a = pts[i], b = pts[i + 1];
+                    double T = 0;
+                    bool known = false;
+                    const double lo_y = vmin(a.y, b.y), hi_y = vmax(a.y, b.y);
+                    if (lo_y <= y && y < hi_y && y - lo_y > slack && hi_y - y > slack) {  // (else: solve)
+                        const double xl = vmin(a.x, b.x) - h, xh = vmax(a.x, b.x) + h;
+                        if (xl > x_max) continue;
+                        if (xh <= x_max && g.first_col(xl) == g.first_col(xh)) {
+                            T = xl;
+                            known = true;
+                        } else {  // the chord's x at y, give or take the capsule's width across it
+                            double ex = (y - a.y) / (b.y - a.y) * (b.x - a.x) + a.x;
+                            double err = h * length(b - a) / (hi_y - lo_y) + slack;
+                            if (ex - err > x_max) continue;
+                            if (ex + err <= x_max && g.first_col(ex - err) == g.first_col(ex + err)) {
+                                T = ex - err;
+                                known = true;
+                            }
+                        }
+                    }
+                    if (!known) {
+                        double t = monotone_root(ay, y, ta, tb, y0 - y, y1 - y);
+                        double x = ((ax[3] * t + ax[2]) * t + ax[1]) * t + ax[0];
+                        if (x > x_max) continue;
+                        T = x;
+                    }
+                    cross(row, T, dir);
+                }
+            }
+        }
+    }
+    winding_.assign(n_, 0);
+    int w_row = e.winding;
+    for (int row = 0; row < rows; ++row) {
+        w_row += row_add_[row];
+        const int* leg = leg_.data() + (size_t)row * (cols + 1);
+        int acc = 0;
+        for (int col = 0; col < cols; ++col) {
+            acc += leg[col];
+            winding_[g.at(row, col)] = w_row + acc;
+        }
+    }
+}
+
+void TileFields::compute_entry(const SceneView& sc, const TileView& bins, int tile, const TileEntry& e,
+                               const SampleGrid& g, double r, bool args, double* sd, SdfArg* arg) {
+    scan(sc, bins, tile, e, g, r);
+    const PreparedDraw& d = sc.draws[e.draw];
+    const LocalItem* items = bins.items.data() + e.first;
+    // A piece's bound at p: the distance to its control points' box in its chord's frame
+    // (a lower bound of the distance to its part of the curve), squared, before the margin
+    // for rounding (Piece::slack) is taken off.
+    auto bound2 = [](const Piece& pc, Vec2 p) {
+        Vec2 q = p - pc.a;
+        double t = vclamp(dot(q, pc.v) * pc.inv2, 0.0, 1.0);
+        Vec2 w = q - t * pc.v;
+        return dot(w, w);
+    };
+    // The samples within `reach` of a piece's box.
+    auto near = [&](const Piece& pc, double reach, auto visit) {
+        const int r0 = g.first_row(pc.box.y0 - reach), r1 = g.after_row(pc.box.y1 + reach);
+        const int c0 = g.first_col(pc.box.x0 - reach), c1 = g.after_col(pc.box.x1 + reach);
+        for (int row = r0; row < r1; ++row) {
+            const int* index = g.index.data() + (size_t)row * g.col_x.size();
+            for (int col = c0; col < c1; ++col) visit(index[col], Vec2{g.col_x[col], g.row_y[row]});
+        }
+    };
+    // 1. Each sample's nearest bound, and its segment's distance d*.
+    bound_.assign(n_, r);
+    nearest_.assign(n_, -1);
+    for (const Piece& pc : pieces_)
+        near(pc, r, [&](int s, Vec2 p) {
+            double lim = bound_[s] + pc.h, b2 = bound2(pc, p);
+            if (b2 < lim * lim) {
+                bound_[s] = std::sqrt(b2) - pc.h;
+                nearest_[s] = pc.li;
+            }
+        });
+    dstar_.resize(n_);
+    for (int row = 0; row < (int)g.row_y.size(); ++row)
+        for (int col = 0; col < (int)g.col_x.size(); ++col) {
+            int s = g.at(row, col);
+            double best = r;
+            if (nearest_[s] >= 0) fill_distance_step(sc, d, items[nearest_[s]].item, {g.col_x[col], g.row_y[row]}, best, nullptr);
+            dstar_[s] = best;
+        }
+    // 2. In the entry's order, the segments that may come within d* (or ON_EDGE, where the
+    // args must find a second segment on a vertex), each measured once per sample.
+    best_.assign(n_, r);
+    stamp_.assign(n_, -1);
+    double reach = 0;  // (the samples' limits are small where segments crowd, and so the reach)
+    for (int s = 0; s < n_; ++s) reach = vmax(reach, args ? vmax(dstar_[s], ON_EDGE) : dstar_[s]);
+    for (const Piece& pc : pieces_)
+        near(pc, reach, [&](int s, Vec2 p) {
+            if (stamp_[s] == pc.li) return;
+            double limit = (args ? vmax(dstar_[s], ON_EDGE) : dstar_[s]) + pc.h;
+            if (bound2(pc, p) > limit * limit) return;
+            stamp_[s] = pc.li;
+            fill_distance_step(sc, d, items[pc.li].item, p, best_[s], args ? arg + s : nullptr);
+        });
+    for (int s = 0; s < n_; ++s) sd[s] = winding_inside(winding_[s], d.fill_rule) ? -best_[s] : best_[s];
+}
+
+}  // namespace vf

@@ -1,0 +1,111 @@
+// The analytical prefilter's long fill entries, a tile at a time (the CPU passes; issue 28):
+// an entry's signed distance (and where it came from) at every sample of a tile, computed
+// segment by segment rather than sample by sample, so that its cost follows the pixels
+// each segment reaches.
+//
+// Sample by sample (entry_sdf), each of a tile's samples goes through every segment the
+// tile lists: a path of 30,000 cubics across a 64 px canvas lists thousands in each tile,
+// hundreds of which pass within a pixel of each sample. Here, per entry:
+//   * winding numbers: the same path as tile_winding (scene/tiles.h), counted a row of
+//     samples at a time (the analytical samples lie on a grid: strata centres): the
+//     vertical leg's crossings add to every row at or below them, and each crossing of a
+//     sample row by a segment adds to the samples on its left (one root per crossing at
+//     most, none where the crossing's x range holds no sample);
+//   * distances: each curve's part near the tile is cut into pieces of about a pixel, each
+//     bounded by the box of its control points in its chord's frame (tight for a short
+//     piece); a first sweep finds each sample's nearest bound, whose segment's distance
+//     d* the sample then measures exactly; a second sweep measures, in the tile's order of
+//     segments, only the segments some piece of which may come within d* (or ON_EDGE),
+//     with the same step as fill_distance (fill_distance_step). The distance and its
+//     SdfArg are then entry_sdf's: the closest segment is the first one in order at the
+//     least distance, and a segment farther than d* can neither be it nor change it.
+// The winding numbers differ from tile_winding's only for a sample within rounding of a
+// curve (a crossing's side is decided by the crossing's x, not a bracket per sample),
+// where the coverage is 1/2 either way; tests/unit/renderer/test_long_paths.py compares
+// the two on every entry (field_min_items = 0).
+#pragma once
+
+#include <cmath>
+#include <vector>
+
+#include "scene/coverage.h"
+#include "scene/scene.h"
+#include "scene/tiles.h"
+
+namespace vf {
+
+// Entries listing at least this many segments in a tile are computed here (see
+// field_min_items_ref; a test hook sets it to 0 to compare every entry).
+int& field_min_items_ref();
+
+// The analytical samples of one tile: N x N strata centres per pixel, at the positions
+// pixel_forward and pixel_backward use, as a grid of columns and rows (each sorted).
+struct SampleGrid {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0, N = 1;
+    std::vector<double> col_x, row_y;
+    std::vector<int> index;  // [row * columns + col]: the sample's index among the tile's (see tile_sample)
+    void build(const TileView& bins, int tile, int width, int height, int N, double R);
+    int count() const { return (x1 - x0) * (y1 - y0) * N * N; }
+    int at(int row, int col) const { return index[(size_t)row * col_x.size() + col]; }
+    // The first column (row) at or after x (y): lower_bound, from a guess on an even grid.
+    int first_col(double x) const { return first(col_x, x, col0_, col_step_); }
+    int first_row(double y) const { return first(row_y, y, row0_, row_step_); }
+    // The first column (row) after x (y): upper_bound.
+    int after_col(double x) const { return after(col_x, x, col0_, col_step_); }
+    int after_row(double y) const { return after(row_y, y, row0_, row_step_); }
+
+  private:
+    double col0_ = 0, col_step_ = 1, row0_ = 0, row_step_ = 1;  // (steps stored inverted)
+    static int guess(const std::vector<double>& v, double x, double v0, double inv_step) {
+        double k = (x - v0) * inv_step;
+        return k < 0 ? 0 : k >= (double)v.size() ? (int)v.size() : (int)k;
+    }
+    static int first(const std::vector<double>& v, double x, double v0, double step) {
+        int i = guess(v, x, v0, step), n = (int)v.size();
+        while (i > 0 && v[i - 1] >= x) --i;
+        while (i < n && v[i] < x) ++i;
+        return i;
+    }
+    static int after(const std::vector<double>& v, double x, double v0, double step) {
+        int i = guess(v, x, v0, step), n = (int)v.size();
+        while (i > 0 && v[i - 1] > x) --i;
+        while (i < n && v[i] <= x) ++i;
+        return i;
+    }
+};
+
+// The fields of one tile's long fill entries, reused from tile to tile by a worker.
+class TileFields {
+  public:
+    // Computes every fill entry of the tile that lists at least field_min_items segments
+    // (none with brute_force), with their SdfArgs when `args` (the backward pass).
+    void compute(const SceneView& sc, const TileView& bins, int tile, const SampleGrid& grid, double r, bool args);
+    // The view the per-sample code reads (empty where no entry was computed).
+    FieldView view() const;
+
+  private:
+    static constexpr int MAX_CAPSULES = 64;
+    struct Piece {     // a capsule of a curve near the tile's samples
+        int li;        // its segment's index in the entry's local items
+        Vec2 a, v;     // the chord from a to a + v
+        double inv2;   // 1 / |v|^2 (0 for a point)
+        double h;      // how far the curve strays from the chord, with a margin for rounding
+        Box box;       // the chord's box grown by h
+    };
+    void compute_entry(const SceneView& sc, const TileView& bins, int tile, const TileEntry& e, const SampleGrid& g,
+                       double r, bool args, double* sd, SdfArg* arg);
+    void scan(const SceneView& sc, const TileView& bins, int tile, const TileEntry& e, const SampleGrid& g, double r);
+
+    int n_ = 0, slots_ = 0, tile_ = -1;
+    bool args_ = false;
+    std::vector<int> slot_;
+    std::vector<double> sd_;
+    std::vector<SdfArg> arg_;
+    // scratch
+    std::vector<int> winding_, row_add_, leg_;
+    std::vector<Piece> pieces_;
+    std::vector<double> bound_, dstar_, best_;
+    std::vector<int> nearest_, stamp_;
+};
+
+}  // namespace vf
