@@ -93,9 +93,23 @@ void TileFields::compute(const SceneView& sc, const TileView& bins, int tile, co
     tile_ = tile;
     slot_.assign(count, -1);
     int slots = 0;
-    for (int k = 0; k < count; ++k) {
-        const PreparedDraw& d = sc.draws[es[k].draw];
-        if (d.kind == DRAW_FILL && !d.is_ellipse && es[k].count >= min_items) slot_[k] = slots++;
+    // Entries behind an opaque one that covers every sample of the tile are never reached
+    // (the forward pass stops at an opaque sample; without layers the backward pass at the
+    // second opaque draw, collect_hits_analytic): a fill under a stroke 10^7 px wide.
+    const Box area{grid.col_x.front(), grid.row_y.front(), grid.col_x.back(), grid.row_y.back()};
+    int covering = 0;
+    const bool no_layers = sc.layer_parent.size() <= 1;
+    for (int k = count - 1; k >= 0 && covering < (args ? 2 : 1); --k) {
+        const TileEntry& e = es[k];
+        const PreparedDraw& d = sc.draws[e.draw];
+        if (d.kind == DRAW_FILL && !d.is_ellipse && e.count >= min_items) slot_[k] = slots++;
+        const PreparedPaint& paint = sc.paints[d.paint];
+        const Box reach = grown(d.box, r);
+        const bool covers_all = !d.is_ellipse && (d.kind == DRAW_STROKE ? e.winding != 0 :
+                                                  e.count == 0 && winding_inside(e.winding, d.fill_rule));
+        if (covers_all && no_layers && paint.kind == PAINT_SOLID && paint.rgba[3] >= 1 && reach.x0 <= area.x0 &&
+            reach.y0 <= area.y0 && reach.x1 >= area.x1 && reach.y1 >= area.y1)
+            ++covering;
     }
     slots_ = slots;
     if (slots == 0) return;
@@ -196,8 +210,10 @@ void TileFields::scan(const SceneView& sc, const TileView& bins, int tile, const
             const LegCrossings& c = bins.crossings[item.cross];
             for (int k = 0; k < c.n; ++k) row_add_[g.first_row(c.y[k])] += c.dir[k];
         }
+        // (winding: some sample row within its heights has samples left of it, within the
+        // region; distance: within r of the samples)
+        if (item.y1 < area.y0 - r || item.y0 > area.y1 + r) continue;
         const PreparedSegment& s = segs[item.item];
-        // (winding: some sample row within its heights has samples left of it, within the region)
         const bool wind = s.box.x0 <= x_max && s.box.x1 > area.x0 && s.box.y1 >= area.y0 && s.box.y0 <= area.y1;
         if (!wind && box_distance2(s.box, area) >= r2) continue;
         double ax[4], ay[4];
