@@ -1,9 +1,12 @@
-"""One long path at 64 x 64 px, both modes: what a segment costs (issue 28).
+"""One long path at 64 x 64 px, both modes, forward and backward: what a segment costs
+(issue 28).
 
-    python benchmarks/long_paths.py [--threads 2] [--repeats 3] [--sizes 3000,30000,300000]
+    python benchmarks/long_paths.py [--threads 2] [--repeats 3] [--samples 2]
+                                    [--sizes 3000,30000,300000] [--kinds walk,wide,across]
+                                    [--budget 120]
 
-Scenes (a 64-unit canvas rendered at 64 px, one sample per pixel as `vecfit render`
---samples 1):
+Scenes (a 64-unit canvas rendered at 64 px; --samples N: N x N samples per pixel, 2 as
+`vecfit render` by default):
   walk      one closed path of N cubics, a random walk of 2-unit steps, filled;
   wide      N mixed lines / quadratics / cubics (a walk of 6-unit steps), a linear
             gradient fill and stroke-width 1e7 (the fuzzer's failing case);
@@ -11,16 +14,20 @@ Scenes (a 64-unit canvas rendered at 64 px, one sample per pixel as `vecfit rend
             segment crosses every row of tiles: the worst case, where a segment reaches
             most pixels), filled.
 The paths are built as Scenes (300,000 segments is over the SVG reader's limit). Each row:
-the median wall time of `vecfit.render` over --repeats runs (packing included), and that
-divided by N. Targets: the analytical mode within a small factor of Monte Carlo, and
-<= 1 s for 30,000 segments.
+the median wall time over --repeats of `vecfit.render` (forward: packing included) and
+of the backward pass of a random image adjoint into every point (backward), and each
+divided by N. A pass stopped at --budget seconds (the core cancels it as it would for a
+Ctrl-C) shows `>` and the budget, and the larger sizes of that path and mode are not run.
+Targets: a 64-px render of 30,000 segments in <= 1 s on 2 threads in either mode.
 """
 from __future__ import annotations
 
 import argparse
 import random
+import signal
 import time
 import warnings
+from contextlib import contextmanager
 
 import common  # noqa: F401  (OMP_WAIT_POLICY before torch)
 
@@ -65,32 +72,85 @@ def scene_of(kind: str, n: int, tmp) -> vecfit.Scene:
     return scene
 
 
+class Overtime(Exception):
+    pass
+
+
+@contextmanager
+def deadline(seconds: float):
+    """Raises Overtime in the block after `seconds` (the core polls for signals while it
+    works and cancels its call)."""
+    def alarm(signum, frame):
+        raise Overtime
+    previous = signal.signal(signal.SIGALRM, alarm)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def timed(scene, mode: str, samples: int, threads: int, repeats: int, budget: float):
+    """Median seconds of the forward pass and of the backward pass (None: over budget)."""
+    points = scene.shapes[0].geometry.points
+    points.requires_grad_(True)
+    forward, backward = [], []
+    adjoint = torch.rand(64, 64, 4, generator=torch.Generator().manual_seed(0))
+    for _ in range(repeats):
+        points.grad = None
+        try:
+            with deadline(budget):
+                start = time.perf_counter()
+                image = vecfit.render(scene, 64, 64, samples=samples, mode=mode, threads=threads)
+                forward.append(time.perf_counter() - start)
+        except Overtime:
+            return None, None
+        assert torch.isfinite(image).all()
+        try:
+            with deadline(budget):
+                start = time.perf_counter()
+                image.backward(adjoint)
+                backward.append(time.perf_counter() - start)
+        except Exception as e:  # (Overtime, perhaps as autograd passes it on)
+            if "Overtime" not in repr(e) and not isinstance(e, Overtime):
+                raise
+            return float(np.median(forward)), None
+        assert torch.isfinite(points.grad).all()
+    return float(np.median(forward)), float(np.median(backward))
+
+
 def main():
     import tempfile
     from pathlib import Path as FsPath
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--samples", type=int, default=2)
     parser.add_argument("--sizes", default="3000,30000,300000")
     parser.add_argument("--kinds", default="walk,wide,across")
+    parser.add_argument("--modes", default="mc,analytic")
+    parser.add_argument("--budget", type=float, default=120.0, help="seconds a pass may take")
     a = parser.parse_args()
     sizes = [int(s) for s in a.sizes.split(",")]
-    print(f"{'path':7} {'segments':>9} {'mc s':>8} {'analytic s':>11} {'mc us/seg':>10} {'an. us/seg':>11}")
+    print(f"{'path':7} {'segments':>9} {'mode':9} {'forward s':>10} {'backward s':>11} {'fwd us/seg':>11} "
+          f"{'bwd us/seg':>11}")
+    cell = lambda v, w: f"{v:{w}.3f}" if v is not None else f"{'>' + format(a.budget, 'g'):>{w}}"  # noqa: E731
+    per = lambda v, n, w: f"{1e6 * v / n:{w}.2f}" if v is not None else f"{'-':>{w}}"  # noqa: E731
     with tempfile.TemporaryDirectory() as tmp:
         for kind in a.kinds.split(","):
-            for n in sizes:
-                scene = scene_of(kind, n, FsPath(tmp))
-                row = {}
-                for mode in ("mc", "analytic"):
-                    times = []
-                    for _ in range(a.repeats):
-                        start = time.perf_counter()
-                        image = vecfit.render(scene, 64, 64, samples=1, mode=mode, threads=a.threads)
-                        times.append(time.perf_counter() - start)
-                    assert torch.isfinite(image).all()
-                    row[mode] = float(np.median(times))
-                print(f"{kind:7} {n:9} {row['mc']:8.3f} {row['analytic']:11.3f} {1e6 * row['mc'] / n:10.2f} "
-                      f"{1e6 * row['analytic'] / n:11.2f}", flush=True)
+            for mode in a.modes.split(","):
+                over = False
+                for n in sizes:
+                    if over:
+                        print(f"{kind:7} {n:9} {mode:9} {'-':>10} {'-':>11} (not run: a smaller size was over "
+                              f"the budget)", flush=True)
+                        continue
+                    scene = scene_of(kind, n, FsPath(tmp))
+                    fwd, bwd = timed(scene, mode, a.samples, a.threads, a.repeats, a.budget)
+                    over = fwd is None or bwd is None
+                    print(f"{kind:7} {n:9} {mode:9} {cell(fwd, 10)} {cell(bwd, 11)} {per(fwd, n, 11)} "
+                          f"{per(bwd, n, 11)}", flush=True)
 
 
 if __name__ == "__main__":

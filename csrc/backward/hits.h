@@ -83,8 +83,8 @@ VF_HD void draw_covers_pair(const SceneView& sc, const TileView& bins, int draw,
     int wa = e.winding, wb = e.winding;
     for (int i = 0; i < e.count; ++i) {
         const LocalItem& li = items[i];
-        wa += ray_crossings(segs[li.item], a, region.x1);
-        wb += ray_crossings(segs[li.item], b, region.x1);
+        if (li.spans(a.y)) wa += ray_crossings(segs[li.item], a, region.x1);
+        if (li.spans(b.y)) wb += ray_crossings(segs[li.item], b, region.x1);
         wa += bins.leg_crossings(li, a.y);
         wb += bins.leg_crossings(li, b.y);
     }
@@ -141,7 +141,10 @@ VF_HD void collect_hits_analytic(const SceneView& sc, const TileView& bins, Vec2
     Box region = bins.region(tile);
     const TileEntry* es = bins.begin(tile);
     if (fields && fields->tile != tile) fields = nullptr;  // (a sample beyond its pixel's tile)
-    for (int k = bins.count(tile) - 1; k >= 0; --k) {
+    // Without layers, what lies behind a second opaque hit cannot matter (see collect_hits).
+    const bool may_stop = sc.layer_parent.size() <= 1;
+    int opaque = 0;
+    for (int k = bins.count(tile) - 1; k >= 0 && !(may_stop && opaque >= 2); --k) {
         const TileEntry& e = es[k];
         const PreparedDraw& d = sc.draws[e.draw];
         Box near = grown(d.box, r);
@@ -176,6 +179,7 @@ VF_HD void collect_hits_analytic(const SceneView& sc, const TileView& bins, Vec2
         paint_color(sc, sc.paints[d.paint], p, h.paint);
         for (int i = 0; i < 4; ++i) h.c[i] = h.cov * h.paint[i];
         hits.push_back(h);
+        if (h.c[3] >= 1) ++opaque;
     }
 }
 

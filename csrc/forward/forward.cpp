@@ -117,15 +117,16 @@ void tile_forward(const SceneView& sc, const TileView& bins, const RenderOptions
             const LocalItem* items = bins.items.data() + e.first;
             for (int li = 0; li < e.count; ++li) {
                 const LocalItem& item = items[li];
-                const PreparedSegment& seg = segs[item.item];
                 // Only the rows whose samples (within R of their row's centre line) can lie
                 // in the segment's height range can cross it. (Clamped as doubles: a
                 // coordinate can be 10^28 px.)
-                int r0 = clamp_to_int(std::ceil(seg.box.y0 - 0.5 - R) - y0, 0, rows);
-                int r1 = clamp_to_int(std::floor(seg.box.y1 - 0.5 + R) - y0, -1, rows - 1);
-                if (r0 <= r1)
+                int r0 = clamp_to_int(std::ceil(item.y0 - 0.5 - R) - y0, 0, rows);
+                int r1 = clamp_to_int(std::floor(item.y1 - 0.5 + R) - y0, -1, rows - 1);
+                if (r0 <= r1) {
+                    const PreparedSegment& seg = segs[item.item];
                     for (int a = ts.row_begin[r0]; a < ts.row_begin[r1 + 1]; ++a)
                         ts.winding[a] += ray_crossings(seg, ts.p[ts.active[a]], region.x1);
+                }
                 if (item.cross >= 0) {  // the vertical leg: every sample at or below
                     const LegCrossings& c = bins.crossings[item.cross];
                     for (int j = 0; j < c.n; ++j)

@@ -3,6 +3,7 @@
 #include "scene/field.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 
 namespace vf {
@@ -15,6 +16,12 @@ int& field_min_items_ref() {
 }
 
 namespace {
+
+// A double as a float no smaller.
+float float_above(double v) {
+    float f = (float)v;
+    return (double)f < v ? std::nextafter(f, INFINITY) : f;
+}
 
 // About how long a capsule is (pixels), and the most a sub-piece is cut into: a capsule a
 // pixel long lies within about 1 / (8 x radius of curvature) of its curve, which sets
@@ -86,9 +93,23 @@ void TileFields::compute(const SceneView& sc, const TileView& bins, int tile, co
     tile_ = tile;
     slot_.assign(count, -1);
     int slots = 0;
-    for (int k = 0; k < count; ++k) {
-        const PreparedDraw& d = sc.draws[es[k].draw];
-        if (d.kind == DRAW_FILL && !d.is_ellipse && es[k].count >= min_items) slot_[k] = slots++;
+    // Entries behind an opaque one that covers every sample of the tile are never reached
+    // (the forward pass stops at an opaque sample; without layers the backward pass at the
+    // second opaque draw, collect_hits_analytic): a fill under a stroke 10^7 px wide.
+    const Box area{grid.col_x.front(), grid.row_y.front(), grid.col_x.back(), grid.row_y.back()};
+    int covering = 0;
+    const bool no_layers = sc.layer_parent.size() <= 1;
+    for (int k = count - 1; k >= 0 && covering < (args ? 2 : 1); --k) {
+        const TileEntry& e = es[k];
+        const PreparedDraw& d = sc.draws[e.draw];
+        if (d.kind == DRAW_FILL && !d.is_ellipse && e.count >= min_items) slot_[k] = slots++;
+        const PreparedPaint& paint = sc.paints[d.paint];
+        const Box reach = grown(d.box, r);
+        const bool covers_all = !d.is_ellipse && (d.kind == DRAW_STROKE ? e.winding != 0 :
+                                                  e.count == 0 && winding_inside(e.winding, d.fill_rule));
+        if (covers_all && no_layers && paint.kind == PAINT_SOLID && paint.rgba[3] >= 1 && reach.x0 <= area.x0 &&
+            reach.y0 <= area.y0 && reach.x1 >= area.x1 && reach.y1 >= area.y1)
+            ++covering;
     }
     slots_ = slots;
     if (slots == 0) return;
@@ -142,6 +163,45 @@ void TileFields::scan(const SceneView& sc, const TileView& bins, int tile, const
         leg[0] += dir;
         leg[n_left] -= dir;
     };
+    // A capsule from a to b (h wide), if it comes within r of the samples, relative to
+    // origin_ in floats: h grows by what the floats may be off (a few of their ulps).
+    origin_ = {area.x0, area.y0};
+    auto push_piece = [&](int li, Vec2 a, Vec2 b, double h) {
+        Box box;
+        expand(box, a);
+        expand(box, b);
+        if (box_distance2(grown(box, h), area) >= r2) return;
+        Piece pc;
+        pc.li = li;
+        a = a - origin_;
+        b = b - origin_;
+        pc.a[0] = (float)a.x;
+        pc.a[1] = (float)a.y;
+        pc.v[0] = (float)(b.x - a.x);
+        pc.v[1] = (float)(b.y - a.y);
+        double vx = pc.v[0], vy = pc.v[1], l2 = vx * vx + vy * vy;
+        pc.inv2 = l2 > 0 ? (float)(1 / l2) : 0.0f;
+        double big = 1 + vmax(vmax(std::fabs(a.x), std::fabs(a.y)), vmax(std::fabs(b.x), std::fabs(b.y)));
+        pc.h = float_above(h + 8 * FLT_EPSILON * big);
+        pieces_.push_back(pc);
+    };
+    // A line's part within r + 1 of the samples (the rest is farther than r from each).
+    const Box clip_box = grown(area, r + 1);
+    auto push_line = [&](int li, Vec2 a, Vec2 b) {
+        double t0 = 0, t1 = 1;
+        const double dx = b.x - a.x, dy = b.y - a.y;
+        auto clip = [&](double p, double q) {  // p t <= q
+            if (p == 0) return q >= 0;
+            double t = q / p;
+            if (p < 0) t0 = vmax(t0, t);
+            else t1 = vmin(t1, t);
+            return t0 <= t1;
+        };
+        if (!(clip(-dx, a.x - clip_box.x0) && clip(dx, clip_box.x1 - a.x) && clip(-dy, a.y - clip_box.y0) &&
+              clip(dy, clip_box.y1 - a.y)))
+            return;
+        push_piece(li, t0 > 0 ? a + t0 * (b - a) : a, t1 < 1 ? a + t1 * (b - a) : b, 0.0);
+    };
     Vec2 pts[MAX_CAPSULES + 1];
     for (int li = 0; li < e.count; ++li) {
         if (li + 8 < e.count) __builtin_prefetch(&segs[items[li + 8].item].box);  // (a tile's segments are scattered)
@@ -150,8 +210,10 @@ void TileFields::scan(const SceneView& sc, const TileView& bins, int tile, const
             const LegCrossings& c = bins.crossings[item.cross];
             for (int k = 0; k < c.n; ++k) row_add_[g.first_row(c.y[k])] += c.dir[k];
         }
+        // (winding: some sample row within its heights has samples left of it, within the
+        // region; distance: within r of the samples)
+        if (item.y1 < area.y0 - r || item.y0 > area.y1 + r) continue;
         const PreparedSegment& s = segs[item.item];
-        // (winding: some sample row within its heights has samples left of it, within the region)
         const bool wind = s.box.x0 <= x_max && s.box.x1 > area.x0 && s.box.y1 >= area.y0 && s.box.y0 <= area.y1;
         if (!wind && box_distance2(s.box, area) >= r2) continue;
         double ax[4], ay[4];
@@ -186,21 +248,10 @@ void TileFields::scan(const SceneView& sc, const TileView& bins, int tile, const
                 const double slack = 1e-12 * (scale + std::fabs(sub.x0) + std::fabs(sub.x1) + std::fabs(sub.y0) +
                                               std::fabs(sub.y1));
                 const double h = sub_piece_capsules(s, ax, ay, k, j, n, pts) + slack;
-                if (near)
-                    for (int i = 0; i < n; ++i) {
-                        Piece pc;
-                        pc.li = li;
-                        pc.a = pts[i];
-                        pc.v = pts[i + 1] - pts[i];
-                        double l2 = dot(pc.v, pc.v);
-                        pc.inv2 = l2 > 0 ? 1 / l2 : 0;
-                        pc.h = h;
-                        pc.box = Box{};
-                        expand(pc.box, pts[i]);
-                        expand(pc.box, pts[i + 1]);
-                        pc.box = grown(pc.box, h);
-                        if (box_distance2(pc.box, area) < r2) pieces_.push_back(pc);
-                    }
+                if (near) {
+                    if (s.seg.degree == 1) push_line(li, pts[0], pts[1]);
+                    else for (int i = 0; i < n; ++i) push_piece(li, pts[i], pts[i + 1], h);
+                }
                 if (!rows_here) continue;
                 int i = dir > 0 ? 0 : n - 1;  // the capsule at the row's height (rows go up in y)
                 for (int row = r_lo; row < r_hi; ++row) {
@@ -256,19 +307,20 @@ void TileFields::compute_entry(const SceneView& sc, const TileView& bins, int ti
     scan(sc, bins, tile, e, g, r);
     const PreparedDraw& d = sc.draws[e.draw];
     const LocalItem* items = bins.items.data() + e.first;
-    // A piece's bound at p: the distance to its control points' box in its chord's frame
-    // (a lower bound of the distance to its part of the curve), squared, before the margin
-    // for rounding (Piece::slack) is taken off.
-    auto bound2 = [](const Piece& pc, Vec2 p) {
-        Vec2 q = p - pc.a;
-        double t = vclamp(dot(q, pc.v) * pc.inv2, 0.0, 1.0);
-        Vec2 w = q - t * pc.v;
-        return dot(w, w);
+    // A piece's bound at p: the distance to its chord (relative to origin_), squared, before
+    // its width h is taken off (a lower bound of the distance to its part of the curve).
+    auto bound2 = [&](const Piece& pc, Vec2 p) {
+        double qx = p.x - origin_.x - pc.a[0], qy = p.y - origin_.y - pc.a[1];
+        double t = vclamp((qx * pc.v[0] + qy * pc.v[1]) * pc.inv2, 0.0, 1.0);
+        double wx = qx - t * pc.v[0], wy = qy - t * pc.v[1];
+        return wx * wx + wy * wy;
     };
-    // The samples within `reach` of a piece's box.
+    // The samples within `reach` of a piece (its chord's box grown by h).
     auto near = [&](const Piece& pc, double reach, auto visit) {
-        const int r0 = g.first_row(pc.box.y0 - reach), r1 = g.after_row(pc.box.y1 + reach);
-        const int c0 = g.first_col(pc.box.x0 - reach), c1 = g.after_col(pc.box.x1 + reach);
+        double x0 = origin_.x + pc.a[0], x1 = x0 + pc.v[0], y0 = origin_.y + pc.a[1], y1 = y0 + pc.v[1];
+        reach += pc.h;
+        const int r0 = g.first_row(vmin(y0, y1) - reach), r1 = g.after_row(vmax(y0, y1) + reach);
+        const int c0 = g.first_col(vmin(x0, x1) - reach), c1 = g.after_col(vmax(x0, x1) + reach);
         for (int row = r0; row < r1; ++row) {
             const int* index = g.index.data() + (size_t)row * g.col_x.size();
             for (int col = c0; col < c1; ++col) visit(index[col], Vec2{g.col_x[col], g.row_y[row]});

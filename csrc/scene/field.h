@@ -85,18 +85,19 @@ class TileFields {
 
   private:
     static constexpr int MAX_CAPSULES = 64;
-    struct Piece {     // a capsule of a curve near the tile's samples
+    struct Piece {     // a capsule of a curve near the tile's samples (28 bytes: a long path's
+                       // tile holds over 100,000 of them)
         int li;        // its segment's index in the entry's local items
-        Vec2 a, v;     // the chord from a to a + v
-        double inv2;   // 1 / |v|^2 (0 for a point)
-        double h;      // how far the curve strays from the chord, with a margin for rounding
-        Box box;       // the chord's box grown by h
+        float a[2], v[2];  // the chord from a to a + v, relative to origin_
+        float inv2;    // 1 / |v|^2 (0 for a point)
+        float h;       // how far the curve strays from the chord, with margins for rounding
     };
     void compute_entry(const SceneView& sc, const TileView& bins, int tile, const TileEntry& e, const SampleGrid& g,
                        double r, bool args, double* sd, SdfArg* arg);
     void scan(const SceneView& sc, const TileView& bins, int tile, const TileEntry& e, const SampleGrid& g, double r);
 
     int n_ = 0, slots_ = 0, tile_ = -1;
+    Vec2 origin_;  // pieces' coordinates are relative to it (the tile's first sample)
     bool args_ = false;
     std::vector<int> slot_;
     std::vector<double> sd_;

@@ -395,6 +395,10 @@ PreparedScene prepare_scene(const SceneArrays& a) {
             double m = std::max(d.ellipse.r0, d.ellipse.r1) + (d.kind == DRAW_STROKE ? d.half_width : 0);
             Box b{c.x - m, c.y - m, c.x + m, c.y + m};
             d.box = d.kind == DRAW_STROKE && !d.metric_identity ? to_pixel_box(b, d.metric_inv) : b;
+            // Axes all 0 (a circle of radius <= 0 kept in a fitting loop's pack, see
+            // vecfit/renderer/persistent.py, or a scale of 0): nothing is drawn, as SVG
+            // draws nothing (a point would have had the analytical kernel's half coverage).
+            if (e[2] == 0 && e[3] == 0 && e[4] == 0 && e[5] == 0) d.box = Box{};
         } else {
             check(shape[0] == SHAPE_PATH, "unknown shape kind");
             check(!d.varying || (d.kind == DRAW_STROKE && a.n_point_widths == a.n_points),

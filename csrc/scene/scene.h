@@ -99,16 +99,17 @@ struct PreparedSegment {
 };
 
 // Stroke geometry at a segment's end: the join with the next segment, or the cap.
+// (Fields in order of size: 112 bytes, two per stroke item.)
 struct StrokeEnd {
-    enum Kind : int8_t { NONE = 0, DISK, SQUARE, POLYGON } kind = NONE;
     Vec2 center;            // disk / square centre
     Vec2 axis{1, 0};        // square: unit direction of one side pair
     Vec2 poly[4];           // polygon (bevel triangle or miter quadrilateral), convex
-    int n_poly = 0;
     // Half width of this end's piece (stroke space): the draw's, or with per-point widths
     // the vertex's. Also set for butt ends (kind NONE), whose end line it bounds.
     double hw = 0;
     int32_t width_index = -1;  // per-point widths: the point whose width hw is (gradients)
+    enum Kind : int8_t { NONE = 0, DISK, SQUARE, POLYGON } kind = NONE;
+    int8_t n_poly = 0;
 };
 
 // A stroke segment in stroke space (pixel space mapped by the draw's metric), with the
@@ -116,28 +117,27 @@ struct StrokeEnd {
 // starts an open subpath.
 struct StrokeSegment {
     Segment seg;           // in stroke space
-    int32_t source = -1;   // index into PreparedScene::segments (its path segment)
-    int32_t next = -1;     // the stroke item after the join at this item's end (index into stroke_items)
     double t0 = 0, t1 = 1; // the part of the source segment this item is (curves are split
                            // into short pieces: tighter bounds, fewer roots to find)
-    bool butt_start = false, butt_end = false;  // free end with a butt cap: an edge of the stroke
-    bool bevel_start = false;  // the join at this item's start (prev's end) is a bevel: seam rule
-    int32_t prev = -1;     // the stroke item whose end joins this item's start (index into
-                           // stroke_items; here, it fills what was padding)
     StrokeEnd start, end;
     Box box;               // pixel-space bounds of everything above, widened by the half width
     // The segment's control points in the frame of its chord (origin p0, unit axis u):
     // a tighter bound than the box, which spares most samples the quintic.
     Vec2 frame_u{1, 0};
     double s_min = 0, s_max = 0, n_min = 0, n_max = 0;
-    // Gently curved (radius of curvature above the piece's length plus its reach): the
-    // distance to any point in reach has at most one critical point on the piece.
-    bool simple = false;
     // Half widths (stroke space) at the piece's control points: the width profile is a
     // Bézier of the same degree, hw(t) = sum hw[i] b_i(t) (per-point widths; otherwise all
     // equal to the draw's half width). hw_max bounds it (convex hull property).
     double hw[4] = {0, 0, 0, 0};
     double hw_max = 0;
+    int32_t source = -1;   // index into PreparedScene::segments (its path segment)
+    int32_t next = -1;     // the stroke item after the join at this item's end (index into stroke_items)
+    int32_t prev = -1;     // the stroke item whose end joins this item's start (index into stroke_items)
+    bool butt_start = false, butt_end = false;  // free end with a butt cap: an edge of the stroke
+    bool bevel_start = false;  // the join at this item's start (prev's end) is a bevel: seam rule
+    // Gently curved (radius of curvature above the piece's length plus its reach): the
+    // distance to any point in reach has at most one critical point on the piece.
+    bool simple = false;
 };
 
 struct PreparedDraw {

@@ -11,6 +11,15 @@
 namespace vf {
 namespace {
 
+float float_below(double v) {
+    float f = (float)v;
+    return (double)f > v ? std::nextafter(f, -INFINITY) : f;
+}
+float float_above(double v) {
+    float f = (float)v;
+    return (double)f < v ? std::nextafter(f, INFINITY) : f;
+}
+
 struct TileRange {
     int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
     bool empty() const { return x1 < x0 || y1 < y0; }
@@ -140,9 +149,11 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
         }
     }
     // The tiles an item is listed in: those its box reaches, but for a curve of a fill only
-    // those one of its sub-pieces' boxes reach (a curve across the canvas was listed in
-    // every tile of its box). A curve that reaches no part of a region crosses neither leg
-    // of the winding path there (the corner rays count every segment, see above).
+    // those its capsules reach (sub_piece_capsules: chords about half a tile long grown by
+    // how far the curve strays from them; a curve across the canvas was listed in every
+    // tile of its box, then in the fifty of its sub-pieces' boxes, and passes through a
+    // dozen). A curve that reaches no part of a region crosses neither leg of the winding
+    // path there (the corner rays count every segment, see above).
     std::vector<int>& stamp = scratch.stamp;
     stamp.assign(w * h, -1);
     auto for_each_tile = [&](int k, auto visit) {
@@ -259,6 +270,8 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
                 li.item = local[i];
                 if (fill) {
                     const PreparedSegment& s = sc.fill_items[d.first_item + li.item];
+                    li.y0 = float_below(s.box.y0);
+                    li.y1 = float_above(s.box.y1);
                     LegCrossings c;
                     if (s.box.x0 <= region.x1 && region.x1 <= s.box.x1)
                         c.n = (int8_t)vertical_crossings(s, region.x1, region.y0, region.y1, c.y, c.dir);

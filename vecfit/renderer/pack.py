@@ -291,22 +291,26 @@ class Packer:
 
     def _record_presence(self, shape: Shape, has_stroke: bool, scaled: bool) -> None:
         """Tells the provenance which of the shape's draws exist because of a value that the
-        loop may change (a stroke's width above 0, an ellipse's radii)."""
+        loop may change (a stroke's width above 0)."""
         g = shape.geometry
         if shape.stroke is not None and scaled:
             widths = g.widths if isinstance(g, Path) and g.widths is not None else shape.stroke_width
             self.provenance.present_if_positive(widths, has_stroke)
-        if isinstance(g, (Circle, Ellipse)):
-            r = g.radius if isinstance(g, Circle) else g.radii
-            self.provenance.present_if_positive(r, value(r.min()) > 0, every=True)
+        # (an ellipse's radii gate its axes instead: see _add_ellipse)
 
     def _add_ellipse(self, geometry, m: torch.Tensor) -> int | None:
         r = geometry.radius.reshape(1).expand(2) if isinstance(geometry, Circle) else geometry.radii
-        if value(r.min()) <= 0:
+        present = value(r.min()) > 0
+        if not present and not self.provenance:
             return None
         c = affine_apply(m, geometry.center.reshape(1, 2).float())[0]
         axes = m[:2, :2] @ torch.diag(r.float())
         if self.provenance:
+            # Kept with axes 0 while a radius is <= 0 (the core draws nothing there), so
+            # that a fitting loop's pack keeps its structure as radii cross 0: the axes'
+            # routes are gated by the radii (Provenance.ellipse).
+            if not present:
+                axes = axes * 0.0
             self.provenance.ellipse(len(self.out.ellipses), geometry.center, geometry.radius if isinstance(geometry, Circle)
                                else geometry.radii, m.detach().numpy())
         self.out.ellipses.append(torch.cat([c, axes.reshape(4)]))

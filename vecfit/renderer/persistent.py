@@ -60,6 +60,7 @@ class _Route:
     source_index: np.ndarray
     coefficient: np.ndarray
     constant: np.ndarray | None = None  # the part that does not depend on the tensor (else 0)
+    gate: torch.Tensor | None = None    # the route applies while this tensor's values are all > 0 (else 0)
 
 
 class Provenance:
@@ -97,7 +98,9 @@ class Provenance:
                                               np.full(n, m[c, 2])))
 
     def ellipse(self, row: int, center: torch.Tensor, radii: torch.Tensor, m: np.ndarray) -> None:
-        """An ellipses row: centre mapped by m, axes = m's linear part times diag(radii)."""
+        """An ellipses row: centre mapped by m, axes = m's linear part times diag(radii)
+        while every radius is > 0, else 0 (the draw stays, drawing nothing: see
+        Packer._add_ellipse), so that a radius crossing 0 changes no structure."""
         first = row * COLUMNS["ellipses"]
         for c in range(2):
             for j in range(2):
@@ -108,7 +111,7 @@ class Provenance:
         for i in range(2):
             for j in range(2):
                 self.routes.append(_Route("ellipses", np.array([first + 2 + 2 * i + j]), radii,
-                                          np.array([0 if circle else j]), np.array([m[i, j]])))
+                                          np.array([0 if circle else j]), np.array([m[i, j]]), gate=radii))
 
     def rect(self, rect) -> None:
         """A rect becomes a path (geometry.rect_as_path): with square corners, its corners
@@ -150,7 +153,7 @@ class PersistentPack:
     float arrays for this iteration; ``leaves`` are the kinds' flat tensors (requiring
     grad), in the order of the kinds given to build."""
 
-    def __init__(self, structure, shapes, base, destination, source, coefficient, conditions):
+    def __init__(self, structure, shapes, base, destination, source, coefficient, conditions, gates=None):
         self.structure = structure
         self._shapes = shapes          # FLOAT_INPUTS' shapes, in order
         self._base = base              # all float arrays side by side (float32)
@@ -158,6 +161,7 @@ class PersistentPack:
         self._source = source
         self._coefficient = coefficient
         self._conditions = conditions  # (kind, a, b, expected): see _conditions
+        self._gates = gates            # (entries, coefficients, x index, run starts, open): see _gate
 
     @classmethod
     def build(cls, scene: Scene, width: int, height: int, kinds: list[FlatTensors]) -> "PersistentPack | None":
@@ -188,6 +192,8 @@ class PersistentPack:
         first_of = dict(zip(FLOAT_INPUTS, starts[:-1]))
         base = torch.cat([f.reshape(-1) for f in floats]) if floats else torch.zeros(0)
         dst, src, coef, constant_at, constant = [], [], [], [], []
+        gated = []  # (first entry, entries, gate tensor's first element in x, its size)
+        n_entries = 0
         for r in provenance.routes:
             where = at.get(id(r.tensor))
             if where is None:
@@ -198,16 +204,21 @@ class PersistentPack:
             coef.append(r.coefficient)
             constant_at.append(d)
             constant.append(r.constant if r.constant is not None else np.zeros(len(d)))
+            if r.gate is not None:
+                gated.append((n_entries, len(d), at.get(id(r.gate)), r.gate.numel(), r.gate))
+            n_entries += len(d)
         base = base.clone()
         if dst:
             base[torch.from_numpy(np.concatenate(constant_at))] = torch.from_numpy(
                 np.concatenate(constant)).float()
         as_index = lambda parts: torch.from_numpy(np.concatenate(parts).astype(np.int64)) if parts \
             else torch.zeros(0, dtype=torch.int64)  # noqa: E731
+        coefficient = torch.from_numpy(np.concatenate(coef)).float() if coef else torch.zeros(0)
         pack = cls({k: v for k, v in arrays.items() if k not in FLOAT_INPUTS}, [f.shape for f in floats],
-                   base, as_index(dst), as_index(src),
-                   torch.from_numpy(np.concatenate(coef)).float() if coef else torch.zeros(0),
-                   _conditions(provenance.presence, provenance.differences, at))
+                   base, as_index(dst), as_index(src), coefficient,
+                   _conditions(provenance.presence, provenance.differences, at), _gates(gated, coefficient))
+        if pack._gates is not None:
+            pack._gate(np.concatenate([k.flat.detach().reshape(-1).numpy() for k in kinds]))
         # (the check differentiates: a pack first built in a no-grad evaluation, the loop's
         # last, had no graph to check and raised)
         with torch.enable_grad():
@@ -226,11 +237,14 @@ class PersistentPack:
         return self.structure, floats
 
     def still_valid(self, flats: list[torch.Tensor]) -> bool:
-        """Whether every draw that exists because of a value (a stroke's width, an
-        ellipse's radii) still exists, and no other has come to exist."""
-        if not self._conditions:
+        """Whether every draw that exists because of a value (a stroke's width) still
+        exists, and no other has come to exist. (An ellipse whose radii cross 0 keeps its
+        draw: its axes' routes open or close, _gate.)"""
+        if not self._conditions and self._gates is None:
             return True
         x = (torch.cat(flats) if len(flats) > 1 else flats[0]).detach().numpy()
+        if self._gates is not None:
+            self._gate(x)
         for kind, a, b, expected in self._conditions:
             if kind == "difference":
                 values = x[a] - x[b]
@@ -239,6 +253,19 @@ class PersistentPack:
             if not np.array_equal(values > 0, expected):
                 return False
         return True
+
+    def _gate(self, x: np.ndarray) -> None:
+        """Opens the gated routes whose gate tensor's values in x are all > 0 and closes
+        the others (their coefficients 0: an ellipse's axes 0 while a radius is <= 0)."""
+        entries, coefficients, index, starts, was_open = self._gates
+        now_open = np.minimum.reduceat(x[index], starts) > 0
+        if np.array_equal(now_open, was_open):
+            return
+        changed = np.flatnonzero(now_open != was_open)
+        for k in changed:
+            e = entries[k]
+            self._coefficient[e] = coefficients[e] if now_open[k] else 0.0
+        was_open[:] = now_open
 
     def _agrees(self, kinds, packed: list[torch.Tensor]) -> bool:
         """Once per build: the same floats as the Packer's (``packed``, with its autograd
@@ -265,6 +292,27 @@ class PersistentPack:
             if not torch.allclose(f, reference, rtol=1e-4, atol=1e-4 * max(1.0, scale)):
                 return False
         return True
+
+
+def _gates(gated, coefficient: torch.Tensor):
+    """The gated routes (see _Route.gate) by gate tensor, as PersistentPack._gate reads
+    them: each gate's coefficient entries, the coefficients themselves, the gate tensors'
+    elements in x with where each one's run starts, and which gates are open (none yet:
+    the build opens those that are)."""
+    rows = [(first, n, where, size, gate) for first, n, where, size, gate in gated if where is not None]
+    if not rows:
+        return None
+    by_gate: dict[int, list] = {}
+    order = []
+    for first, n, where, size, gate in rows:
+        if id(gate) not in by_gate:
+            by_gate[id(gate)] = [[], where, size]
+            order.append(id(gate))
+        by_gate[id(gate)][0].append(np.arange(first, first + n))
+    entries = [torch.from_numpy(np.concatenate(by_gate[g][0]).astype(np.int64)) for g in order]
+    index = np.concatenate([by_gate[g][1] + np.arange(by_gate[g][2]) for g in order])
+    starts = np.concatenate([[0], np.cumsum([by_gate[g][2] for g in order])[:-1]]).astype(np.int64)
+    return entries, coefficient.clone(), index, starts, np.ones(len(order), dtype=bool)
 
 
 def _conditions(presence, differences, at: dict[int, int]) -> list:

@@ -150,10 +150,45 @@ def test_draws_that_come_and_go_make_it_stale(tmp_path):
     with torch.no_grad():
         scene.shapes[-1].stroke_width.fill_(0.0)  # the open path's stroke disappears
     assert not pack.still_valid(flats)
+
+
+@pytest.mark.parametrize("mode", ["mc", "analytic"])
+def test_radius_crossing_zero_keeps_the_pack(tmp_path, mode):
+    """A circle whose radius crosses 0 keeps its draw, its axes 0 while the radius is <= 0
+    (the core draws nothing there): the pack stays valid, and its images and gradients
+    are those of packing the Scene anew (to float rounding, as _assert_same), either
+    side of 0 (10,000 tiny circles were packed anew on every iteration, issue 28)."""
+    scene = _scene(tmp_path)
+    kinds = parameter_kinds(scene, {"points": 1.0, "colors": 0.01, "radii": 0.5}, 64, 48)
+    pack = PersistentPack.build(scene, 64, 48, kinds)
+    flats = [k.flat for k in kinds]
+    circle = scene.shapes[3].geometry
+    for radius in (-0.5, 0.0, 20.0, -3.0):
+        with torch.no_grad():
+            circle.radius.fill_(radius)
+        assert pack.still_valid(flats)
+        for with_pack in (False, True):
+            for k in kinds:
+                k.zero_grad()
+            leaves = [k.flat.detach().requires_grad_() for k in kinds]
+            image = render(scene, 64, 48, seed=5, threads=2, mode=mode,
+                           packed=pack.arrays(leaves) if with_pack else None)
+            (image * torch.linspace(-1, 1, image.numel()).reshape(image.shape)).sum().backward()
+            grads = {k.name: k.gradient(leaf if with_pack else None) for k, leaf in zip(kinds, leaves)}
+            if not with_pack:
+                expected = (image.detach(), grads)
+        assert torch.allclose(image.detach(), expected[0], atol=1e-6), radius
+        for name, g in grads.items():
+            assert torch.allclose(g, expected[1][name], rtol=1e-5, atol=1e-6 * max(1.0, float(g.abs().max()))), name
+    # a fresh build where the radius is already <= 0 opens the gate once it is > 0
+    pack = PersistentPack.build(scene, 64, 48, kinds)
+    assert pack is not None
     with torch.no_grad():
-        scene.shapes[-1].stroke_width.fill_(2.0)
-        scene.shapes[3].geometry.radius.fill_(0.0)  # the circle disappears
-    assert not pack.still_valid(flats)
+        circle.radius.fill_(20.0)
+    assert pack.still_valid(flats)
+    leaves = [k.flat.detach().requires_grad_() for k in kinds]
+    assert torch.allclose(render(scene, 64, 48, seed=5, threads=2, mode=mode, packed=pack.arrays(leaves)).detach(),
+                          render(scene, 64, 48, seed=5, threads=2, mode=mode).detach(), atol=1e-6)
 
 
 def test_loop_same_fit_either_way(tmp_path, monkeypatch):
