@@ -2,7 +2,7 @@
 arrays it is given (the packed scene) and the image it returns.
 
     python benchmarks/memory.py [--cases tiger,paths,walk,across,wide] [--modes mc,analytic]
-                                [--threads 2] [--samples 2]
+                                [--threads 2] [--samples 2] [--budget 60]
 
 Each row runs in a fresh process (Linux only: it reads /proc/self/status): the scene is
 built, torch and the core are warmed up on a small scene, the peak resident set is reset
@@ -123,19 +123,26 @@ def main():
     parser.add_argument("--passes", default="forward,backward")
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--samples", type=int, default=2)
+    parser.add_argument("--budget", type=float, default=60.0,
+                        help="seconds a row may take (Monte Carlo backward passes of canvas-wide paths take minutes)")
     parser.add_argument("--child", help=argparse.SUPPRESS)
     a = parser.parse_args()
     if a.child:
         case, mode, back = a.child.split(",")
         print(json.dumps(child(case, mode, back == "1", a.threads, a.samples)))
         return
-    print(f"{'scene':8} {'mode':9} {'pass':9} {'arrays MB':>10} {'image MB':>9} {'render MB':>10} {'ratio':>7}")
+    print(f"{'scene':8} {'mode':9} {'pass':9} {'arrays MB':>10} {'image MB':>9} {'render MB':>10} {'ratio':>7}", flush=True)
     for case in a.cases.split(","):
         for mode in a.modes.split(","):
             for p in a.passes.split(","):
-                out = subprocess.run([sys.executable, __file__, "--child", f"{case},{mode},{int(p == 'backward')}",
-                                      "--threads", str(a.threads), "--samples", str(a.samples)],
-                                     capture_output=True, text=True, cwd=HERE, env=dict(os.environ))
+                try:
+                    out = subprocess.run([sys.executable, __file__, "--child", f"{case},{mode},{int(p == 'backward')}",
+                                          "--threads", str(a.threads), "--samples", str(a.samples)],
+                                         capture_output=True, text=True, cwd=HERE, env=dict(os.environ),
+                                         timeout=a.budget)
+                except subprocess.TimeoutExpired:
+                    print(f"{case:8} {mode:9} {p:9} not measured: over the {a.budget:g} s budget", flush=True)
+                    continue
                 if out.returncode != 0:
                     print(f"{case:8} {mode:9} {p:9} failed: {out.stderr.strip().splitlines()[-1:]}")
                     continue

@@ -128,3 +128,36 @@ def test_fields_match_per_sample(tmp_path, name, samples, filt):
     assert fi[..., 3].sum() > 0 and sg.abs().sum() > 0
     assert torch.equal(fi, si), float((fi - si).abs().max())
     assert torch.equal(fg, sg), float((fg - sg).abs().max())
+
+
+# README's "Limits and guarantees" states what the core holds for a render by segment:
+# these bounds are the figures it names (bytes per segment).
+PREPARED_PER_FILLED_SEGMENT = 400
+PREPARED_PER_STROKED_SEGMENT = 1_400
+TILE_LISTS_PER_SHORT_SEGMENT = 64
+
+
+def footprint_per_segment(tmp_path, body: str, segments: int, mode: str = "mc") -> dict:
+    from vecfit.renderer.options import RenderOptions
+    from vecfit.renderer.raster import FLOAT_INPUTS, packed_for_core
+
+    svg = tmp_path / "scene.svg"
+    svg.write_text(f'<svg {NS} width="64" height="64">{GRADIENT}{body}</svg>')
+    structure, floats = packed_for_core(quiet_load(svg), 64, 64)
+    arrays = dict(structure, **{name: t.detach().numpy() for name, t in zip(FLOAT_INPUTS, floats)})
+    parts = _core.footprint(arrays, RenderOptions(64, 64, mode=mode).core())
+    return {part: size / segments for part, size in parts.items()}
+
+
+@pytest.mark.parametrize("kinds", ["L", "Q", "C", "LQC"])
+def test_memory_per_segment_within_the_stated_limits(tmp_path, kinds):
+    n = 3000
+    filled = footprint_per_segment(tmp_path, f'<path d="{walk(n, 64, 2, kinds)} Z" fill="#3a6"/>', n)
+    assert filled["fill_items"] <= PREPARED_PER_FILLED_SEGMENT, filled
+    assert filled["tile_items"] <= TILE_LISTS_PER_SHORT_SEGMENT, filled
+    for mode in ("mc", "analytic"):
+        stroked = footprint_per_segment(
+            tmp_path, f'<path d="{walk(n, 64, 6, kinds)}" fill="url(#g)" stroke="green" stroke-width="1e7"/>',
+            n, mode)
+        assert stroked["stroke_items"] + stroked["segments"] <= PREPARED_PER_STROKED_SEGMENT, stroked
+        assert stroked["fill_items"] <= PREPARED_PER_FILLED_SEGMENT, stroked
