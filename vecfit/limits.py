@@ -17,7 +17,8 @@ MAX_ELEMENTS = 100_000
 
 # Path segments in a whole scene (arcs count as the cubics they become). Rendering time
 # grows with the segments crossing each tile: 10^6 lines across a 64 px canvas ran past
-# 40 s; 99,000 take 57 s (mc) to 230 s (analytic) on 2 cores, the worst case allowed.
+# 40 s; 99,000, filled and stroked, take 2.2 s (mc) to 223 s (analytic: the stroke's
+# distances) on 2 cores, the worst case allowed (benchmarks/RESULTS.md).
 MAX_SEGMENTS = 100_000
 
 # Groups with opacity nested in each other (each is composited as a layer); the core's
