@@ -5,9 +5,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import torch
 
 from vecfit.errors import VecfitError
+from vecfit.scene.arrays import is_tensor
 
 
 def fmt(value, decimals: int = 4) -> str:
@@ -33,7 +33,7 @@ def matrix(m) -> str:
 
 
 def finite(t) -> np.ndarray:
-    a = t.detach().cpu().double().numpy() if isinstance(t, torch.Tensor) else np.asarray(t, float)
+    a = t.detach().cpu().double().numpy() if is_tensor(t) else np.asarray(t, float)
     if not np.isfinite(a).all():
         raise VecfitError("cannot write non-finite values (NaN or infinity) to SVG")
     return a
