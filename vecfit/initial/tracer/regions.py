@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from scipy import ndimage
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
@@ -32,16 +33,30 @@ class Regions:
 
 def components(classes: np.ndarray) -> tuple[np.ndarray, int]:
     """8-connected components of each colour class (int32 [H, W], -1 stays -1), the
-    same connectivity that cv2.findContours gives the outline of a region."""
+    same connectivity that cv2.findContours gives the outline of a region; numbered class
+    by class, and within a class in raster order of their first pixel. (OpenCV numbers
+    them in an order that depends on how many threads it splits the image between, and
+    merging breaks ties by number: so the trace would depend on the machine.) Each class
+    is labelled within its bounding box: most classes of an emoji cover a small part."""
     comp = np.full(classes.shape, -1, np.int32)
     count = 0
-    for c in np.unique(classes):
-        if c < 0:
+    k = int(classes.max()) + 1 if classes.size else 0
+    for c, box in enumerate(ndimage.find_objects(classes + 1, max_label=k)):
+        if box is None:
             continue
-        mask = classes == c
-        n, cc = cv2.connectedComponents(mask.astype(np.uint8), connectivity=8, ltype=cv2.CV_32S)
-        comp[mask] = cc[mask] - 1 + count
+        mask = classes[box] == c
+        n, cc = cv2.connectedComponents(mask.view(np.uint8), connectivity=8, ltype=cv2.CV_32S)
+        view = comp[box]
+        view[mask] = cc[mask] - 1 + count
         count += n - 1
+    if count:
+        flat = comp.ravel()
+        ids, first = np.unique(flat, return_index=True)
+        first = first[ids >= 0]  # ids are 0 .. count - 1, class by class
+        cls = classes.ravel()[first]
+        renumber = np.empty(count, np.int32)
+        renumber[np.lexsort((first, cls))] = np.arange(count, dtype=np.int32)
+        comp = np.where(comp >= 0, renumber[np.maximum(comp, 0)], -1).astype(np.int32)
     return comp, count
 
 
