@@ -18,7 +18,7 @@ def fmt(value, decimals: int = 4) -> str:
     s = f"{v:.{decimals}f}"
     if "." in s:
         s = s.rstrip("0").rstrip(".")
-    return "0" if s in ("-0", "") else s
+    return "0" if s == "-0" or not s else s
 
 
 def hex_color(rgba) -> str:

@@ -198,10 +198,13 @@ class Stretches:
         ext = p[start + src]
         ext[before] = 2 * p[start[before]] - ext[before]
         ext[after] = 2 * p[start[after] + m[after] - 1] - ext[after]
-        base = ext_first[self.owner] + self.pos  # where each point's window begins in ext
-        out = np.zeros_like(p)
+        # the weighted sums over every window of ext (contiguous slices), then each
+        # point's own window: where it begins in ext
+        windows = len(ext) - 2 * r
+        acc = np.zeros((windows, 2))
         for j, w in enumerate(k):
-            out += w * ext[base + j]
+            acc += w * ext[j:j + windows]
+        out = acc[ext_first[self.owner] + self.pos]
         ends = (self.pos == 0) | (self.pos == n[self.owner] - 1)
         out[ends] = p[ends]
         return out

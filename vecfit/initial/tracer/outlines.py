@@ -102,16 +102,20 @@ def fill_corner_notches(mask: np.ndarray, arm: int = 3) -> np.ndarray:
     two sides and nothing along the other two (unlike a staircase step). Shorter arms
     also catch ragged photo edges, where filling adds segments and no accuracy."""
     m = np.pad(mask, arm)
+    empty = ~m
     h, w = mask.shape
 
-    def at(dx, dy):
-        return m[arm + dy:arm + dy + h, arm + dx:arm + dx + w]
+    def at(a, dx, dy):
+        return a[arm + dy:arm + dy + h, arm + dx:arm + dx + w]
 
     add = np.zeros_like(mask)
     for sx in (-1, 1):
         for sy in (-1, 1):
-            hit = ~(at(-sx, 0) | at(0, -sy))
+            hit = at(empty, -sx, 0) & at(empty, 0, -sy)
             for k in range(1, arm + 1):
-                hit &= at(k * sx, 0) & at(0, k * sy) & ~at(k * sx, -sy) & ~at(-sx, k * sy)
+                hit &= at(m, k * sx, 0)
+                hit &= at(m, 0, k * sy)
+                hit &= at(empty, k * sx, -sy)
+                hit &= at(empty, -sx, k * sy)
             add |= hit
     return mask | add

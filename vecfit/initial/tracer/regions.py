@@ -51,8 +51,9 @@ def components(classes: np.ndarray) -> tuple[np.ndarray, int]:
         count += n - 1
     if count:
         flat = comp.ravel()
-        ids, first = np.unique(flat, return_index=True)
-        first = first[ids >= 0]  # ids are 0 .. count - 1, class by class
+        where = np.flatnonzero(flat >= 0)
+        first = np.full(count, len(flat), np.int64)
+        np.minimum.at(first, flat[where], where)  # each component's first pixel
         cls = classes.ravel()[first]
         renumber = np.empty(count, np.int32)
         renumber[np.lexsort((first, cls))] = np.arange(count, dtype=np.int32)
