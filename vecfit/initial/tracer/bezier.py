@@ -57,15 +57,26 @@ class Loops:
         reach[self.lengths < 5] = 0
         if which is not None:
             reach[~which] = 0
-        per_point = reach[self.owner]
-        for r in np.unique(reach[reach > 0]):
-            rows = np.flatnonzero(per_point == r)
+        for r in np.unique(reach[reach > 0]).tolist():
+            loops = np.flatnonzero(reach == r)
             k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
             k /= k.sum()
-            acc = np.zeros((len(rows), 2))
+            # the loops, each extended by r points at either end round itself, end to end:
+            # every window is then a contiguous slice
+            n = self.lengths[loops]
+            ext_n = n + 2 * r
+            ext_first = np.concatenate([[0], np.cumsum(ext_n)[:-1]])
+            which = np.repeat(np.arange(len(loops)), ext_n)
+            t = np.arange(ext_n.sum()) - ext_first[which] - r
+            ext = self.points[self.first[loops][which] + t % n[which]]
+            windows = len(ext) - 2 * r
+            acc = np.zeros((windows, 2))
             for j, weight in enumerate(k):
-                acc += weight * self.points[self.shifted(j - r, rows)]
-            out[rows] = acc
+                acc += weight * ext[j:j + windows]
+            inside = t >= 0
+            inside[t >= n[which]] = False
+            rows = self.first[loops][which[inside]] + t[inside]
+            out[rows] = acc[np.flatnonzero(inside) - r]
         return out
 
 
@@ -390,6 +401,20 @@ def _fit_all(st: Stretches, s: np.ndarray, tangents: np.ndarray, t1, t2, tol: fl
     return ctrl[order], own[order]
 
 
+def _medians(values: np.ndarray, group: np.ndarray, valid: np.ndarray, wanted: np.ndarray) -> np.ndarray:
+    """np.median of the valid values of each group in `wanted` (a mask over the groups),
+    in group order, for groups with at least one value."""
+    values, group = values[valid], group[valid]
+    order = np.lexsort((values, group))
+    values, group = values[order], group[order]
+    count = np.bincount(group, minlength=len(wanted))
+    start = np.concatenate([[0], np.cumsum(count)[:-1]])
+    ids = np.flatnonzero(wanted & (count > 0))
+    lo = values[start[ids] + (count[ids] - 1) // 2]
+    hi = values[start[ids] + count[ids] // 2]
+    return np.where(count[ids] % 2 == 1, lo, (lo + hi) / 2)
+
+
 def fit_outlines(outlines: list[np.ndarray], tolerance: float, corner_angle: float,
                  smoothing: float = 1.0, corner_window: float = 3.0) -> list[np.ndarray]:
     """Cubic segments [S, 4, 2] of each closed outline (each segment starts where the
@@ -400,21 +425,27 @@ def fit_outlines(outlines: list[np.ndarray], tolerance: float, corner_angle: flo
     staircase, and the fit is to the smoothed copy, so the staircase does not eat into
     the tolerance. corner_window (pixels) is how far either side the corner angle is
     measured."""
-    cleaned = []
-    for points in outlines:
-        keep = np.any(points != np.roll(points, 1, 0), axis=1)  # outlines may touch themselves
-        cleaned.append(points[keep] if keep.any() else points[:1])
-    spacing = [np.median(np.hypot(*np.diff(p, axis=0).T)) for p in cleaned if len(p) >= 3]
-    step = float(np.median(spacing)) if spacing else 1.0
+    result = [np.zeros((0, 4, 2)) for _ in outlines]
+    if not outlines:
+        return result
+    raw = Loops(np.concatenate(outlines).astype(float, copy=False), np.array([len(o) for o in outlines]))
+    keep = np.any(raw.points != raw.points[raw.shifted(-1)], axis=1)  # outlines may touch themselves
+    alike = (np.bincount(raw.owner[keep], minlength=len(outlines)) == 0) & (raw.lengths > 0)
+    keep[raw.first[alike]] = True  # an outline of one point repeated: that point
+    lengths = np.bincount(raw.owner[keep], minlength=len(outlines))
+    cleaned = Loops(raw.points[keep], lengths)
+    spacing = _medians(np.hypot(*np.diff(cleaned.points, axis=0).T), cleaned.owner[1:],
+                       cleaned.pos[1:] > 0, lengths >= 3)
+    step = float(np.median(spacing)) if len(spacing) else 1.0
     step = step if step > 0 else 1.0
     sigma = smoothing / step
     window = max(1, int(round(TANGENT_REACH / step)))
     reach = max(1, int(round(corner_window / step)))
-    result = [np.zeros((0, 4, 2)) for _ in outlines]
-    used = [i for i, p in enumerate(cleaned) if len(p) >= 3]
-    if not used:
+    used = np.flatnonzero(lengths >= 3)
+    if not len(used):
         return result
-    loops = Loops(np.concatenate([cleaned[i] for i in used]), np.array([len(cleaned[i]) for i in used]))
+    rows = np.isin(cleaned.owner, used)
+    loops = Loops(cleaned.points[rows], lengths[used])
     points, lengths, owner, given1, given2 = cut_outlines(loops, sigma, window, corner_angle, reach)
     st = Stretches(points, lengths)
     s = st.smoothed(sigma)
@@ -429,7 +460,7 @@ def fit_outlines(outlines: list[np.ndarray], tolerance: float, corner_angle: flo
     ctrl, stretch_of = _fit_all(st, s, tangents, t1, t2, tolerance)
     outline_of = owner[stretch_of]  # sorted: stretches are in outline order
     bounds = np.searchsorted(outline_of, np.arange(len(used) + 1))
-    for k, i in enumerate(used):
+    for k, i in enumerate(used.tolist()):
         result[i] = ctrl[bounds[k]:bounds[k + 1]]
     return result
 
