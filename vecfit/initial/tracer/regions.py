@@ -171,9 +171,33 @@ class _Merger:
             self.adj[a][b] = length
             self.adj[b][a] = length
         self.live = n
-        self.heap = []
-        for r in range(n):
-            self.push(r)
+        self.heap = self._first_entries(area, color * area[:, None], edges)
+        heapq.heapify(self.heap)
+
+    def _first_entries(self, area, sums, edges) -> list:
+        """Every region's first heap entry, as push makes it, for all regions at once: the
+        cost of each edge both ways in push's own float arithmetic, and each region's
+        cheapest neighbour (of equal costs the lowest index, the first that push meets:
+        adjacency lists hold neighbours in ascending order)."""
+        n = len(area)
+        best, target = np.full(n, np.inf), np.full(n, -1, np.int64)
+        if len(edges):
+            r = np.concatenate([edges[:, 0], edges[:, 1]])
+            t = np.concatenate([edges[:, 1], edges[:, 0]])
+            ar, at = area[r], area[t]
+            d = [sums[r, k] / ar - sums[t, k] / at for k in range(3)]
+            cost = ar * at / (ar + at) * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+            order = np.lexsort((t, cost, r))
+            r, t, cost = r[order], t[order], cost[order]
+            first = np.r_[True, r[1:] != r[:-1]]
+            best[r[first]], target[r[first]] = cost[first], t[first]
+        entries = []
+        for i, (c, j) in enumerate(zip(best.tolist(), target.tolist())):
+            if j < 0:
+                c = self.cost(i, -1)
+            must = self.small[i] and (j >= 0 or self.area[i] < self.min_area)
+            entries.append((0 if must else 1, c, i, 0, j, 0))
+        return entries
 
     def cost(self, r: int, t: int) -> float:
         ar, (sr, sg, sb) = self.area[r], self.sum[r]
