@@ -8,9 +8,11 @@ its ends held, so corners stay sharp, and fitted by least squares with fixed end
 Gems 1990), reparameterised by Newton steps and split at the worst point until the error
 is within tolerance. Pieces meet with a shared tangent except at corners.
 
-A traced image has thousands of stretches of a few dozen points each, so the fitting
-runs on all of them at once, one level of splitting at a time (arrays of pieces rather
-than a recursion per piece): per-call overhead, not arithmetic, is what costs here.
+A traced image has a thousand outlines and thousands of stretches of a few dozen points
+each, so everything runs on all of them at once: the outlines laid end to end (Loops)
+are cleaned, smoothed and cut together, and the fitting goes one level of splitting at
+a time (arrays of pieces rather than a recursion per piece): per-call overhead, not
+arithmetic, is what costs here.
 """
 from __future__ import annotations
 
