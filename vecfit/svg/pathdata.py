@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .numbers import fmt
+from .numbers import fmt, fmt_many
 from .units import NUMBER
 
 _TOKEN = re.compile(rf"[MmZzLlHhVvCcSsQqTtAa]|{NUMBER}|[^\s,]")
@@ -293,7 +293,8 @@ def format_path_data(points, degrees, subpaths, decimals: int = 4, compact: bool
     out the spaces before command letters.
     """
     # every point formatted once, as "x y" (a trace writes 50,000 numbers)
-    text = [f"{fmt(x, decimals)} {fmt(y, decimals)}" for x, y in np.asarray(points, float).reshape(-1, 2).tolist()]
+    numbers = fmt_many(points, decimals)
+    text = [f"{x} {y}" for x, y in zip(numbers[0::2], numbers[1::2])]
     degrees = np.asarray(degrees).tolist()
     out, p = [], 0
     for first, count, closed in subpaths:
