@@ -5,7 +5,8 @@
                                [--refine 1000[,...]] [--iterations N] [--set KEY=VALUE ...]
 
 For each image and path budget: the paths and segments written, the trace time in-process
-(median of --repeats), where it goes (quantisation, regions, drawing order, outlines with
+(median of --repeats; wall and the process's CPU time, which a machine shared with other
+work disturbs less), where it goes (quantisation, regions, drawing order, outlines with
 their sub-pixel placement, the Bezier fit with the SVG text), and the PSNR of the trace
 rendered by vecfit (MC 2x2, box filter, over white) against the image
 (skimage.metrics.peak_signal_noise_ratio on float RGB, data_range 1); then the mean PSNR
@@ -64,7 +65,7 @@ def measure(image: np.ndarray, settings, repeats: int = 1) -> dict:
     from vecfit.initial.tracer import trace_image
     from vecfit.io.compositing import composite
 
-    times, stages = [], {k: [] for k in STAGES}
+    times, cpu, stages = [], [], {k: [] for k in STAGES}
     for _ in range(repeats):
         marks = []
 
@@ -72,9 +73,10 @@ def measure(image: np.ndarray, settings, repeats: int = 1) -> dict:
             if not marks or marks[-1][0] != stage:
                 marks.append((stage, time.perf_counter()))
 
-        start = time.perf_counter()
+        start, start_cpu = time.perf_counter(), time.process_time()
         result = trace_image(image, settings, progress=progress)
         times.append(time.perf_counter() - start)
+        cpu.append(time.process_time() - start_cpu)
         marks.append(("end", start + times[-1]))
         for (stage, a), (_, b) in zip(marks, marks[1:]):
             stages[stage].append(b - a)
@@ -82,7 +84,7 @@ def measure(image: np.ndarray, settings, repeats: int = 1) -> dict:
     over_white = composite(image.astype(np.float64), (1.0, 1.0, 1.0))
     psnr = peak_signal_noise_ratio(over_white, render_svg(result.svg, w, h).astype(np.float64), data_range=1)
     return {"paths": result.paths, "segments": result.segments, "colors": result.colors,
-            "seconds": float(np.median(times)), "psnr": psnr,
+            "seconds": float(np.median(times)), "cpu": float(np.median(cpu)), "psnr": psnr,
             "stages": {k: float(np.median(v)) if v else 0.0 for k, v in stages.items()}}
 
 
@@ -136,26 +138,27 @@ def main():
           f"tolerance={defaults.tolerance} corner_angle={defaults.corner_angle} "
           f"blur={defaults.blur} overlap={defaults.overlap} smoothing={defaults.smoothing}")
     head = (f"{'image':22s} {'budget':>6s} {'paths':>6s} {'segments':>8s} {'seg/path':>8s} "
-            f"{'trace s':>8s} {'PSNR dB':>8s}   " + " ".join(f"{k:>8s}" for k in STAGES))
+            f"{'trace s':>8s} {'CPU s':>8s} {'PSNR dB':>8s}   " + " ".join(f"{k:>8s}" for k in STAGES))
     print(head)
     print("-" * len(head))
     inputs = [(f"{name} {im.shape[1]}x{im.shape[0]}", im, budgets) for name, im in
               [(n, load(n)) for n in images if n]]
     inputs += [(f"{name} {im.shape[1]}x{im.shape[0]}", im, budgets[:1]) for name, im in emoji(args.emoji)]
-    psnr, seconds = {}, {}
+    psnr, seconds, cpu = {}, {}, {}
     for label, image, image_budgets in inputs:
         group = "emoji" if label.startswith(("noto", "fxemoji")) else "photos"
         for b in image_budgets:
             r = measure(image, TraceSettings.defaults(paths=b), args.repeats)
             psnr.setdefault((group, b), []).append(r["psnr"])
             seconds.setdefault((group, b), []).append(r["seconds"])
+            cpu.setdefault((group, b), []).append(r["cpu"])
             print(f"{label:22s} {b:6d} {r['paths']:6d} {r['segments']:8d} "
-                  f"{r['segments'] / r['paths']:8.1f} {r['seconds']:8.3f} {r['psnr']:8.2f}   "
+                  f"{r['segments'] / r['paths']:8.1f} {r['seconds']:8.3f} {r['cpu']:8.3f} {r['psnr']:8.2f}   "
                   + " ".join(f"{r['stages'][k]:8.3f}" for k in STAGES), flush=True)
     print("-" * len(head))
     for (group, b), values in psnr.items():
         print(f"{'mean ' + group:22s} {b:6d} {'':6s} {'':8s} {'':8s} {np.median(seconds[(group, b)]):8.3f} "
-              f"{np.mean(values):8.2f}   (time: median)")
+              f"{np.median(cpu[(group, b)]):8.3f} {np.mean(values):8.2f}   (times: median)")
 
     if args.overlap_check:
         b = defaults.paths
