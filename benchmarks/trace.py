@@ -1,12 +1,18 @@
 """Tracing quality and speed: skimage's photographs traced at several path budgets.
 
     python benchmarks/trace.py [--budgets 250,500,1000,2000] [--images astronaut,...]
-                               [--overlap-check] [--refine 1000[,...]] [--iterations N] [--set KEY=VALUE ...]
+                               [--emoji N] [--repeats 3] [--overlap-check]
+                               [--refine 1000[,...]] [--iterations N] [--set KEY=VALUE ...]
 
-For each image and path budget: the paths and segments written, the trace time, and the
-PSNR of the trace rendered by vecfit (MC 2x2, box filter, over white) against the image
+For each image and path budget: the paths and segments written, the trace time in-process
+(median of --repeats; wall and the process's CPU time, which a machine shared with other
+work disturbs less), where it goes (quantisation, regions, drawing order, outlines with
+their sub-pixel placement, the Bezier fit with the SVG text), and the PSNR of the trace
+rendered by vecfit (MC 2x2, box filter, over white) against the image
 (skimage.metrics.peak_signal_noise_ratio on float RGB, data_range 1); then the mean PSNR
-per budget. --overlap-check also traces at the default budget with shapes not reaching
+per budget. --emoji N adds N emoji of the shared real-world corpus (noto and fxemoji in
+turn), rendered by resvg at 512 px, traced at the first budget (their transparency
+stays transparent; PSNR over white). --overlap-check also traces at the default budget with shapes not reaching
 under their neighbours (overlap 0), which shows the seams that overlap closes. --refine B
 runs the whole `vecfit trace` job (trace, then refine with the defaults) at budget B and
 scores the written SVG as resvg renders it, next to vecfit's own figures, with wall times,
@@ -48,24 +54,69 @@ def render_svg(svg: str, width: int, height: int) -> np.ndarray:
     return vecfit.render(scene, width, height, samples=2, background=[1, 1, 1, 1]).numpy()[..., :3]
 
 
-def measure(image: np.ndarray, settings) -> dict:
+STAGES = ["quantise", "regions", "order", "outline", "fit"]
+
+
+def measure(image: np.ndarray, settings, repeats: int = 1) -> dict:
+    """Trace `repeats` times: median time in all and per stage (from trace_image's
+    progress calls), and the last trace's counts and PSNR."""
     from skimage.metrics import peak_signal_noise_ratio
 
     from vecfit.initial.tracer import trace_image
+    from vecfit.io.compositing import composite
 
-    start = time.perf_counter()
-    result = trace_image(image, settings)
-    seconds = time.perf_counter() - start
+    times, cpu, stages = [], [], {k: [] for k in STAGES}
+    for _ in range(repeats):
+        marks = []
+
+        def progress(stage, fraction):
+            if not marks or marks[-1][0] != stage:
+                marks.append((stage, time.perf_counter()))
+
+        start, start_cpu = time.perf_counter(), time.process_time()
+        result = trace_image(image, settings, progress=progress)
+        times.append(time.perf_counter() - start)
+        cpu.append(time.process_time() - start_cpu)
+        marks.append(("end", start + times[-1]))
+        for (stage, a), (_, b) in zip(marks, marks[1:]):
+            stages[stage].append(b - a)
     h, w = image.shape[:2]
-    psnr = peak_signal_noise_ratio(image[..., :3], render_svg(result.svg, w, h), data_range=1)
+    over_white = composite(image.astype(np.float64), (1.0, 1.0, 1.0))
+    psnr = peak_signal_noise_ratio(over_white, render_svg(result.svg, w, h).astype(np.float64), data_range=1)
     return {"paths": result.paths, "segments": result.segments, "colors": result.colors,
-            "seconds": seconds, "psnr": psnr}
+            "seconds": float(np.median(times)), "cpu": float(np.median(cpu)), "psnr": psnr,
+            "stages": {k: float(np.median(v)) if v else 0.0 for k, v in stages.items()}}
+
+
+def emoji(count: int, width: int = 512) -> list[tuple[str, np.ndarray]]:
+    """The first `count` emoji of the shared real-world corpus (noto-emoji and fxemoji in
+    turn, every 8th of each), rendered by resvg at `width` px: float RGBA."""
+    import csv
+    import io
+
+    import resvg_py
+    from PIL import Image
+
+    from common import SHARED  # (benchmarks/ is on sys.path: the script's own folder)
+    root = SHARED / "realworld"
+    with open(root / "manifest.tsv") as f:
+        rows = list(csv.DictReader(f, delimiter="\t"))
+    sets = [[r for r in rows if r["tags"].split(",")[0] == tag][::8] for tag in ("noto-emoji", "fxemoji")]
+    chosen = [r for pair in zip(*sets) for r in pair][:count]
+    out = []
+    for r in chosen:
+        png = bytes(resvg_py.svg_to_bytes(svg_path=str(root / r["svg"]), width=width))
+        rgba = np.asarray(Image.open(io.BytesIO(png)).convert("RGBA"), np.float32) / 255
+        out.append((r["name"], rgba))
+    return out
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--budgets", default=",".join(map(str, BUDGETS)))
     ap.add_argument("--images", default=",".join(IMAGES))
+    ap.add_argument("--emoji", type=int, default=0, help="also trace this many emoji (512 px)")
+    ap.add_argument("--repeats", type=int, default=3, help="traces timed per image (median)")
     ap.add_argument("--overlap-check", action="store_true")
     ap.add_argument("--refine", default="", help="budgets to trace and refine at, e.g. 1000")
     ap.add_argument("--iterations", type=int, help="refinement iterations (default: the config's)")
@@ -86,22 +137,28 @@ def main():
     print(f"defaults: colors={defaults.colors} min_area={defaults.min_area} "
           f"tolerance={defaults.tolerance} corner_angle={defaults.corner_angle} "
           f"blur={defaults.blur} overlap={defaults.overlap} smoothing={defaults.smoothing}")
-    head = (f"{'image':16s} {'budget':>6s} {'paths':>6s} {'segments':>8s} {'seg/path':>8s} "
-            f"{'trace s':>8s} {'PSNR dB':>8s}")
+    head = (f"{'image':22s} {'budget':>6s} {'paths':>6s} {'segments':>8s} {'seg/path':>8s} "
+            f"{'trace s':>8s} {'CPU s':>8s} {'PSNR dB':>8s}   " + " ".join(f"{k:>8s}" for k in STAGES))
     print(head)
     print("-" * len(head))
-    psnr = {b: [] for b in budgets}
-    for name in images:
-        image = load(name)
-        label = f"{name} {image.shape[1]}x{image.shape[0]}"
-        for b in budgets:
-            r = measure(image, TraceSettings.defaults(paths=b))
-            psnr[b].append(r["psnr"])
-            print(f"{label:16s} {b:6d} {r['paths']:6d} {r['segments']:8d} "
-                  f"{r['segments'] / r['paths']:8.1f} {r['seconds']:8.2f} {r['psnr']:8.2f}", flush=True)
+    inputs = [(f"{name} {im.shape[1]}x{im.shape[0]}", im, budgets) for name, im in
+              [(n, load(n)) for n in images if n]]
+    inputs += [(f"{name} {im.shape[1]}x{im.shape[0]}", im, budgets[:1]) for name, im in emoji(args.emoji)]
+    psnr, seconds, cpu = {}, {}, {}
+    for label, image, image_budgets in inputs:
+        group = "emoji" if label.startswith(("noto", "fxemoji")) else "photos"
+        for b in image_budgets:
+            r = measure(image, TraceSettings.defaults(paths=b), args.repeats)
+            psnr.setdefault((group, b), []).append(r["psnr"])
+            seconds.setdefault((group, b), []).append(r["seconds"])
+            cpu.setdefault((group, b), []).append(r["cpu"])
+            print(f"{label:22s} {b:6d} {r['paths']:6d} {r['segments']:8d} "
+                  f"{r['segments'] / r['paths']:8.1f} {r['seconds']:8.3f} {r['cpu']:8.3f} {r['psnr']:8.2f}   "
+                  + " ".join(f"{r['stages'][k]:8.3f}" for k in STAGES), flush=True)
     print("-" * len(head))
-    for b in budgets:
-        print(f"{'mean':16s} {b:6d} {'':6s} {'':8s} {'':8s} {'':8s} {np.mean(psnr[b]):8.2f}")
+    for (group, b), values in psnr.items():
+        print(f"{'mean ' + group:22s} {b:6d} {'':6s} {'':8s} {'':8s} {np.median(seconds[(group, b)]):8.3f} "
+              f"{np.median(cpu[(group, b)]):8.3f} {np.mean(values):8.2f}   (times: median)")
 
     if args.overlap_check:
         b = defaults.paths

@@ -53,6 +53,10 @@ def _import_torch_holding_ctrl_c() -> None:
         raise KeyboardInterrupt
 
 
+# Commands that may run without torch: they import it themselves where they need it.
+_WITHOUT_TORCH = {"info"}
+
+
 class _Main(click.Group):
     """The command group. A Ctrl-C anywhere (while torch is imported, too) ends the
     command with "interrupted" and exit code 130, as a shell expects, where click would
@@ -60,11 +64,12 @@ class _Main(click.Group):
 
     def parse_args(self, ctx, args):
         ctx.meta["vecfit.help"] = any(a in ("-h", "--help") for a in args)  # (help needs no torch)
+        ctx.meta["vecfit.command"] = next((a for a in args if not a.startswith("-")), None)
         return super().parse_args(ctx, args)
 
     def invoke(self, ctx):
-        if not ctx.meta.get("vecfit.help"):
-            _import_torch_holding_ctrl_c()
+        if not ctx.meta.get("vecfit.help") and ctx.meta.get("vecfit.command") not in _WITHOUT_TORCH:
+            _import_torch_holding_ctrl_c()  # (info reads the SVG without torch)
         return super().invoke(ctx)
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
@@ -170,14 +175,15 @@ def info(svg, build):
         if not build:
             raise click.UsageError("give an SVG file, or --build")
         return
-    import vecfit  # (the Scene's tensors: torch is imported only from here on)
     from vecfit.errors import VecfitError
+    from vecfit.scene.arrays import numpy_arrays
     from vecfit.scene.summary import summarize
+    from vecfit.svg.read import load_svg
 
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), numpy_arrays():  # counting needs no torch
             warnings.simplefilter("ignore")
-            scene = vecfit.load_svg(svg)
+            scene = load_svg(svg)
     except VecfitError as e:
         _echo_err(f"error: {e}")
         sys.exit(EXIT_FAILED)

@@ -4,6 +4,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -87,9 +88,39 @@ def test_info_on_non_svg_is_a_clear_error(tmp_path):
     assert r.exit_code == 1 and "notes.svg" in r.output and "Traceback" not in r.output
 
 
-def test_version_starts_without_torch():
-    """`vecfit --version` says the core's build without importing torch (a second of start-up)."""
-    code = ("import sys\nfrom vecfit.cli.commands import main\nsys.argv = ['vecfit', '--version']\n"
+def _modules_after(*args) -> tuple[str, bool]:
+    """Runs the command line in a fresh Python with ``args``; its output and whether torch
+    was imported by the end."""
+    code = ("import sys\nfrom vecfit.cli.commands import main\n"
+            f"sys.argv = ['vecfit', *{list(map(str, args))!r}]\n"
             "try:\n    main()\nexcept SystemExit:\n    pass\nprint('torch' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
-    assert out.stdout.split()[-1] == "False" and out.stdout.startswith("vecfit "), out.stdout + out.stderr
+    lines = out.stdout.split()
+    return out.stdout + out.stderr, bool(lines) and lines[-1] == "True"
+
+
+@pytest.mark.parametrize("args", [["--version"], ["info", "--build"]])
+def test_version_starts_without_torch(args):
+    """`vecfit --version` and `info --build` say the core's build without importing torch
+    (a second of start-up)."""
+    output, torch_imported = _modules_after(*args)
+    assert "vecfit 0" in output and not torch_imported, output
+
+
+@pytest.mark.parametrize("name", ["tiger.svg", "golden"])
+def test_info_runs_without_torch(name, tmp_path):
+    """`vecfit info` reads the SVG into NumPy arrays (vecfit.scene.arrays): no torch."""
+    if name == "golden":
+        path = tmp_path / "effects.svg"  # a gradient, a group with opacity, a clip path, a use
+        path.write_text(
+            '<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" '
+            'width="40" height="30" viewBox="0 0 80 60"><defs><linearGradient id="g"><stop offset="0"/>'
+            '<stop offset="1" stop-color="red"/></linearGradient><clipPath id="c"><circle cx="20" cy="20" '
+            'r="15"/></clipPath></defs><g opacity="0.5" clip-path="url(#c)"><rect id="r" width="50" '
+            'height="40" fill="url(#g)"/></g><use xlink:href="#r" x="30"/><ellipse cx="9" cy="9" rx="4" '
+            'ry="3" stroke="blue"/></svg>')
+    else:
+        path = Path(__file__).resolve().parents[2] / "examples" / name
+    output, torch_imported = _modules_after("info", path)
+    assert "shapes:" in output and "Traceback" not in output, output
+    assert not torch_imported, output

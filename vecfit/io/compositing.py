@@ -5,7 +5,6 @@ a background in the same arithmetic.)"""
 from __future__ import annotations
 
 import numpy as np
-import torch
 
 
 def composite(rgba: np.ndarray, background) -> np.ndarray:
@@ -18,6 +17,7 @@ def composite(rgba: np.ndarray, background) -> np.ndarray:
 
 def composite_torch(rgba: torch.Tensor, background) -> torch.Tensor:
     """``composite`` for tensors (differentiable)."""
+    import torch
     a = rgba[..., 3:]
     if background is not None:
         return rgba[..., :3] * a + torch.tensor(background[:3], dtype=rgba.dtype) * (1 - a)

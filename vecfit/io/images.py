@@ -3,12 +3,12 @@ so an interrupted run never leaves a half-written output."""
 from __future__ import annotations
 
 import os
+import sys
 import tempfile
 from pathlib import Path
 
 import cv2
 import numpy as np
-import torch
 from PIL import Image, UnidentifiedImageError
 
 from vecfit.errors import VecfitError
@@ -16,7 +16,9 @@ from vecfit.limits import MAX_IMAGE_PIXELS
 
 
 def to_uint8(image: torch.Tensor | np.ndarray) -> np.ndarray:
-    a = image.detach().cpu().numpy() if isinstance(image, torch.Tensor) else np.asarray(image)
+    torch = sys.modules.get("torch")  # (a tensor exists only once torch is imported)
+    is_tensor = torch is not None and isinstance(image, torch.Tensor)
+    a = image.detach().cpu().numpy() if is_tensor else np.asarray(image)
     return (np.clip(a, 0, 1) * 255 + 0.5).astype(np.uint8)
 
 

@@ -28,13 +28,17 @@ from __future__ import annotations
 
 import math
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import torch
 
 from vecfit import limits
 
-from .geometry import ellipse_as_path, rect_as_path
+from . import arrays
 from .model import Circle, Ellipse, Path, Rect
+
+if TYPE_CHECKING:
+    import torch
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 _GL_X = (_GL_X + 1) / 2   # nodes on [0, 1]
@@ -112,7 +116,7 @@ class _Segments:
         self.degrees = degrees
         self.index = index            # [G, 4] point indices (-1: unused)
         self.sub_of = sub_of
-        pts = path.points.detach().double().cpu().numpy().reshape(-1, 2)
+        pts = np.asarray(arrays.to_numpy(path.points), np.float64).reshape(-1, 2)
         cubic = np.zeros((len(degrees), 4, 2))
         for d in (1, 2, 3):
             rows = np.nonzero(degrees == d)[0]
@@ -238,6 +242,7 @@ def outline_path(geometry) -> Path | None:
     """The geometry as the path its stroke follows (rects from (x + rx, y), circles and
     ellipses from (cx + rx, cy), clockwise on the screen, as SVG 2 defines); None when it
     has no outline (a zero-size rect, a radius not above 0)."""
+    from .geometry import ellipse_as_path, rect_as_path  # (torch: made as tensors)
     if isinstance(geometry, Rect):
         return rect_as_path(geometry)
     if isinstance(geometry, (Circle, Ellipse)):
@@ -296,6 +301,8 @@ def dash_path(path: Path, pattern, offset: float = 0.0, max_dashes: float | None
     path's own units, as open subpaths; None where the stroke is drawn solid: an invalid
     pattern or offset, or a dash_count (for a stroke ``width`` wide) over ``max_dashes``
     (limits.MAX_DASHES by default)."""
+    import torch
+
     pattern = dash_pattern(pattern)
     offset = float(offset)
     if pattern is None or not math.isfinite(offset):
@@ -446,6 +453,8 @@ def _implicit_shift(path: Path, segs: _Segments, seg: np.ndarray, t: np.ndarray)
     unit tangent and b_i the Bernstein basis (same quadrature as the lengths, in numpy);
     torch then only sees linear functions of the points with those coefficients (their
     values are subtracted out), so the graph stays small."""
+    import torch
+
     G = len(segs.degrees)
     # Coefficients per sub-interval, summed per segment and per end.
     part_coef = segs.length_gradient(np.repeat(np.arange(G), segs.m), segs.part_lo, segs.part_hi)  # [P, 4, 2]

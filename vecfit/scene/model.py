@@ -2,7 +2,9 @@
 
 A Scene is what the SVG reader produces, what the renderer draws and what the optimiser
 changes. Every float that a user may want to optimise is a torch tensor; structure
-(segment degrees, fill rules, caps, ...) is plain Python.
+(segment degrees, fill rules, caps, ...) is plain Python. (Within
+``arrays.numpy_arrays()`` the floats are NumPy arrays instead, for readers that only
+look: vecfit info; the tensors are made by ``arrays``, which imports torch on first use.)
 
 Coordinates: each shape's geometry is in its own user space. ``Shape.transform`` maps it
 into the user space of its group, each ``Group.transform`` into its parent's, and
@@ -18,8 +20,14 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any, Optional, Union
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import torch
+
+from . import arrays
+
+if TYPE_CHECKING:
+    import torch
 
 LINE, QUADRATIC, CUBIC = 1, 2, 3
 # mix-blend-mode and feBlend modes drawn (renderer/filters.py): the separable ones.
@@ -28,11 +36,11 @@ BLEND_MODES = frozenset({"normal", "multiply", "screen", "overlay", "darken", "l
 
 
 def identity() -> torch.Tensor:
-    return torch.eye(3, dtype=torch.float32)
+    return arrays.identity()
 
 
 def as_tensor(x, shape=None) -> torch.Tensor:
-    t = torch.as_tensor(x, dtype=torch.float32).clone()
+    t = arrays.floats(x)
     if shape is not None:
         t = t.reshape(shape)
     return t
@@ -123,7 +131,7 @@ class Ellipse:
 class Rect:
     p_min: torch.Tensor    # [2] x, y
     p_max: torch.Tensor    # [2] x + width, y + height
-    corner_radii: torch.Tensor = field(default_factory=lambda: torch.zeros(2))  # [2] rx, ry
+    corner_radii: torch.Tensor = field(default_factory=lambda: arrays.zeros(2))  # [2] rx, ry
 
 
 Geometry = Union[Path, Circle, Ellipse, Rect]
@@ -200,7 +208,7 @@ class Group:
     """An SVG <g> (or the root <svg>): a transform and an opacity applied to the
     composite of its children (group opacity is a layer, not a per-shape alpha)."""
     transform: torch.Tensor = field(default_factory=identity)  # [3, 3] to parent's space
-    opacity: torch.Tensor = field(default_factory=lambda: torch.tensor(1.0))
+    opacity: torch.Tensor = field(default_factory=lambda: arrays.scalar(1.0))
     parent: int = -1          # index into Scene.groups, -1 for the root
     source: Any = None        # id (or other handle) of the element, for write-back
     # Effects on the group's layer, in SVG's order: filter, then clip, then mask, then
@@ -226,14 +234,14 @@ class Shape:
     geometry: Geometry
     fill: Optional[Paint] = None
     stroke: Optional[Paint] = None
-    stroke_width: torch.Tensor = field(default_factory=lambda: torch.tensor(1.0))  # unless Path.widths
+    stroke_width: torch.Tensor = field(default_factory=lambda: arrays.scalar(1.0))  # unless Path.widths
     fill_rule: str = "nonzero"     # or "evenodd"
     linecap: str = "butt"          # butt | round | square
     linejoin: str = "miter"        # miter | round | bevel
     miter_limit: float = 4.0
-    opacity: torch.Tensor = field(default_factory=lambda: torch.tensor(1.0))
-    fill_opacity: torch.Tensor = field(default_factory=lambda: torch.tensor(1.0))
-    stroke_opacity: torch.Tensor = field(default_factory=lambda: torch.tensor(1.0))
+    opacity: torch.Tensor = field(default_factory=lambda: arrays.scalar(1.0))
+    fill_opacity: torch.Tensor = field(default_factory=lambda: arrays.scalar(1.0))
+    stroke_opacity: torch.Tensor = field(default_factory=lambda: arrays.scalar(1.0))
     transform: torch.Tensor = field(default_factory=identity)  # [3, 3] to group's space
     group: int = -1                # index into Scene.groups, -1 for the root
     source: Any = None             # id (or other handle) of the element, for write-back
@@ -364,7 +372,7 @@ def _copied(value, memo: dict):
     key = id(value)
     if key in memo:
         return memo[key]
-    if isinstance(value, torch.Tensor):
+    if arrays.is_tensor(value):
         out = value.detach().clone()
     elif isinstance(value, np.ndarray):
         out = value.copy()

@@ -4,8 +4,8 @@ from __future__ import annotations
 from collections import Counter
 
 import numpy as np
-import torch
 
+from .arrays import to_numpy
 from .model import (CUBIC, LINE, QUADRATIC, Circle, ClipPath, Ellipse, LinearGradient, Mask, Path,
                     RadialGradient, Rect, Scene, Solid)
 
@@ -30,13 +30,12 @@ def _canvas(scene: Scene) -> list[str]:
     """Size, and the user-space region the canvas shows (the viewBox when the aspect
     ratios agree), from the inverse of the view matrix."""
     lines = [f"canvas: {_num(scene.width)} x {_num(scene.height)} px"]
-    view = scene.view.detach().double()
+    view = np.asarray(to_numpy(scene.view), np.float64)
     try:
-        inv = torch.linalg.inv(view)
-    except RuntimeError:
+        inv = np.linalg.inv(view)
+    except np.linalg.LinAlgError:
         return lines + ["view: not invertible"]
-    corners = inv @ torch.tensor([[0.0, scene.width], [0.0, scene.height], [1.0, 1.0]],
-                                 dtype=torch.float64)
+    corners = inv @ np.array([[0.0, scene.width], [0.0, scene.height], [1.0, 1.0]])
     (x0, x1), (y0, y1) = corners[0].tolist(), corners[1].tolist()
     lines.append(f"viewBox: {_num(x0)} {_num(y0)} {_num(x1 - x0)} {_num(y1 - y0)}"
                  f" (the user-space region shown)")

@@ -5,9 +5,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import torch
 
 from vecfit.errors import VecfitError
+from vecfit.scene.arrays import is_tensor
 
 
 def fmt(value, decimals: int = 4) -> str:
@@ -18,7 +18,20 @@ def fmt(value, decimals: int = 4) -> str:
     s = f"{v:.{decimals}f}"
     if "." in s:
         s = s.rstrip("0").rstrip(".")
-    return "0" if s in ("-0", "") else s
+    return "0" if s == "-0" or not s else s
+
+
+def fmt_many(values, decimals: int = 4) -> list[str]:
+    """``fmt`` of every number in ``values`` (a trace writes 50,000: one check of
+    finiteness for all, then the formatting without a call per number)."""
+    a = np.asarray(values, float).ravel()
+    if not np.isfinite(a).all():
+        fmt(a[~np.isfinite(a)][0])  # raises, naming the value
+    pattern = f"%.{decimals}f"
+    out = [pattern % v for v in a.tolist()]
+    if decimals > 0:
+        out = [t.rstrip("0").rstrip(".") for t in out]
+    return ["0" if t == "-0" or not t else t for t in out]
 
 
 def hex_color(rgba) -> str:
@@ -33,7 +46,7 @@ def matrix(m) -> str:
 
 
 def finite(t) -> np.ndarray:
-    a = t.detach().cpu().double().numpy() if isinstance(t, torch.Tensor) else np.asarray(t, float)
+    a = t.detach().cpu().double().numpy() if is_tensor(t) else np.asarray(t, float)
     if not np.isfinite(a).all():
         raise VecfitError("cannot write non-finite values (NaN or infinity) to SVG")
     return a

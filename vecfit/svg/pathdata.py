@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .numbers import fmt
+from .numbers import fmt, fmt_many
 from .units import NUMBER
 
 _TOKEN = re.compile(rf"[MmZzLlHhVvCcSsQqTtAa]|{NUMBER}|[^\s,]")
@@ -292,18 +292,22 @@ def format_path_data(points, degrees, subpaths, decimals: int = 4, compact: bool
     and followed by ``Z``. Numbers have at most ``decimals`` decimals; ``compact`` leaves
     out the spaces before command letters.
     """
+    # every point formatted once, as "x y" (a trace writes 50,000 numbers)
+    numbers = fmt_many(points, decimals)
+    text = [f"{x} {y}" for x, y in zip(numbers[0::2], numbers[1::2])]
+    degrees = np.asarray(degrees).tolist()
     out, p = [], 0
     for first, count, closed in subpaths:
         start = p
-        out.append(f"M{fmt(points[p][0], decimals)} {fmt(points[p][1], decimals)}")
+        out.append("M" + text[p])
         p += 1
         for k in range(first, first + count):
             d = int(degrees[k])
             last = closed and k == first + count - 1
             if last and d == 1:
                 break
-            ends = [points[p + j] for j in range(d - 1 if last else d)] + ([points[start]] if last else [])
-            out.append(_LETTERS[d] + " ".join(f"{fmt(x, decimals)} {fmt(y, decimals)}" for x, y in ends))
+            ends = text[p:p + (d - 1 if last else d)] + ([text[start]] if last else [])
+            out.append(_LETTERS[d] + " ".join(ends))
             p += d - 1 if last else d
         if closed:
             out.append("Z")

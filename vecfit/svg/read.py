@@ -18,11 +18,10 @@ import math
 import re
 
 import numpy as np
-import torch
 
 from vecfit import limits
 from vecfit.errors import SvgError
-from vecfit.scene import BLEND_MODES, ClipPath, Filter, Group, Mask, Rect, Scene, Shape
+from vecfit.scene import BLEND_MODES, ClipPath, Filter, Group, Mask, Path, Rect, Scene, Shape, arrays
 from vecfit.scene.dashes import dash_count, dash_pattern, outline_path
 
 from .effects import func_iri, parse_filter, region, units_of
@@ -310,7 +309,7 @@ class Reader:
         if _singular(transform):
             content.shapes, content.groups = [], []  # draws nothing: lets nothing through
         elif transform is not None:
-            content.view = torch.tensor(transform, dtype=torch.float32)
+            content.view = arrays.floats(transform)
         clip = ClipPath(content=content, units=units_of(element, "clipPathUnits", "userSpaceOnUse"),
                         source=self.document.handle_of(element))
         clip.clip = self._reference(self.document.computed(element), "clip-path", "clipPath", _name(element),
@@ -331,20 +330,20 @@ class Reader:
         """The clip of a nested <svg> or <symbol> instance to its viewport (overflow
         hidden): a rect 0, 0, width, height before the viewBox's mapping."""
         lim = Limiter()  # (a viewport of 1e400 px, a viewBox of 1e-300: clamped, as numbers are)
-        rect = Shape(geometry=Rect(p_min=torch.zeros(2), p_max=lim.tensor(np.array([width, height]))),
+        rect = Shape(geometry=Rect(p_min=arrays.zeros(2), p_max=lim.tensor(np.array([width, height]))),
                      fill=solid(BLACK))
-        view = torch.eye(3) if inverse_view is None else lim.tensor(np.asarray(inverse_view))
+        view = arrays.identity() if inverse_view is None else lim.tensor(np.asarray(inverse_view))
         return ClipPath(content=Scene(width=self.width, height=self.height, shapes=[rect], view=view))
 
     def _group(self, transform, opacity, parent, element, effects=None) -> int:
         lim = Limiter()
-        m = torch.eye(3) if transform is None else lim.tensor(transform)
+        m = arrays.identity() if transform is None else lim.tensor(transform)
         if lim.clamped:
             self.skips.add("out-of-range numbers", _name(element))
         if self._in_clip:
             opacity = 1.0  # a clip path's content has no opacity
         clip, mask, filt, blend, isolate = effects or NO_EFFECTS
-        self.groups.append(Group(transform=m, opacity=torch.tensor(float(opacity)), parent=parent,
+        self.groups.append(Group(transform=m, opacity=arrays.scalar(opacity), parent=parent,
                                  source=self.document.handle_of(element), clip=clip, mask=mask, filter=filt,
                                  blend=blend, isolate=isolate))
         return len(self.groups) - 1
@@ -442,10 +441,10 @@ class Reader:
             linecap=_choice(style.get("stroke-linecap"), CAPS, "butt"),
             linejoin=JOINS.get((style.get("stroke-linejoin") or "").strip(), "miter"),
             miter_limit=_miter_limit(style.get("stroke-miterlimit")),
-            opacity=torch.tensor(parse_opacity(style.get("opacity"))),
-            fill_opacity=torch.tensor(parse_opacity(style.get("fill-opacity"))),
-            stroke_opacity=torch.tensor(parse_opacity(style.get("stroke-opacity"))),
-            transform=torch.eye(3) if transform is None else lim.tensor(transform),
+            opacity=arrays.scalar(parse_opacity(style.get("opacity"))),
+            fill_opacity=arrays.scalar(parse_opacity(style.get("fill-opacity"))),
+            stroke_opacity=arrays.scalar(parse_opacity(style.get("stroke-opacity"))),
+            transform=arrays.identity() if transform is None else lim.tensor(transform),
             group=group, source=self.document.handle_of(element),
             dash_array=dash_array, dash_offset=dash_offset,
             **dict(zip(("clip", "mask", "filter", "blend"), (effects or NO_EFFECTS)[:4])))
@@ -469,7 +468,9 @@ class Reader:
         if items == ["none"] or any(v is None for v in values) or (pattern := dash_pattern(values)) is None:
             return None, 0.0
         offset = parse_length(style.get("stroke-dashoffset"), self._diagonal())
-        outline = outline_path(geometry)
+        # (rects and ellipses become paths in torch: a NumPy reading imports it here)
+        outline = outline_path(arrays.as_torch(geometry) if arrays.making_numpy() and not isinstance(geometry, Path)
+                               else geometry)
         count = dash_count(outline, pattern, width) if outline is not None else 0.0
         if self._dash_count + count > limits.MAX_DASHES:
             self.skips.add("stroke-dasharray", name)

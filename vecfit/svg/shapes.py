@@ -10,9 +10,7 @@ from __future__ import annotations
 import math
 import re
 
-import torch
-
-from vecfit.scene import Circle, Ellipse, Path, Rect
+from vecfit.scene import Circle, Ellipse, Path, Rect, arrays
 
 from .pathdata import PathDataError, Subpath, parse_path_data, to_arrays
 from .units import clamp_array, parse_length, parse_number
@@ -27,10 +25,10 @@ class Limiter:
     def __init__(self):
         self.clamped = False
 
-    def tensor(self, values) -> torch.Tensor:
+    def tensor(self, values):
         a, changed = clamp_array(values)
         self.clamped |= changed
-        return torch.as_tensor(a, dtype=torch.float32).clone()
+        return arrays.floats(a)
 
 
 class ShapeReader:

@@ -268,3 +268,18 @@ def test_bad_images_are_refused(image):
 def test_nonsense_settings_are_refused(settings):
     with pytest.raises(VecfitError, match="trace setting"):
         trace_image(np.ones((8, 8, 4), np.float32), TraceSettings.defaults(**settings))
+
+
+def test_tracing_imports_no_torch():
+    """The tracer works in NumPy and writes SVG text: tracing an image imports no torch
+    (a second of start-up that `trace --no-refine` and the Python API need not pay)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, numpy as np\n"
+            "from vecfit.initial.tracer import trace_image\n"
+            "img = np.zeros((40, 60, 4), np.float32); img[..., 3] = 1; img[10:30, 15:45, 0] = 1\n"
+            "svg = trace_image(img).svg\n"
+            "print('<path' in svg, 'torch' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.stdout.split() == ["True", "False"], out.stdout + out.stderr

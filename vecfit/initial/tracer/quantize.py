@@ -28,21 +28,47 @@ def quantize_colors(rgb: np.ndarray, opaque: np.ndarray, colors: int, seed: int,
     k-means runs on at most `sample` opaque pixels (a seeded random subset, for speed),
     then every opaque pixel takes the nearest centre."""
     labels = np.full(opaque.shape, -1, np.int32)
-    lab = to_lab(rgb)[opaque]
-    if len(lab) == 0:
+    colours, which = distinct_colors(rgb[opaque])
+    if len(colours) == 0:
         return labels
+    colours_lab = to_lab(colours[None])[0]
+    lab = colours_lab[which]
     rng = np.random.default_rng(seed)
     data = lab if len(lab) <= sample else lab[rng.choice(len(lab), sample, replace=False)]
-    distinct = np.unique(data, axis=0)
-    if len(distinct) <= colors:
-        centres = distinct  # few colours (flat art, tiny images): each is its own cluster
+    if count_distinct(data) <= colors:
+        centres = np.unique(data, axis=0)  # few colours (flat art, tiny images): each is its own cluster
     else:
         cv2.setRNGSeed(seed)  # cv2.kmeans draws its k-means++ seeds from OpenCV's global RNG
         criteria = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 30, 0.05)
         _, _, centres = cv2.kmeans(np.ascontiguousarray(data), colors, None, criteria, attempts,
                                    cv2.KMEANS_PP_CENTERS)
-    labels[opaque] = nearest_centre(lab, centres)
+    # each distinct colour is labelled once (an emoji has a few thousand, a photo's
+    # 250,000 pixels about 100,000)
+    labels[opaque] = nearest_centre(colours_lab, centres)[which]
     return labels
+
+
+def distinct_colors(rgb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct rows of rgb [N, 3] and, for each row, the index of its own: found by
+    their 8-bit values where the colours are 8-bit ones (as read from files), else by
+    their exact float values."""
+    if len(rgb) == 0:
+        return rgb.reshape(0, 3), np.zeros(0, np.int64)
+    levels = np.rint(rgb * 255)
+    if np.array_equal((levels / 255).astype(rgb.dtype), rgb):
+        key = (levels[:, 0].astype(np.int64) << 16) | (levels[:, 1].astype(np.int64) << 8) | levels[:, 2].astype(np.int64)
+        _, first, which = np.unique(key, return_index=True, return_inverse=True)
+    else:
+        _, first, which = np.unique(np.ascontiguousarray(rgb).view(np.dtype((np.void, rgb.itemsize * 3))),
+                                    return_index=True, return_inverse=True)
+    return np.ascontiguousarray(rgb[first]), which.reshape(-1)
+
+
+def count_distinct(rows: np.ndarray) -> int:
+    """How many distinct rows a float array [N, C] has (compared as bytes: -0.0 and 0.0
+    differ, which colours converted from [0, 1] do not produce)."""
+    rows = np.ascontiguousarray(rows)
+    return len(np.unique(rows.view(np.dtype((np.void, rows.itemsize * rows.shape[1])))))
 
 
 def nearest_centre(points: np.ndarray, centres: np.ndarray, chunk: int = 1 << 16) -> np.ndarray:

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from scipy import ndimage
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
@@ -32,16 +33,31 @@ class Regions:
 
 def components(classes: np.ndarray) -> tuple[np.ndarray, int]:
     """8-connected components of each colour class (int32 [H, W], -1 stays -1), the
-    same connectivity that cv2.findContours gives the outline of a region."""
+    same connectivity that cv2.findContours gives the outline of a region; numbered class
+    by class, and within a class in raster order of their first pixel. (OpenCV numbers
+    them in an order that depends on how many threads it splits the image between, and
+    merging breaks ties by number: so the trace would depend on the machine.) Each class
+    is labelled within its bounding box: most classes of an emoji cover a small part."""
     comp = np.full(classes.shape, -1, np.int32)
     count = 0
-    for c in np.unique(classes):
-        if c < 0:
+    k = int(classes.max()) + 1 if classes.size else 0
+    for c, box in enumerate(ndimage.find_objects(classes + 1, max_label=k)):
+        if box is None:
             continue
-        mask = classes == c
-        n, cc = cv2.connectedComponents(mask.astype(np.uint8), connectivity=8, ltype=cv2.CV_32S)
-        comp[mask] = cc[mask] - 1 + count
+        mask = classes[box] == c
+        n, cc = cv2.connectedComponents(mask.view(np.uint8), connectivity=8, ltype=cv2.CV_32S)
+        view = comp[box]
+        view[mask] = cc[mask] - 1 + count
         count += n - 1
+    if count:
+        flat = comp.ravel()
+        where = np.flatnonzero(flat >= 0)
+        first = np.full(count, len(flat), np.int64)
+        np.minimum.at(first, flat[where], where)  # each component's first pixel
+        cls = classes.ravel()[first]
+        renumber = np.empty(count, np.int32)
+        renumber[np.lexsort((first, cls))] = np.arange(count, dtype=np.int32)
+        comp = np.where(comp >= 0, renumber[np.maximum(comp, 0)], -1).astype(np.int32)
     return comp, count
 
 
@@ -155,9 +171,33 @@ class _Merger:
             self.adj[a][b] = length
             self.adj[b][a] = length
         self.live = n
-        self.heap = []
-        for r in range(n):
-            self.push(r)
+        self.heap = self._first_entries(area, color * area[:, None], edges)
+        heapq.heapify(self.heap)
+
+    def _first_entries(self, area, sums, edges) -> list:
+        """Every region's first heap entry, as push makes it, for all regions at once: the
+        cost of each edge both ways in push's own float arithmetic, and each region's
+        cheapest neighbour (of equal costs the lowest index, the first that push meets:
+        adjacency lists hold neighbours in ascending order)."""
+        n = len(area)
+        best, target = np.full(n, np.inf), np.full(n, -1, np.int64)
+        if len(edges):
+            r = np.concatenate([edges[:, 0], edges[:, 1]])
+            t = np.concatenate([edges[:, 1], edges[:, 0]])
+            ar, at = area[r], area[t]
+            d = [sums[r, k] / ar - sums[t, k] / at for k in range(3)]
+            cost = ar * at / (ar + at) * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+            order = np.lexsort((t, cost, r))
+            r, t, cost = r[order], t[order], cost[order]
+            first = np.r_[True, r[1:] != r[:-1]]
+            best[r[first]], target[r[first]] = cost[first], t[first]
+        entries = []
+        for i, (c, j) in enumerate(zip(best.tolist(), target.tolist())):
+            if j < 0:
+                c = self.cost(i, -1)
+            must = self.small[i] and (j >= 0 or self.area[i] < self.min_area)
+            entries.append((0 if must else 1, c, i, 0, j, 0))
+        return entries
 
     def cost(self, r: int, t: int) -> float:
         ar, (sr, sg, sb) = self.area[r], self.sum[r]

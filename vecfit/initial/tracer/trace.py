@@ -16,7 +16,7 @@ from vecfit.errors import VecfitError
 from vecfit.svg.numbers import hex_color
 
 from .bezier import fit_outlines
-from .outlines import drawing_order, grown_mask, region_boxes, shape_outlines
+from .outlines import drawing_order, grown_masks, region_boxes, shape_outlines
 from .quantize import OPAQUE, prefilter, quantize_colors
 from .regions import build_regions, palette_colors
 from .settings import TraceResult, TraceSettings, check_settings
@@ -85,10 +85,12 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
 
     report("outline", 0.4)
     shapes, outlines, holes = [], [], []  # shapes: (region, its outlines' slice of `outlines`)
+    drawn = [i for i in order.tolist() if i != background]
+    masks = dict(zip(drawn, grown_masks(regions.labels, rank, drawn, boxes, int(s.overlap))))
     for j, i in enumerate(order):
         if i == background:
             continue
-        mask, (x0, y0) = grown_mask(regions.labels, rank, i, boxes[i], int(s.overlap))
+        mask, (x0, y0) = masks.pop(i)
         # pixels no region draws (transparent, or an isolated speck that was dropped)
         transparent = regions.labels[y0:y0 + mask.shape[0], x0:x0 + mask.shape[1]] < 0
         found, is_hole = shape_outlines(mask, transparent, (x0, y0))

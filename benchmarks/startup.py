@@ -1,0 +1,59 @@
+"""Start-up: how long the command takes to answer when it has little to do, and whether it
+imported torch (over a second of start-up by itself).
+
+    python benchmarks/startup.py [--repeats 7]
+
+Each row runs the command in a fresh process `--repeats` times and gives the median wall
+time; `import numpy` and `import torch` alone are the yardsticks (everything imports
+numpy). "torch" says whether the command's process imported it (checked by running the
+command line's main in-process, in a fresh interpreter, and looking at sys.modules).
+"""
+from __future__ import annotations
+
+import argparse
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def wall(argv: list[str], repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        subprocess.run(argv, capture_output=True, check=False)
+        times.append(time.perf_counter() - start)
+    return statistics.median(times)
+
+
+def imports_torch(args: list[str]) -> bool:
+    code = ("import sys\nfrom vecfit.cli.commands import main\n"
+            f"sys.argv = ['vecfit', *{args!r}]\n"
+            "try:\n    main()\nexcept SystemExit:\n    pass\nprint('torch' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    return out.stdout.split()[-1:] == ["True"]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=7)
+    args = ap.parse_args()
+    tiger = str(ROOT / "examples" / "tiger.svg")
+    small = str(ROOT / "tests" / "oracles" / "golden" / "caps.svg")
+    rows = [("import numpy", [sys.executable, "-c", "import numpy"], None),
+            ("import torch", [sys.executable, "-c", "import torch"], None),
+            ("vecfit --version", [sys.executable, "-m", "vecfit", "--version"], ["--version"]),
+            ("vecfit info (1 shape)", [sys.executable, "-m", "vecfit", "info", small], ["info", small]),
+            ("vecfit info tiger.svg", [sys.executable, "-m", "vecfit", "info", tiger], ["info", tiger])]
+    print(f"| command | median wall s ({args.repeats} runs) | imports torch |")
+    print("|---|---|---|")
+    for label, argv, cli in rows:
+        torch = "" if cli is None else ("yes" if imports_torch(cli) else "no")
+        print(f"| {label} | {wall(argv, args.repeats):.3f} | {torch} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
