@@ -1,9 +1,9 @@
 """vecfit beside vtracer: the same images traced by vtracer at its defaults and by `vecfit
 trace` without refinement and at each effort (quick, normal, best).
 
-    python benchmarks/vtracer.py [--rows vtracer,trace,quick,normal,best] [--emoji 8,4]
-                                 [--photos astronaut,chelsea,coffee,rocket] [--repeats 3]
-                                 [--command-rows vtracer,trace,quick] [--threads 2]
+    python benchmarks/versus_vtracer.py [--rows vtracer,trace,quick,normal,best] [--emoji 8,4]
+                                        [--photos astronaut,chelsea,coffee,rocket] [--repeats 3]
+                                        [--command-rows vtracer,trace,quick] [--threads 2]
 
 The images: Noto and fxemoji SVGs of the shared real-world corpus (../shared/realworld,
 its manifest.tsv) rendered by resvg at 512 px wide (RGBA, made here, not kept), and
@@ -18,7 +18,8 @@ own in its Python package, so ``python -c`` calling ``convert_image_to_svg_py``;
 each the median of --repeats runs for rows that take under 5 s, else one run. For vecfit's refining
 rows, "refine s" is the report's time after tracing (the optimisation and its renders),
 so a faster tracer's total can be read off as its trace time plus this.
-vtracer comes from the ``bench`` extra (pip install ".[bench]").
+vtracer comes from the ``bench`` extra (pip install ".[bench]"); this script is not called
+vtracer.py, which would shadow the package when run from benchmarks/.
 """
 from __future__ import annotations
 
