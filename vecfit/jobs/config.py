@@ -68,10 +68,9 @@ def resolve(command: str, *, preset: str | None = None, config_file=None,
     user = None if config_file is None else read_toml(config_file)
     if user is not None and "effort" in user:
         chosen = user.pop("effort")
-        if effort is None:
-            effort = chosen
-            if not isinstance(effort, str):
-                raise VecfitError(f"{config_file}: effort must be str, not {effort!r}")
+        if not isinstance(chosen, str):
+            raise VecfitError(f"{config_file}: effort must be str, not {chosen!r}")
+        effort = chosen if effort is None else effort  # an --effort option wins over the file
     effort = DEFAULT_EFFORT if effort is None else effort
     if effort not in EFFORTS:
         raise VecfitError(f"unknown effort {effort!r} (known: {', '.join(EFFORTS)})")
