@@ -17,7 +17,9 @@ own in its Python package, so ``python -c`` calling ``convert_image_to_svg_py``;
 --command-rows, as the slow rows' command time is their in-process time plus start-up),
 each the median of --repeats runs for rows that take under 5 s, else one run. For vecfit's refining
 rows, "refine s" is the report's time after tracing (the optimisation and its renders),
-so a faster tracer's total can be read off as its trace time plus this.
+so a faster tracer's total can be read off as its trace time plus this. A row NAME@vt
+runs NAME with vecfit's path budget lowered to the number of shapes vtracer wrote for that
+image (where that is fewer than vecfit's budget), for the comparison at no more paths.
 vtracer comes from the ``bench`` extra (pip install ".[bench]"); this script is not called
 vtracer.py, which would shadow the package when run from benchmarks/.
 """
@@ -39,6 +41,7 @@ from common import SHARED, resvg_rgb
 
 PHOTOS = ["astronaut", "chelsea", "coffee", "rocket"]
 ROWS = ["vtracer", "trace", "quick", "normal", "best"]
+PHOTO_PATHS = 1000  # vecfit's default budget (configs/trace.toml)
 EMOJI_PATHS = 64
 EMOJI_WIDTH = 512
 SLOW = 5.0  # seconds: rows slower than this are timed once
@@ -169,7 +172,8 @@ def measure(row: str, png: bytes, png_path: Path, paths, threads: int, repeats: 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--rows", default=",".join(ROWS), help=f"of {','.join(ROWS)}")
+    ap.add_argument("--rows", default=",".join(ROWS),
+                    help=f"of {','.join(ROWS)}, each also as NAME@vt (vtracer's number of paths)")
     ap.add_argument("--emoji", default="8,4", help="Noto and fxemoji files (0,0: none)")
     ap.add_argument("--photos", default=",".join(PHOTOS), help="skimage.data photos ('': none)")
     ap.add_argument("--repeats", type=int, default=3)
@@ -191,8 +195,15 @@ def main():
             png_path = folder / f"{name}.png"
             png_path.write_bytes(png)
             kind = "photo" if paths is None else "emoji"
+            vtracer_shapes = None
             for row in rows:
-                r = measure(row, png, png_path, paths, args.threads, args.repeats,
+                budget = paths
+                if row.endswith("@vt"):
+                    if vtracer_shapes is None:
+                        vtracer_shapes = score(run_in_process("vtracer", png, None, 1)[0], over_white(png),
+                                               folder)["shapes"]
+                    budget = min(paths or PHOTO_PATHS, vtracer_shapes)
+                r = measure(row.removesuffix("@vt"), png, png_path, budget, args.threads, args.repeats,
                             row in args.command_rows.split(","), folder)
                 summary.setdefault((kind, row), []).append(r)
                 command_s = f"{r['command_s']:.2f}" if "command_s" in r else "-"
