@@ -203,6 +203,9 @@ def optimize_options(f):
                      help="Comparison PNG (default: the output's name + .compare.png)."),
         click.option("--config", "config_file", type=click.Path(dir_okay=False),
                      help="TOML file overriding the defaults in configs/."),
+        click.option("--effort", type=click.Choice(["quick", "normal", "best"]),
+                     help="quick: a short refinement; normal: the defaults; best: longer "
+                          "(configs/: the [efforts] tables).  [default: normal]"),
         click.option("--iterations", "--iters", type=click.IntRange(min=0), help="Adam iterations."),
         click.option("--loss", type=click.Choice(["l2", "l1", "ssim", "pyramid"]), help="Image loss."),
         click.option("--mode", type=click.Choice(["mc", "analytic"]),
@@ -249,7 +252,8 @@ def _resolve_config(command, preset, config_file, options, extra=None):
         "lr": _parse_learning_rates(options["learning_rates"]),
     }, **(extra or {})}
     try:
-        return resolve(command, preset=preset, config_file=config_file, overrides=overrides)
+        return resolve(command, preset=preset, config_file=config_file, overrides=overrides,
+                       effort=options["effort"])
     except VecfitError as e:
         _echo_err(f"error: {e}")
         sys.exit(EXIT_USAGE)
@@ -440,6 +444,8 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
 @click.option("--config", "config_file", type=click.Path(dir_okay=False),
               help="TOML file overriding the defaults in configs/.")
 @click.option("--preset", help="A preset of the mode's file in configs/.")
+@click.option("--effort", type=click.Choice(["quick", "normal", "best"]),
+              help="Every image's effort (as the mode's --effort).  [default: normal]")
 @click.option("--init-dir", type=click.Path(exists=True, file_okay=False),
               help="refine, edit: the folder of the SVGs (default: IN_DIR).")
 @click.option("-j", "--jobs", type=click.IntRange(min=0), default=1, show_default=True,
@@ -454,8 +460,8 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
                    "'distributed' package; paths must be the same on the workers).")
 @click.option("--device", **DEVICE_OPTION)
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar or per-image lines.")
-def batch(in_dir, out_dir, mode, width, height, config_file, preset, init_dir, jobs, threads, resume,
-          scheduler, device, quiet):
+def batch(in_dir, out_dir, mode, width, height, config_file, preset, effort, init_dir, jobs, threads,
+          resume, scheduler, device, quiet):
     """Run refine, trace, paint or edit on every image in IN_DIR (*.png, *.jpg, *.jpeg,
     *.bmp, *.tif, *.tiff, *.webp; not recursive), or retarget on every SVG there (*.svg,
     *.svgz; --width and/or --height give the new size), writing NAME.svg, NAME.report.json and
@@ -480,7 +486,7 @@ def batch(in_dir, out_dir, mode, width, height, config_file, preset, init_dir, j
         reporter = Progress(quiet=quiet)
         try:
             result = run_batch(in_dir, out_dir, mode, config_file=config_file, preset=preset,
-                               jobs=jobs, threads=threads, resume=resume, init_dir=init_dir,
+                               effort=effort, jobs=jobs, threads=threads, resume=resume, init_dir=init_dir,
                                scheduler=scheduler, reporter=reporter, device=device,
                                width=width, height=height)
         except BatchUsageError as e:

@@ -45,16 +45,17 @@ def available_cores() -> int:
 
 
 def resolve_config(mode: str, preset: str | None = None, config_file=None, device: str | None = None,
-                   size: dict | None = None) -> dict:
+                   size: dict | None = None, effort: str | None = None) -> dict:
     """The command's settings (vecfit.jobs.config.resolve, which also checks the values, the
-    device included); BatchUsageError when they are bad. size: retarget's width / height."""
+    device included); BatchUsageError when they are bad. size: retarget's width / height;
+    effort: quick, normal or best (None: the config file's, else normal)."""
     from vecfit.jobs.config import resolve
 
     overrides = {"optimize": {"device": device}}
     if size:
         overrides["retarget"] = size
     try:
-        return resolve(mode, preset=preset, config_file=config_file, overrides=overrides)
+        return resolve(mode, preset=preset, config_file=config_file, overrides=overrides, effort=effort)
     except VecfitError as e:
         raise BatchUsageError(str(e)) from None
 
@@ -119,7 +120,7 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
               jobs: int = 1, threads: int | None = None, resume: bool = True, init_dir=None,
               scheduler: str | None = None, client=None, job: str | None = None,
               reporter=None, device: str | None = None, width: str | None = None,
-              height: str | None = None) -> BatchResult:
+              height: str | None = None, effort: str | None = None) -> BatchResult:
     """Runs ``mode`` (refine, trace, paint, edit) on every image directly in ``in_dir``, or
     retarget on every SVG there (to ``width`` and/or ``height``: pixels or a percentage), writing
     NAME.svg, NAME.report.json and NAME.compare.png per image and the summary into
@@ -133,6 +134,8 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
     mode's job function (same signature; for tests and extensions). reporter: an object
     with start(total), row(row) and finish() (see vecfit.batch.progress.Progress).
     device: where pixels are shaded (auto, cpu, cuda[:N]; default: the config's).
+    effort: every image's effort, quick, normal or best (configs/: the mode's [efforts]
+    tables; default: the config file's, else normal).
 
     Raises BatchUsageError before any work when the run cannot start."""
     started = time.time()
@@ -160,7 +163,7 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
         raise BatchUsageError("--mode retarget needs --width (and/or --height)")
     if jobs < 0 or (threads is not None and threads < 1):
         raise BatchUsageError("jobs must be >= 0 and threads >= 1")
-    config = resolve_config(mode, preset, config_file, device, size)
+    config = resolve_config(mode, preset, config_file, device, size, effort)
     if scheduler is not None and client is None:
         from .execute import connect
         try:
@@ -244,7 +247,7 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
             "scheduler": scheduler, "started_at": time.strftime("%Y-%m-%d %H:%M:%S", time.localtime(started)),
             "finished_at": time.strftime("%Y-%m-%d %H:%M:%S"), "seconds": time.time() - started,
             "interrupted": interrupted, "exit_code": result.exit_code, "counts": counts,
-            "config": config,
+            "effort": config["effort"], "config": config,
         }
         result.summary = write_all(out_dir, in_dir, meta, ordered)
     return result

@@ -151,7 +151,7 @@ def write_html(path: Path, meta: dict, rows: list[dict]) -> None:
     parts = [
         "<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
         f"<title>vecfit batch: {e(meta['in_dir'])}</title>", f"<style>{_STYLE}</style></head><body>",
-        f"<h1>vecfit batch ({e(meta['mode'])})</h1>",
+        f"<h1>vecfit batch ({e(meta['mode'])}, effort {e(str(meta.get('effort', 'normal')))})</h1>",
         f"<p>{e(meta['in_dir'])} → {e(meta['out_dir'])}, {len(rows)} images: "
         + ", ".join(f"{n} {e(s)}" for s, n in counts.items() if n)
         + f". {meta['seconds']:.1f} s, {meta['finished_at']}.</p>",

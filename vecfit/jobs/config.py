@@ -1,10 +1,13 @@
 """Settings of the optimising commands, from TOML files in configs/.
 
 Resolution, last wins: configs/refine.toml (the optimisation defaults every command starts
-from), the command's own file (configs/trace.toml, ...), a preset from that file's
-``[presets.NAME]`` tables, the user's ``--config`` file, then command-line options. Every
-key must exist in the defaults, with a value of the same type, so a typo is an error
-naming the file and the key rather than a setting silently ignored.
+from), the command's own file (configs/trace.toml, ...), the effort (``--effort
+quick|normal|best``: that file's ``[efforts.NAME]`` table; normal is the file as it is), a
+preset from that file's ``[presets.NAME]`` tables, the user's ``--config`` file, then
+command-line options. Every key must exist in the defaults, with a value of the same type,
+so a typo is an error naming the file and the key rather than a setting silently ignored.
+The resolved settings carry the effort used as their ``effort`` entry (so reports and
+batch resumes see it).
 """
 from __future__ import annotations
 
@@ -48,33 +51,55 @@ def _checked(value, expected, name: str, source: str):
     return value
 
 
+EFFORTS = ("quick", "normal", "best")
+DEFAULT_EFFORT = "normal"
+
+
 def resolve(command: str, *, preset: str | None = None, config_file=None,
-            overrides: dict | None = None) -> dict:
-    """The settings of ``command`` (refine, trace, paint, edit, retarget): defaults, its file, a preset,
-    the user's file and the overrides (a nested dict like the files), in that order."""
+            overrides: dict | None = None, effort: str | None = None) -> dict:
+    """The settings of ``command`` (refine, trace, paint, edit, retarget): defaults, its file,
+    the effort, a preset, the user's file and the overrides (a nested dict like the files), in
+    that order. ``effort`` None: the user's file's top-level ``effort``, else normal."""
     root = configs_dir()
     settings = read_toml(root / "refine.toml")
+    efforts = settings.pop("efforts", {})
     schema = copy.deepcopy(settings)
     presets: dict = {}
+    user = None if config_file is None else read_toml(config_file)
+    if user is not None and "effort" in user:
+        chosen = user.pop("effort")
+        if not isinstance(chosen, str):
+            raise VecfitError(f"{config_file}: effort must be str, not {chosen!r}")
+        effort = chosen if effort is None else effort  # an --effort option wins over the file
+    effort = DEFAULT_EFFORT if effort is None else effort
+    if effort not in EFFORTS:
+        raise VecfitError(f"unknown effort {effort!r} (known: {', '.join(EFFORTS)})")
     if command != "refine":
         own = read_toml(root / f"{command}.toml")
         presets = own.pop("presets", {})
+        efforts = own.pop("efforts", {})
         for key, value in own.items():  # the command's own tables join the schema
             if key not in schema:
                 if not isinstance(value, dict):
                     raise VecfitError(f"configs/{command}.toml: {key!r} must be inside a table")
                 schema[key] = copy.deepcopy(value)
         settings = merge(settings, own, schema, f"configs/{command}.toml")
+    if effort != DEFAULT_EFFORT:
+        if effort not in efforts:
+            raise VecfitError(f"effort {effort!r} is not defined for {command} (configs/{command}.toml "
+                              f"has no [efforts.{effort}] table)")
+        settings = merge(settings, efforts[effort], schema, f"effort {effort!r}")
     if preset is not None:
         if preset not in presets:
             known = ", ".join(sorted(presets)) or "none"
             raise VecfitError(f"unknown preset {preset!r} for {command} (known: {known})")
         settings = merge(settings, presets[preset], schema, f"preset {preset!r}")
-    if config_file is not None:
-        settings = merge(settings, read_toml(config_file), schema, str(config_file))
+    if user is not None:
+        settings = merge(settings, user, schema, str(config_file))
     if overrides:
         settings = merge(settings, _drop_none(overrides), schema, "command line")
     validate(settings)
+    settings["effort"] = effort
     return settings
 
 

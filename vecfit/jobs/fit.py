@@ -174,6 +174,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         "loss_curve": result.losses,
         "seed": opt["seed"],
         "device": opt["device"],  # what "auto" came to
+        "effort": config.get("effort", "normal"),  # quick | normal | best (configs/: [efforts])
         "config": config,
     }
     if outputs.report is not None:

@@ -199,6 +199,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
         "loss_curve": losses,
         "seed": opt["seed"],
         "device": opt["device"],
+        "effort": config.get("effort", "normal"),  # quick | normal | best (configs/: [efforts])
         "config": config,
     }
     if outputs.report is not None:
