@@ -113,8 +113,11 @@ bool any_adjoint(const double* gpix, int W, int x0, int y0, int x1, int y1) {
 // wide drew a thousand samples on each offset curve and join of every item, millions of
 // pixels away, and threw them out one by one. (Its count is 0, not the piece dropped: the
 // other pieces' random numbers, keyed by their place in the list, stay the same.)
+//
+// Each piece's box (pixel space, the whole of what its samples can reach before the
+// filter) goes to `boxes`, in the pieces' order, for allot_by_adjoint below.
 std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_, int width, int height, double R,
-                                   int threads) {
+                                   int threads, std::vector<Box>& boxes) {
     const double cap = std::ceil(density_ * 4.0 * ((double)width + height));
     auto count = [&](double len) { return clamp_to_int(std::ceil(std::min(density_ * len, cap)), 1, 1 << 30); };
     // Where samples count, a little grown (for rounding), in pixel space.
@@ -224,21 +227,25 @@ std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_, int wi
         Vec2 n = perp(seg_end_tangent(s.seg, side == 1));
         return edge(at - hw * n, at + hw * n);
     };
-    auto draw_pieces = [&](int di, std::vector<Piece>& out) {
+    // (A stroke's pieces take the draw's box, which holds its whole outline.)
+    auto draw_pieces = [&](int di, std::vector<Piece>& out, std::vector<Box>& out_boxes) {
         const PreparedDraw& d = sc_.draws[di];
         if (!valid(d.box)) return;
+        const size_t before = out.size();
         if (d.is_ellipse) {
             double r = std::max(d.ellipse.r0, d.ellipse.r1) + (d.kind == DRAW_STROKE ? d.half_width : 0);
             double len = 2 * M_PI * r * (d.kind == DRAW_STROKE ? d.metric_scale : 1.0);
             int n = reaches(d.box) ? count(len) : 0;
             if (d.kind == DRAW_FILL) out.push_back({Piece::ELLIPSE, di, 0, 0, n});
             else for (int s = -1; s <= 1; s += 2) out.push_back({Piece::ELLIPSE, di, 0, s, n});
+            out_boxes.resize(out.size(), d.box);
             return;
         }
         for (int k = 0; k < d.n_items; ++k) {
             if (d.kind == DRAW_FILL) {
                 const PreparedSegment& seg = sc_.fill_items[d.first_item + k];
                 out.push_back({Piece::FILL_SEGMENT, di, k, 0, reaches(seg.box) ? count(polygon_length(seg.seg)) : 0});
+                out_boxes.push_back(seg.box);
             } else {
                 // Offset curves are about as long as the curve plus hw times its turning.
                 const StrokeSegment& s = sc_.stroke_items[d.first_item + k];
@@ -259,6 +266,7 @@ std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_, int wi
                     out.push_back({Piece::END, di, k, 1, end_reaches(d, s, 1) ? count(end_len(s.end.hw)) : 0});
             }
         }
+        out_boxes.resize(before + (out.size() - before), d.box);
     };
     // Runs of draws on the threads, joined in draw order: the serial list exactly.
     const int n_draws = (int)sc_.draws.size();
@@ -266,16 +274,91 @@ std::vector<Piece> boundary_pieces(const SceneView& sc_, double density_, int wi
     const std::vector<int> bounds = draw_runs(sc_.draws.data(), n_draws, threads);
     const int n_runs = (int)bounds.size() - 1;
     std::vector<std::vector<Piece>> runs(n_runs);
+    std::vector<std::vector<Box>> run_boxes(n_runs);
     ThreadPool::instance().parallel_for(n_runs, threads, [&](int r, int) {
-        for (int di = bounds[r]; di < bounds[r + 1]; ++di) draw_pieces(di, runs[r]);
+        for (int di = bounds[r]; di < bounds[r + 1]; ++di) draw_pieces(di, runs[r], run_boxes[r]);
     });
-    if (n_runs == 1) return std::move(runs[0]);
+    if (n_runs == 1) {
+        boxes = std::move(run_boxes[0]);
+        return std::move(runs[0]);
+    }
     std::vector<Piece> out;
     size_t n = 0;
     for (const auto& run : runs) n += run.size();
     out.reserve(n);
-    for (const auto& run : runs) out.insert(out.end(), run.begin(), run.end());
+    boxes.clear();
+    boxes.reserve(n);
+    for (int r = 0; r < n_runs; ++r) {
+        out.insert(out.end(), runs[r].begin(), runs[r].end());
+        boxes.insert(boxes.end(), run_boxes[r].begin(), run_boxes[r].end());
+    }
     return out;
+}
+
+// A boundary budget (RenderOptions::boundary_budget, samples per pixel of the image): where
+// the pieces ask for more samples than budget x W x H, the samples are allotted instead in
+// proportion to each piece's asked count times the mean pixel adjoint (|dL/dcolour|,
+// summed over the channels) of the tiles its box reaches, grown by the filter: the
+// boundary term is an integral of the adjoint times the jump along the boundary, so
+// where the adjoints are small its samples add little but noise. A dense trace's
+// boundary is longer than its image is wide many times over, and most of it lies where
+// the fit is already good.
+//
+// Unbiased: a piece that gets n >= 1 samples is still sampled in n strata, each weighted
+// by its length / n; one that would get e < 1 is drawn by lot with chance e (keyed by the
+// seed and the piece) and its sample then counts 1 / e (Piece::scale). Only pieces whose
+// whole reach has zero adjoint get none for certain, and they would add exactly 0.
+void allot_by_adjoint(std::vector<Piece>& pieces, const std::vector<Box>& boxes, const std::vector<double>& gpix,
+                      int W, int H, double R, double budget, uint64_t seed) {
+    if (budget <= 0) return;
+    const double total_budget = budget * (double)W * H;
+    double asked = 0;
+    for (const Piece& pc : pieces) asked += pc.count;
+    if (asked <= total_budget) return;
+    // Summed-area table of the adjoint's magnitude per tile.
+    const int nx = (W + TILE - 1) / TILE, ny = (H + TILE - 1) / TILE;
+    std::vector<double> sat((size_t)(nx + 1) * (ny + 1), 0.0);
+    for (int ty = 0; ty < ny; ++ty)
+        for (int tx = 0; tx < nx; ++tx) {
+            double m = 0;
+            for (int y = ty * TILE, y1 = std::min(H, y + TILE); y < y1; ++y)
+                for (int x = tx * TILE, x1 = std::min(W, x + TILE); x < x1; ++x) {
+                    const double* gp = gpix.data() + 4 * ((size_t)y * W + x);
+                    m += std::fabs(gp[0]) + std::fabs(gp[1]) + std::fabs(gp[2]) + std::fabs(gp[3]);
+                }
+            sat[(size_t)(ty + 1) * (nx + 1) + tx + 1] = m + sat[(size_t)ty * (nx + 1) + tx + 1] +
+                                                       sat[(size_t)(ty + 1) * (nx + 1) + tx] -
+                                                       sat[(size_t)ty * (nx + 1) + tx];
+        }
+    // Mean adjoint per pixel over the tiles a box reaches (grown by the filter and a pixel).
+    auto importance = [&](const Box& b) {
+        if (!valid(b)) return 0.0;
+        const double g = R + 1;
+        int x0 = clamp_to_int(std::floor((b.x0 - g) / TILE), 0, nx), x1 = clamp_to_int(std::floor((b.x1 + g) / TILE) + 1, 0, nx);
+        int y0 = clamp_to_int(std::floor((b.y0 - g) / TILE), 0, ny), y1 = clamp_to_int(std::floor((b.y1 + g) / TILE) + 1, 0, ny);
+        if (x1 <= x0 || y1 <= y0) return 0.0;
+        double m = sat[(size_t)y1 * (nx + 1) + x1] - sat[(size_t)y0 * (nx + 1) + x1] - sat[(size_t)y1 * (nx + 1) + x0] +
+                   sat[(size_t)y0 * (nx + 1) + x0];
+        return std::max(0.0, m) / ((double)(x1 - x0) * (y1 - y0) * TILE * TILE);
+    };
+    std::vector<double> want(pieces.size());
+    double sum = 0;
+    for (size_t k = 0; k < pieces.size(); ++k) sum += (want[k] = pieces[k].count > 0 ? pieces[k].count * importance(boxes[k]) : 0);
+    if (!(sum > 0)) return;  // (no adjoint anywhere: every sample would add 0; leave them)
+    for (size_t k = 0; k < pieces.size(); ++k) {
+        Piece& pc = pieces[k];
+        if (pc.count == 0) continue;
+        // (never more than asked: the budget moves samples away from where they add little)
+        const double e = std::min((double)pc.count, total_budget * want[k] / sum);
+        if (e >= 1) {
+            pc.count = (int)std::ceil(e);
+            continue;
+        }
+        double u, unused;
+        sample_uniform2(seed ^ 0x5eedb0d9e7a11077ull, (uint64_t)k, 0, u, unused);
+        pc.count = e > 0 && u < e ? 1 : 0;
+        pc.scale = pc.count ? 1 / e : 1;
+    }
 }
 
 
@@ -292,7 +375,11 @@ BackwardPlan plan_backward(const PreparedScene& prepared, const RenderOptions& o
                           o.threads);
     pixel_adjoints(o, image, d_image, plan.gpix);
     const SceneView sc = prepared.view();
-    if (o.mode == MODE_MC) plan.pieces = boundary_pieces(sc, boundary_density, o.width, o.height, R, o.threads);
+    if (o.mode == MODE_MC) {
+        std::vector<Box> boxes;
+        plan.pieces = boundary_pieces(sc, boundary_density, o.width, o.height, R, o.threads, boxes);
+        allot_by_adjoint(plan.pieces, boxes, plan.gpix, o.width, o.height, R, o.boundary_budget, o.seed);
+    }
     BoundaryContext& bc = plan.boundary;
     bc.width = o.width;
     bc.height = o.height;

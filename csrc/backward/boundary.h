@@ -36,10 +36,13 @@ struct BoundarySample {
     }
 };
 
-// A boundary piece: what to sample and how many samples.
+// A boundary piece: what to sample, how many samples, and what each counts for beyond its
+// share of the piece's length (1, or 1 / the chance that a piece kept by lot was drawn:
+// see boundary_pieces in backward.cpp).
 struct Piece {
     enum Kind { FILL_SEGMENT, ELLIPSE, OFFSET, END } kind;
     int draw, item, side, count;
+    double scale = 1;
 };
 
 VF_HD double polygon_length(const Segment& s) {

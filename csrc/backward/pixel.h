@@ -220,7 +220,7 @@ VF_HD void boundary_sample(const SceneView& sc, const TileView& bins, const Boun
             const double* gp = bc.gpix + 4 * ((size_t)py * W + px);
             total += w * (gp[0] * delta[0] + gp[1] * delta[1] + gp[2] * delta[2] + gp[3] * delta[3]);
         }
-    total *= bs.weight;
+    total *= bs.weight * pc.scale;
     if (total == 0) return;
     for (int i = 0; i < bs.nv; ++i) bs.v[i].target += total * bs.v[i].value;
 }

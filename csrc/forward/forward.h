@@ -22,6 +22,11 @@ struct RenderOptions {
     // Monte Carlo backward only: how many of a pixel's samples x samples the interior term
     // revisits (0: all). Fewer, chosen at random and weighted up, keep it unbiased.
     int interior_samples = 0;
+    // Monte Carlo backward only: at most about this many boundary samples per pixel of the
+    // image in all (0: no bound). Past it the samples go to the boundary pieces by their
+    // length times the pixel adjoints near them (backward.cpp, boundary_pieces), so a
+    // dense scene's boundary term costs what its pixels cost, not what its outlines do.
+    double boundary_budget = 0;
     bool brute_force = false;   // test every item of every draw (a check of the tiles)
     bool has_background = false;
     double background[4] = {0, 0, 0, 0};  // straight RGBA

@@ -6,6 +6,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <initializer_list>
 #include <memory>
 #include <stdexcept>
@@ -122,10 +123,12 @@ const char* filter_name(int filter) { return filter >= 0 && filter < 5 ? FILTER_
 // vecfit._core.RenderOptions(...): the options of every pass, checked once here.
 RenderOptions make_options(int width, int height, int samples, const std::string& mode, const std::string& filter,
                            double filter_radius, uint64_t seed, int threads, py::object background,
-                           int interior_samples, bool brute_force, bool premultiplied) {
+                           int interior_samples, bool brute_force, bool premultiplied, double boundary_budget) {
     if (width <= 0 || height <= 0) throw std::invalid_argument("width and height must be positive");
     if (samples <= 0) throw std::invalid_argument("samples must be positive");
     if (interior_samples < 0) throw std::invalid_argument("interior_samples must be >= 0");
+    if (!(boundary_budget >= 0) || !std::isfinite(boundary_budget))
+        throw std::invalid_argument("boundary_budget must be a finite number >= 0");
     RenderOptions o;
     o.width = width;
     o.height = height;
@@ -138,6 +141,7 @@ RenderOptions make_options(int width, int height, int samples, const std::string
     o.interior_samples = interior_samples;
     o.brute_force = brute_force;
     o.premultiplied = premultiplied;
+    o.boundary_budget = boundary_budget;
     if (!background.is_none()) {
         auto bg = background.cast<std::vector<double>>();
         if (bg.size() != 4) throw std::invalid_argument("background must be 4 numbers (RGBA)");
@@ -252,7 +256,7 @@ py::dict footprint(const py::dict& scene, const RenderOptions& options) {
 // The scene at n points (pixel space, [n, 2]) in the analytical mode with kernel radius
 // filter_radius: [n, 4] straight RGBA (pydiffvg's eval_positions).
 RenderOptions points_options(double filter_radius, int threads) {
-    return make_options(1, 1, 1, "analytic", "tent", filter_radius, 0, threads, py::none(), 0, false, false);
+    return make_options(1, 1, 1, "analytic", "tent", filter_radius, 0, threads, py::none(), 0, false, false, 0.0);
 }
 
 const double* points_of(const Array<double>& positions, int& n) {
@@ -376,11 +380,12 @@ PYBIND11_MODULE(_core, m) {
                               "filter and radius, seed, threads (0: all), background (RGBA or None), the interior "
                               "samples the Monte Carlo backward pass revisits (0: all), brute_force (every draw at "
                               "every sample: a check of the tiles), premultiplied (the image premultiplied, not "
-                              "straight)")
+                              "straight), boundary_budget (the Monte Carlo backward's boundary samples per pixel of the "
+                              "image at most, allotted by the pixel adjoints; 0: no bound)")
         .def(py::init(&make_options), py::kw_only(), py::arg("width"), py::arg("height"), py::arg("samples") = 2,
              py::arg("mode") = "mc", py::arg("filter") = "box", py::arg("filter_radius") = 0.5, py::arg("seed") = 0,
              py::arg("threads") = 0, py::arg("background") = py::none(), py::arg("interior_samples") = 0,
-             py::arg("brute_force") = false, py::arg("premultiplied") = false)
+             py::arg("brute_force") = false, py::arg("premultiplied") = false, py::arg("boundary_budget") = 0.0)
         .def_readonly("width", &RenderOptions::width)
         .def_readonly("height", &RenderOptions::height)
         .def_readonly("samples", &RenderOptions::samples)
@@ -392,6 +397,7 @@ PYBIND11_MODULE(_core, m) {
         .def_readonly("interior_samples", &RenderOptions::interior_samples)
         .def_readonly("brute_force", &RenderOptions::brute_force)
         .def_readonly("premultiplied", &RenderOptions::premultiplied)
+        .def_readonly("boundary_budget", &RenderOptions::boundary_budget)
         .def_property_readonly("background", [](const RenderOptions& o) -> py::object {
             if (!o.has_background) return py::none();
             return py::make_tuple(o.background[0], o.background[1], o.background[2], o.background[3]);

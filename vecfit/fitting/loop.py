@@ -41,6 +41,10 @@ MIN_COARSE_SIDE = 32  # and a target this small at half size is cheap enough at 
 # Pack the scene once per size and refresh only its floats (renderer/persistent.py); off
 # packs it on every iteration (tests compare the two).
 PERSISTENT_PACK = True
+# The Monte Carlo backward's boundary samples per pixel of the image at most: a dense trace's
+# outlines are several times as long as its image is wide, and past this budget the samples
+# go where the pixel adjoints are (RenderOptions.boundary_budget; still unbiased).
+BOUNDARY_BUDGET = 2.0
 
 PARAMETER_KINDS = ("points", "colors", "stroke_widths", "opacities", "radii", "gradient_points",
                    "gradient_radii", "stop_offsets", "transforms")
@@ -280,7 +284,8 @@ class _Fit:
             image = render(self.scene, w, h, samples=settings.samples, mode=settings.mode,
                            seed=settings.seed + iteration, background=self.target.background,
                            threads=settings.threads, boundary_samples=settings.boundary_samples,
-                           interior_samples=settings.interior_samples, device=self.device,
+                           interior_samples=settings.interior_samples, boundary_budget=BOUNDARY_BUDGET,
+                           device=self.device,
                            packed=self.packed(w, h))
             self.image = image.detach()
             loss = at.loss(self.loss_fn, settings.loss, at.rendered(image), goal)

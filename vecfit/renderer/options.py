@@ -20,7 +20,9 @@ class RenderOptions:
     seed; threads (0: all cores); background: None or straight RGBA; interior_samples:
     of the N x N, those the Monte Carlo backward pass revisits (0: all); brute_force:
     every draw tested at every sample (a check of the tiles, for tests); premultiplied:
-    the image as premultiplied RGBA (the layers of renderer/layers.py)."""
+    the image as premultiplied RGBA (the layers of renderer/layers.py); boundary_budget:
+    the Monte Carlo backward's boundary samples per pixel of the image at most (0: no
+    bound), allotted by the pixel adjoints."""
     width: int
     height: int
     samples: int = 2
@@ -33,11 +35,14 @@ class RenderOptions:
     interior_samples: int = 0
     brute_force: bool = False
     premultiplied: bool = False
+    boundary_budget: float = 0.0
 
     def __post_init__(self):
         check_options(self.samples, self.mode, self.filter, self.filter_radius)
         if self.interior_samples < 0:
             raise VecfitError("interior_samples must be 0 or more")
+        if not (math.isfinite(self.boundary_budget) and self.boundary_budget >= 0):
+            raise VecfitError(f"boundary_budget must be a number >= 0, not {self.boundary_budget}")
 
     def core(self) -> "_core.RenderOptions":
         """The core's struct."""
@@ -47,7 +52,7 @@ class RenderOptions:
             filter=self.filter, filter_radius=float(self.filter_radius), seed=int(self.seed),
             threads=int(self.threads or 0), background=None if bg is None else [float(v) for v in bg],
             interior_samples=int(self.interior_samples), brute_force=bool(self.brute_force),
-            premultiplied=bool(self.premultiplied))
+            premultiplied=bool(self.premultiplied), boundary_budget=float(self.boundary_budget))
 
 
 def check_options(samples, mode: str, filter: str, filter_radius: float) -> None:

@@ -111,8 +111,8 @@ class _Render(torch.autograd.Function):
 def render(scene: Scene, width: int | None = None, height: int | None = None, *,
            samples: int = 2, mode: str = "mc", filter: str = "box", filter_radius: float = 0.5,
            seed: int = 0, background=None, threads: int | None = None, boundary_samples: float = 2.0,
-           interior_samples: int = 0, device: str = "cpu", packed: tuple | None = None,
-           _brute_force: bool = False, _gpu_lists: bool = False, _premultiplied: bool = False) -> torch.Tensor:
+           interior_samples: int = 0, boundary_budget: float = 0.0, device: str = "cpu",
+           packed: tuple | None = None, _brute_force: bool = False, _gpu_lists: bool = False, _premultiplied: bool = False) -> torch.Tensor:
     """Render ``scene`` into an [H, W, 4] float tensor of straight RGBA.
 
     samples: N means N x N stratified samples per pixel (jittered in "mc" mode, at the
@@ -124,7 +124,9 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     the backward pass samples the boundaries (``boundary_samples`` points per pixel of
     boundary length, same seed) and revisits ``interior_samples`` of each pixel's N x N
     samples for the colours' (interior) term, a random run weighted up (0: all of them);
-    in "analytic" mode it differentiates the prefilter.
+    ``boundary_budget`` (> 0) bounds the boundary samples at that many per pixel of the
+    image, allotted by the pixel adjoints near each boundary, still unbiased (0: no bound).
+    In "analytic" mode the backward pass differentiates the prefilter.
 
     device: where the pixels are shaded: "cpu", "cuda" or "cuda:N" (needs a core built
     with VECFIT_CUDA=1; see vecfit.has_cuda()), or "auto" (a GPU when there is one). The
@@ -148,12 +150,13 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
             layer_seed = (int(seed) + 1_000_003 * number) % (1 << 62)
             return render(sub, samples=samples, mode=mode, filter=filter, filter_radius=filter_radius, seed=layer_seed,
                           threads=threads, boundary_samples=boundary_samples, interior_samples=interior_samples,
-                          device=device, _brute_force=_brute_force, _gpu_lists=_gpu_lists, _premultiplied=True)
+                          boundary_budget=boundary_budget, device=device, _brute_force=_brute_force, _gpu_lists=_gpu_lists, _premultiplied=True)
         return render_layered(scene, width, height, draw, background_rgba(background))
     options = RenderOptions(width, height, samples=int(samples), mode=mode, filter=filter,
                             filter_radius=float(filter_radius), seed=int(seed), threads=int(threads or 0),
                             background=background_rgba(background), interior_samples=int(interior_samples),
-                            brute_force=bool(_brute_force), premultiplied=bool(_premultiplied))
+                            brute_force=bool(_brute_force), premultiplied=bool(_premultiplied),
+                            boundary_budget=float(boundary_budget))
     if packed is None:
         structure, floats = packed_for_core(scene, width, height)
     else:
