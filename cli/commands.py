@@ -53,8 +53,9 @@ def _import_torch_holding_ctrl_c() -> None:
         raise KeyboardInterrupt
 
 
-# Commands that may run without torch: they import it themselves where they need it.
-_WITHOUT_TORCH = {"info"}
+# Commands that may run without torch: they import it themselves where they need it
+# (trace when it refines, once its settings are known).
+_WITHOUT_TORCH = {"info", "trace"}
 
 
 class _Main(click.Group):
@@ -364,8 +365,12 @@ def trace(target, preset, paths, colors, min_area, tolerance, refine, output, re
 
     if not refine:
         options["iterations"] = 0  # the trace written as it is
+    else:
+        _import_torch_holding_ctrl_c()  # (the settings' checks import it too)
     config = _resolve_config("trace", preset, config_file, options, extra={"trace": {
         "paths": paths, "colors": colors, "min_area": min_area, "tolerance": tolerance}})
+    if config["optimize"]["iterations"] > 0:
+        _import_torch_holding_ctrl_c()  # (a trace written as it is needs no torch)
     inputs = Inputs(image=target)
     _run_job("trace", inputs, config, Outputs.beside(inputs.main, output, report, comparison), quiet)
 

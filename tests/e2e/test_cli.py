@@ -124,3 +124,25 @@ def test_info_runs_without_torch(name, tmp_path):
     output, torch_imported = _modules_after("info", path)
     assert "shapes:" in output and "Traceback" not in output, output
     assert not torch_imported, output
+
+
+def test_trace_without_refining_runs_without_torch(tmp_path):
+    """`vecfit trace --no-refine` renders and writes the trace from NumPy arrays (no torch),
+    and writes what the Python API writes for optimize.iterations 0."""
+    yy, xx = np.mgrid[:64, :48]
+    image = np.zeros((64, 48, 3), np.uint8)
+    image[...] = (240, 230, 200)
+    image[(yy - 30) ** 2 + (xx - 22) ** 2 < 15 ** 2] = (200, 30, 40)
+    image[5:20, 30:44] = (20, 60, 200)
+    png = tmp_path / "blobs.png"
+    Image.fromarray(image).save(png)
+    output, torch_imported = _modules_after("trace", png, "--no-refine", "-o", tmp_path / "cli.svg")
+    assert "Traceback" not in output and "0 iterations" in output, output
+    assert not torch_imported, output
+    import json
+
+    import vecfit
+    svg, report = vecfit.trace(image, settings={"optimize": {"iterations": 0}})
+    assert svg == (tmp_path / "cli.svg").read_text()
+    written = json.loads((tmp_path / "cli.report.json").read_text())
+    assert written["optimized"] == report["optimized"] and report["optimized"]["psnr"] > 25

@@ -106,12 +106,15 @@ def resolve(command: str, *, preset: str | None = None, config_file=None,
 def validate(settings: dict) -> None:
     """Checks the values, not just the keys and types: a bad background, loss, rate, trace
     or paint setting is refused here, before any work starts (VecfitError)."""
-    from vecfit.fitting.loop import Settings
     from vecfit.io.colors import fitting_background
 
     if settings["optimize"]["background"].strip().lower() != "auto":
         fitting_background(settings["optimize"]["background"])
-    Settings.from_config(settings["optimize"])
+    # (the loop's settings are checked where it will run: their module imports torch, which
+    # a run of 0 iterations, e.g. `trace --no-refine`, never needs)
+    if settings["optimize"]["iterations"] != 0:
+        from vecfit.fitting.loop import Settings
+        Settings.from_config(settings["optimize"])
     seed = settings["optimize"]["seed"]
     if "trace" in settings:
         from vecfit.initial.tracer import TraceSettings

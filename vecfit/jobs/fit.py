@@ -6,21 +6,21 @@ from __future__ import annotations
 import math
 import time
 import warnings
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import torch
 
 from vecfit import __version__
 from vecfit.errors import VecfitError
-from vecfit.fitting.loop import Settings, Target, optimize
 from vecfit.fitting.metrics import compare, to_rgb
 from vecfit.io.colors import fitting_background
 from vecfit.io.images import downscaled, image_rgba
 from vecfit.io.report import save_comparison, save_report
 from vecfit.renderer import device as devices
-from vecfit.renderer.raster import render
+from vecfit.renderer.forward import render_numpy
 from vecfit.scene import Scene
+from vecfit.scene.arrays import is_tensor, to_numpy
 from vecfit.svg.numbers import hex_color
 from vecfit.svg.document import SvgDocument
 from vecfit.svg.read import read_svg, scene_of
@@ -98,11 +98,43 @@ def generated_scene(document: SvgDocument) -> Scene:
 
 # --------------------------------------------------------------------------- run
 
-def _render_full(scene, w, h, config) -> torch.Tensor:
-    """The scene at w x h pixels, without background (straight RGBA)."""
+def _render_full(scene, w, h, config):
+    """The scene at w x h pixels, without background (straight RGBA): a tensor, or a NumPy
+    array for a Scene of NumPy arrays."""
+    if not is_tensor(scene.view):  # a Scene of NumPy arrays (nothing to optimise): no torch
+        return render_numpy(scene, w, h, samples=config["eval_samples"], seed=config["seed"],
+                            threads=config["threads"], device=config["device"])
+    import torch
+    from vecfit.renderer.raster import render
     with torch.no_grad():
         return render(scene, w, h, samples=config["eval_samples"], seed=config["seed"],
                       threads=config["threads"], device=config["device"])
+
+
+@dataclass
+class _NotOptimised:
+    """What the report takes from the loop's Result (vecfit.fitting.loop) for a Scene of
+    NumPy arrays, written as it is (optimize.iterations 0): the loop, and torch, never run."""
+    parameters: dict
+    losses: list = field(default_factory=list)
+    iterations: int = 0
+    coarse_iterations: int = 0
+    interrupted: bool = False
+    skipped_steps: int = 0
+    seconds: float = 0.0
+    iteration_seconds: list = field(default_factory=list)
+
+
+def _not_optimised(scene: Scene, opt: dict) -> _NotOptimised:
+    """The counts the loop would report for 0 iterations (vecfit.fitting.rates.parameter_kinds:
+    the kinds with a positive rate and tensors), and its refusal of a scene without any."""
+    if opt["iterations"] != 0:
+        raise VecfitError("a Scene of NumPy arrays cannot be optimised (read it with tensors)")
+    counts = {name: sum(int(np.size(t)) for t in tensors) for name, tensors in scene.parameters().items()
+              if float(opt["lr"].get(name, 0.0)) > 0 and tensors}
+    if not counts:
+        raise VecfitError("nothing to optimise: the scene has no parameters with a learning rate above 0")
+    return _NotOptimised(parameters=counts)
 
 
 def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, config: dict, outputs: Outputs,
@@ -119,12 +151,10 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     outputs.forget_report()
     # "auto" settled once, for the loop, the full-size renders and the report alike
     opt = {**config["optimize"], "device": devices.device_name(devices.resolve(config["optimize"]["device"]))}
-    settings = Settings.from_config(opt)
     background = background_for(target, opt["background"])
     h, w = target.shape[:2]
     small = downscaled(target, opt["max_size"])
     sh, sw = small.shape[:2]
-    goal = Target(torch.from_numpy(small), background)
     # Measured at the optimised size: a 12-megapixel photo's full-size renders, SSIM and
     # comparison took a minute and 3 GB around a loop of seconds (--max-size 0: full size).
     target_rgb = to_rgb(small, background)  # (metrics of a transparent target: over white)
@@ -132,12 +162,20 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     # Rendered bare and composited here (the same arithmetic as the core's background):
     # the alpha then also says whether the shapes cover the canvas.
     initial_image = _render_full(scene, sw, sh, opt)
-    initial_rgb = to_rgb(initial_image.numpy(), background)
+    initial_rgb = to_rgb(to_numpy(initial_image), background)
     initial = compare(initial_rgb, target_rgb)
-    progress.start(settings.iterations)
-    result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
+    if is_tensor(scene.view):
+        import torch
+        from vecfit.fitting.loop import Settings, Target, optimize
+        settings = Settings.from_config(opt)
+        progress.start(settings.iterations)
+        result = optimize(scene, Target(torch.from_numpy(small), background), settings, progress=progress,
+                          hooks=hooks, keep_alpha=keep_alpha)
+    else:
+        progress.start(0)
+        result = _not_optimised(scene, opt)
     final_image = initial_image if result.iterations == 0 else _render_full(scene, sw, sh, opt)
-    final_rgb = to_rgb(final_image.numpy(), background)
+    final_rgb = to_rgb(to_numpy(final_image), background)
     final = compare(final_rgb, target_rgb)
     if not all(math.isfinite(final[k]) or (k == "psnr" and final["mse"] == 0) for k in final):
         raise VecfitError(f"the optimised image has non-finite values ({final}); nothing written")
@@ -170,7 +208,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
                     "iterations": [round(t, 4) for t in result.iteration_seconds]},
         "shapes": len(scene.shapes),
         "parameters": {**result.parameters, "total": sum(result.parameters.values())},
-        "loss": settings.loss,
+        "loss": opt["loss"],
         "loss_curve": result.losses,
         "seed": opt["seed"],
         "device": opt["device"],  # what "auto" came to

@@ -2,9 +2,12 @@
 it with the same loop as `vecfit refine` (vecfit.jobs.fit.fit_and_write)."""
 from __future__ import annotations
 
+import contextlib
+
 from vecfit.errors import VecfitError
 from vecfit.initial.tracer import TraceSettings, trace_image
 from vecfit.scene import Rect, Solid
+from vecfit.scene.arrays import numpy_arrays
 
 from .config import settings_of
 from .fit import fit_and_write, generated_scene, load_target
@@ -23,7 +26,9 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     traced = trace_image(target, settings)
     progress.status(f"traced: {traced.paths} paths, {traced.segments} segments, {traced.colors} colours "
                     f"in {traced.seconds:.1f} s")
-    scene = generated_scene(traced.document)
+    # Written as it is, the trace is read as NumPy: rendered and written without torch.
+    with numpy_arrays() if config["optimize"]["iterations"] == 0 else contextlib.nullcontext():
+        scene = generated_scene(traced.document)
     if not scene.shapes:
         raise VecfitError(f"{target_path}: nothing to trace (the image is fully transparent)")
     # The tracer's backdrop (an opaque rect past the canvas's edges) stays opaque, so the

@@ -3,24 +3,28 @@
 Geometry is mapped to pixel space here, with torch operations, so that gradients of
 transforms, rect corners, circle radii and gradient geometry follow from autograd once
 the core returns gradients of the flat float arrays. Integer tables (structure) are numpy.
+A Scene of NumPy arrays (vecfit.scene.arrays.numpy_arrays) packs into NumPy float
+arrays by the same code, without torch: the operations come from vecfit.scene.ops.
 
 The layout of every table (enums, row widths) is the core's own (layout.py, from
 csrc/scene/scene.h).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
-import torch
 
 from vecfit import limits as _limits
 from vecfit.errors import VecfitError, VecfitWarning
 from vecfit.scene import Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect, Scene, Shape, Solid
 from vecfit.scene.dashes import dash_path, dash_pattern, outline_path
 from vecfit.scene.geometry import affine_apply, local_bbox, rect_as_path, value
+from vecfit.scene.arrays import as_torch, is_tensor, to_numpy
+from vecfit.scene.ops import ops_for
 from vecfit.scene.placement import canvas_matrix, group_matrices, stacked_shape_matrices
 
 from .layout import (CAPS, COLUMNS, DRAW_FILL, DRAW_STROKE, FILL_RULES, JOINS, PAINT_LINEAR,
@@ -29,7 +33,8 @@ from .layout import (CAPS, COLUMNS, DRAW_FILL, DRAW_STROKE, FILL_RULES, JOINS, P
 
 @dataclass
 class Packed:
-    """The core's input arrays. Float arrays are torch tensors (differentiable)."""
+    """The core's input arrays. Float arrays are torch tensors (differentiable), or NumPy
+    arrays for a Scene of NumPy arrays."""
     points: list = field(default_factory=list)        # torch [n, 2] chunks
     point_widths: list = field(default_factory=list)  # torch [n] chunks (empty: no draw has them)
     segments: list = field(default_factory=list)      # int arrays [k, 5]
@@ -43,16 +48,20 @@ class Packed:
     stop_offsets: list = field(default_factory=list)  # torch [k]
     stop_colors: list = field(default_factory=list)   # torch [k, 4]
     layer_parents: list = field(default_factory=lambda: [-1])
-    layer_opacity: list = field(default_factory=lambda: [torch.tensor(1.0)])
+    layer_opacity: list = field(default_factory=lambda: [1.0])
     n_points: int = 0
     n_stops: int = 0
+    ops: object = None  # vecfit.scene.ops: the float arrays' kind
 
     def arrays(self) -> dict:
-        """Contiguous arrays for the core: float32 torch tensors and int32 numpy arrays."""
+        """Contiguous arrays for the core: float32 torch tensors (or NumPy arrays) and
+        int32 numpy arrays."""
+        ops = self.ops
+
         def cat(chunks, width):
             if not chunks:
-                return torch.zeros((0, width), dtype=torch.float32)
-            return torch.cat([c.reshape(-1, width).to(torch.float32) for c in chunks])
+                return ops.zeros((0, width))
+            return ops.cat([ops.f32(c.reshape(-1, width)) for c in chunks])
 
         def ints(rows, width):
             return np.asarray(rows, dtype=np.int32).reshape(-1, width)
@@ -72,8 +81,7 @@ class Packed:
             "stop_offsets": cat(self.stop_offsets, COLUMNS["stop_offsets"]).reshape(-1),
             "stop_colors": cat(self.stop_colors, COLUMNS["stop_colors"]),
             "layer_parents": np.asarray(self.layer_parents, dtype=np.int32),
-            "layer_opacity": torch.stack([torch.as_tensor(o, dtype=torch.float32).reshape(())
-                                          for o in self.layer_opacity]),
+            "layer_opacity": ops.stack([ops.f32(o).reshape(()) for o in self.layer_opacity]),
         }
 
 
@@ -85,9 +93,10 @@ class Packer:
     def __init__(self, scene: Scene, width: int, height: int, provenance=None):
         self.scene = scene
         self.provenance = provenance
-        self.out = Packed()
+        self.ops = ops_for(scene.view)
+        self.out = Packed(ops=self.ops)
         self.canvas = canvas_matrix(scene, width, height)
-        self.group_matrix: list[torch.Tensor] = []
+        self.group_matrix: list = []
         self.group_layer: list[int] = []
         self._group_draw_counts = self._count_group_draws()
         self._dash_count = 0  # dashes of the dashed strokes packed so far (limits.MAX_DASHES)
@@ -136,10 +145,10 @@ class Packer:
             g = group.parent
         return out
 
-    def _add_gradient(self, paint, alpha: torch.Tensor, m: torch.Tensor, geometry) -> int | None:
+    def _add_gradient(self, paint, alpha, m, geometry) -> int | None:
         """Adds a gradient paint; returns its index among the gradients, or None when
         it paints nothing."""
-        out = self.out
+        out, ops = self.out, self.ops
         g = m
         if paint.units == "objectBoundingBox":
             if self.provenance:
@@ -151,17 +160,17 @@ class Packer:
             size = hi - lo
             if value(size.min()) <= 0:
                 return None  # SVG: a zero-size bounding box disables the gradient
-            bbox = torch.zeros(3, 3)
+            bbox = ops.zeros((3, 3))
             bbox[0, 0], bbox[1, 1], bbox[0, 2], bbox[1, 2], bbox[2, 2] = size[0], size[1], lo[0], lo[1], 1
             g = g @ bbox
-        g = g @ paint.transform.float()
-        if abs(value(torch.linalg.det(g[:2, :2]))) < 1e-30:
+        g = g @ ops.f32(paint.transform)
+        if abs(value(ops.det(g[:2, :2]))) < 1e-30:
             return None
-        to_paint = torch.linalg.inv(g)[:2].reshape(6)
+        to_paint = ops.inv(g)[:2].reshape(6)
         # its row: after the solids and the gradients before it (see _finish_paints)
         first = (self._n_solid + getattr(self, "_n_gradients", 0)) * COLUMNS["paint_params"]
         if isinstance(paint, LinearGradient):
-            params = torch.cat([to_paint, paint.start.float(), paint.end.float(), torch.zeros(1)])
+            params = ops.cat([to_paint, ops.f32(paint.start), ops.f32(paint.end), ops.zeros(1)])
             kind = PAINT_LINEAR
             if self.provenance:
                 self.provenance.copy("paint_params", first + 6, paint.start)
@@ -169,8 +178,8 @@ class Packer:
         elif isinstance(paint, RadialGradient):
             # SVG 2 semantics, as resvg and browsers draw it: a focal point outside the
             # circle makes a cone, and the area outside the cone is not painted.
-            c, f, r = paint.center.float(), paint.focal.float(), paint.radius.float().reshape(1)
-            params = torch.cat([to_paint, c, r, f])
+            c, f, r = ops.f32(paint.center), ops.f32(paint.focal), ops.f32(paint.radius).reshape(1)
+            params = ops.cat([to_paint, c, r, f])
             kind = PAINT_RADIAL
             if self.provenance:
                 self.provenance.copy("paint_params", first + 6, paint.center)
@@ -178,14 +187,14 @@ class Packer:
                 self.provenance.copy("paint_params", first + 9, paint.focal)
         else:
             raise VecfitError(f"unknown paint {type(paint).__name__}")
-        colors = paint.colors.float()
-        colors = torch.cat([colors[:, :3], colors[:, 3:4] * alpha], dim=1)
+        colors = ops.f32(paint.colors)
+        colors = ops.cat([colors[:, :3], colors[:, 3:4] * alpha], dim=1)
         if self.provenance:
             self.provenance.copy("stop_offsets", out.n_stops, paint.offsets)
-            self.provenance.colors("stop_colors", out.n_stops * 4, paint.colors, torch.full((len(paint.offsets),), value(alpha)))
+            self.provenance.colors("stop_colors", out.n_stops * 4, paint.colors, ops.full((len(paint.offsets),), value(alpha)))
         out.paints.append([kind, out.n_stops, len(paint.offsets)])
         out.paint_params.append(params)
-        out.stop_offsets.append(paint.offsets.float())
+        out.stop_offsets.append(ops.f32(paint.offsets))
         out.stop_colors.append(colors)
         out.n_stops += len(paint.offsets)
         self._n_gradients = getattr(self, "_n_gradients", 0) + 1
@@ -195,18 +204,18 @@ class Packer:
 
     def pack(self) -> Packed:
         self._prepare_groups()
-        out = self.out
+        out, ops = self.out, self.ops
         shapes = self.scene.shapes
         matrices = stacked_shape_matrices(self.scene, self.canvas, self.group_matrix)
         # Similarity (no metric needed for strokes) and uniform scale of every shape.
         lin = matrices[:, :2, :2]
-        scale = torch.sqrt(torch.abs(lin[:, 0, 0] * lin[:, 1, 1] - lin[:, 0, 1] * lin[:, 1, 0]))
-        lin_np = lin.detach().numpy()
+        scale = ops.sqrt(ops.abs(lin[:, 0, 0] * lin[:, 1, 1] - lin[:, 0, 1] * lin[:, 1, 0]))
+        lin_np = ops.numpy(lin)
         big = np.maximum(np.maximum(np.abs(lin_np[:, 0, 0]), np.abs(lin_np[:, 1, 1])), 1e-30)
         similar = ((np.abs(lin_np[:, 0, 1]) <= 1e-9 * big) & (np.abs(lin_np[:, 1, 0]) <= 1e-9 * big)
                    & (np.abs(np.abs(lin_np[:, 0, 0]) - np.abs(lin_np[:, 1, 1])) <= 1e-6 * big))
 
-        scale_np = scale.detach().numpy()
+        scale_np = ops.numpy(scale)
         paths = _PathBatch()
         solid_colors, solid_alphas = [], []   # per solid paint: colour [4], alpha factors
         gradient_rows = []                    # (paint, alpha, matrix, geometry)
@@ -217,7 +226,7 @@ class Packer:
                 solid_colors.append(paint.color)
                 solid_alphas.append(factors)
                 return len(solid_colors) - 1
-            alpha = torch.tensor(1.0)
+            alpha = ops.tensor(1.0)
             for f in factors:
                 alpha = alpha * f
             gradient_rows.append((paint, alpha, matrices[shape_index], geometry))
@@ -284,7 +293,7 @@ class Packer:
                 out.draws.append([stroke_index, DRAW_STROKE, 0, paint, layer,
                                   CAPS[shape.linecap], JOINS[shape.linejoin], per_point])
 
-        paths.finish(out, matrices, scale, self.provenance)
+        paths.finish(out, ops, matrices, scale, self.provenance)
         self._finish_paints(solid_colors, solid_alphas, gradient_rows)
         self._finish_draw_params(stroke_rows, matrices, scale, similar)
         return out
@@ -298,13 +307,14 @@ class Packer:
             self.provenance.present_if_positive(widths, has_stroke)
         # (an ellipse's radii gate its axes instead: see _add_ellipse)
 
-    def _add_ellipse(self, geometry, m: torch.Tensor) -> int | None:
-        r = geometry.radius.reshape(1).expand(2) if isinstance(geometry, Circle) else geometry.radii
+    def _add_ellipse(self, geometry, m) -> int | None:
+        r = self.ops.expand(geometry.radius.reshape(1), 2) if isinstance(geometry, Circle) else geometry.radii
         present = value(r.min()) > 0
         if not present and not self.provenance:
             return None
-        c = affine_apply(m, geometry.center.reshape(1, 2).float())[0]
-        axes = m[:2, :2] @ torch.diag(r.float())
+        ops = self.ops
+        c = affine_apply(m, ops.f32(geometry.center.reshape(1, 2)))[0]
+        axes = m[:2, :2] @ ops.diag(ops.f32(r))
         if self.provenance:
             # Kept with axes 0 while a radius is <= 0 (the core draws nothing there), so
             # that a fitting loop's pack keeps its structure as radii cross 0: the axes'
@@ -313,28 +323,28 @@ class Packer:
                 axes = axes * 0.0
             self.provenance.ellipse(len(self.out.ellipses), geometry.center, geometry.radius if isinstance(geometry, Circle)
                                else geometry.radii, m.detach().numpy())
-        self.out.ellipses.append(torch.cat([c, axes.reshape(4)]))
+        self.out.ellipses.append(ops.cat([c, axes.reshape(4)]))
         self.out.shapes.append([SHAPE_ELLIPSE, 0, 0, len(self.out.ellipses) - 1])
         return len(self.out.shapes) - 1
 
     def _finish_paints(self, solid_colors, solid_alphas, gradient_rows) -> None:
         """Paint table: the solids (stacked in one go), then the gradients; draws that
         point at a gradient are renumbered."""
-        out = self.out
+        out, ops = self.out, self.ops
         n_solid = self._n_solid = len(solid_colors)
         if n_solid:
-            colors = _stack(solid_colors)
+            colors = _stack(ops, solid_colors)
             # Multiply each paint's alpha factors: pad the lists with ones and stack once.
             depth = max(len(f) for f in solid_alphas)
-            one = torch.tensor(1.0)
-            columns = [_stack([f[k] if k < len(f) else one for f in solid_alphas]) for k in range(depth)]
-            alphas = torch.stack(columns).prod(dim=0).reshape(n_solid)
-            colors = torch.cat([colors[:, :3], colors[:, 3:4] * alphas[:, None]], dim=1)
+            one = ops.tensor(1.0)
+            columns = [_stack(ops, [f[k] if k < len(f) else one for f in solid_alphas]) for k in range(depth)]
+            alphas = ops.prod(ops.stack(columns), 0).reshape(n_solid)
+            colors = ops.cat([colors[:, :3], colors[:, 3:4] * alphas[:, None]], dim=1)
             if self.provenance:
-                for row, (color, a) in enumerate(zip(solid_colors, alphas.detach())):
+                for row, (color, a) in enumerate(zip(solid_colors, alphas.detach())):  # (torch only)
                     self.provenance.colors("paint_params", row * COLUMNS["paint_params"] + 6, color, a.reshape(1))
-            ident = torch.eye(2, 3).reshape(1, 6).expand(n_solid, 6)
-            out.paint_params.append(torch.cat([ident, colors, torch.zeros(n_solid, 1)], dim=1))
+            ident = ops.expand(ops.eye(2, 3).reshape(1, 6), n_solid, 6)
+            out.paint_params.append(ops.cat([ident, colors, ops.zeros((n_solid, 1))], dim=1))
             out.paints.extend([[PAINT_SOLID, 0, 0]] * n_solid)
         gradient_index = []
         for paint, alpha, m, geometry in gradient_rows:
@@ -351,36 +361,35 @@ class Packer:
         self._keep_draws = keep
 
     def _finish_draw_params(self, stroke_rows, matrices, scale, similar) -> None:
-        out = self.out
+        out, ops = self.out, self.ops
         n = len(out.draws)
-        params = torch.zeros((n, 6))
+        params = ops.zeros((n, 6))
         params[:, 1] = 4.0
         params[:, 2] = 1.0
         params[:, 5] = 1.0
         if stroke_rows:
-            rows = torch.tensor([r for r, _ in stroke_rows])
+            rows = ops.index([r for r, _ in stroke_rows])
             idx = [i for _, i in stroke_rows]
-            widths = torch.stack([self.scene.shapes[i].stroke_width.float().reshape(()) for i in idx])
+            widths = ops.stack([ops.f32(self.scene.shapes[i].stroke_width).reshape(()) for i in idx])
             s = scale[idx]
             lin = matrices[idx, :2, :2]
             det = lin[:, 0, 0] * lin[:, 1, 1] - lin[:, 0, 1] * lin[:, 1, 0]
             # stroke space: the shape's local space, uniformly scaled (identity for similarities)
-            inv = torch.stack([lin[:, 1, 1], -lin[:, 0, 1], -lin[:, 1, 0], lin[:, 0, 0]], dim=1) / det[:, None]
-            metric = torch.where(torch.as_tensor(similar[idx])[:, None],
-                                 torch.tensor([1.0, 0, 0, 1]).expand(len(idx), 4), s[:, None] * inv)
-            limits = torch.tensor([float(self.scene.shapes[i].miter_limit) for i in idx])
-            stroke_params = torch.cat([(widths * s)[:, None], limits[:, None], metric], dim=1)
-            params = params.index_put((rows,), stroke_params)
+            inv = ops.stack([lin[:, 1, 1], -lin[:, 0, 1], -lin[:, 1, 0], lin[:, 0, 0]], dim=1) / det[:, None]
+            metric = ops.where(ops.from_numpy(similar[idx])[:, None],
+                               ops.expand(ops.tensor([1.0, 0, 0, 1]), len(idx), 4), s[:, None] * inv)
+            limits = ops.tensor([float(self.scene.shapes[i].miter_limit) for i in idx])
+            stroke_params = ops.cat([(widths * s)[:, None], limits[:, None], metric], dim=1)
+            params = ops.put_rows(params, rows, stroke_params)
         keep = getattr(self, "_keep_draws", [True] * n)
         if self.provenance and stroke_rows:
             row_after = np.cumsum(keep) - 1  # rows once the draws that paint nothing are dropped
-            for (row, i), s_i in zip(stroke_rows, s.detach().numpy()):
+            for (row, i), s_i in zip(stroke_rows, ops.numpy(s)):
                 if keep[row]:
                     self.provenance.scaled("draw_params", int(row_after[row]) * COLUMNS["draw_params"],
                                       self.scene.shapes[i].stroke_width, float(s_i))
         if not all(keep):
-            mask = torch.tensor(keep)
-            params = params[mask]
+            params = params[ops.from_numpy(np.asarray(keep))]
             out.draws = [row for row, k in zip(out.draws, keep) if k]
         out.draw_params = [params]
 
@@ -389,7 +398,7 @@ class _PathBatch:
     """All path geometry of a scene, mapped to pixels and indexed in one go."""
 
     def __init__(self):
-        self.points: list[torch.Tensor] = []   # local points per path
+        self.points: list = []                  # local points per path
         self.owner: list[int] = []              # shape index (for its matrix) per path
         self.degrees: list[np.ndarray] = []
         self.subpaths: list[list] = []
@@ -400,9 +409,9 @@ class _PathBatch:
     def add(self, path: Path, shape_index: int, core_shape: int, subpath_slot: int,
             with_widths: bool = False, rect: Rect | None = None) -> int:
         widths = path.widths if with_widths else None
-        if widths is not None and widths.numel() != len(path.points):
+        if widths is not None and _count(widths) != len(path.points):
             raise VecfitError(f"a path's widths must have one value per point "
-                              f"({widths.numel()} widths for {len(path.points)} points)")
+                              f"({_count(widths)} widths for {len(path.points)} points)")
         self.widths.append(widths)
         self.rects.append(rect)
         self.points.append(path.points)
@@ -412,7 +421,7 @@ class _PathBatch:
         self.subpath_slot.append(subpath_slot)
         return core_shape
 
-    def finish(self, out: Packed, matrices: torch.Tensor, scale: torch.Tensor, provenance=None) -> None:
+    def finish(self, out: Packed, ops, matrices, scale, provenance=None) -> None:
         if not self.points:
             return
         counts = [len(p) for p in self.points]
@@ -426,16 +435,16 @@ class _PathBatch:
                 if widths is not None:
                     provenance.scaled("point_widths", row, widths, float(s_np[owner]))
                 row += n
-        local = torch.cat(self.points).float()
+        local = ops.f32(ops.cat(self.points))
         # (numpy: torch's repeat_interleave wakes its thread pool, 0.6 ms a call on 2 busy cores)
-        owner = torch.from_numpy(np.repeat(np.asarray(self.owner, dtype=np.int64), counts))
+        owner = ops.from_numpy(np.repeat(np.asarray(self.owner, dtype=np.int64), counts))
         m = matrices[owner]
-        out.points.append(torch.einsum("nij,nj->ni", m[:, :2, :2], local) + m[:, :2, 2])
+        out.points.append(ops.einsum("nij,nj->ni", m[:, :2, :2], local) + m[:, :2, 2])
         if any(w is not None for w in self.widths):
             # Per-point widths, aligned with the points, in stroke-space units like the
             # uniform width (times the shape's scale; zero where a path has none).
-            local_w = torch.cat([w.float().reshape(-1) if w is not None else torch.zeros(n)
-                                 for w, n in zip(self.widths, counts)])
+            local_w = ops.cat([ops.f32(w).reshape(-1) if w is not None else ops.zeros(n)
+                               for w, n in zip(self.widths, counts)])
             out.point_widths.append(local_w * scale[owner])
         base = out.n_points
         out.n_points += len(local)
@@ -476,10 +485,15 @@ def dashed_stroke(shape: Shape, max_dashes: float | None = None) -> Path | None:
     pattern = dash_pattern(shape.dash_array)
     if pattern is None or not math.isfinite(float(shape.dash_offset)):
         return None
-    g = outline_path(shape.geometry)
+    geometry = shape.geometry
+    plain = not any(is_tensor(v) for v in vars(geometry).values())
+    g = outline_path(as_torch(geometry) if plain else geometry)  # (dashes are cut in torch)
     if g is None or not g.subpaths:
         return None
     dashes = dash_path(g, pattern, float(shape.dash_offset), max_dashes=max_dashes, width=dash_width(shape))
+    if plain and dashes is not None:  # back to the Scene's kind
+        dashes = dataclasses.replace(dashes, points=to_numpy(dashes.points),
+                                     widths=None if dashes.widths is None else to_numpy(dashes.widths))
     if dashes is None:
         warnings.warn(f"{shape.source if shape.source is not None else 'a shape'}: stroke-dasharray makes more "
                       f"than {_limits.MAX_DASHES} dashes in the scene (the limit); stroked solid", VecfitWarning,
@@ -490,8 +504,8 @@ def dashed_stroke(shape: Shape, max_dashes: float | None = None) -> Path | None:
 def dash_width(shape: Shape) -> float:
     """The stroke's widest width (what dash_count weighs dashes by)."""
     g = shape.geometry
-    if isinstance(g, Path) and g.widths is not None and g.widths.numel():
-        return value(g.widths.detach().max())
+    if isinstance(g, Path) and g.widths is not None and _count(g.widths):
+        return value(g.widths.max())
     return value(shape.stroke_width)
 
 
@@ -507,17 +521,21 @@ def _stroke_width_positive(shape: Shape) -> bool:
     """Whether the stroke has any width (per-point widths replace stroke_width)."""
     g = shape.geometry
     if isinstance(g, Path) and g.widths is not None:
-        return g.widths.numel() > 0 and value(g.widths.detach().max()) > 0
+        return _count(g.widths) > 0 and value(g.widths.max()) > 0
     return value(shape.stroke_width) > 0
 
 
-def _stack(tensors: list) -> torch.Tensor:
-    """torch.stack of float32 tensors of one shape, converting only when it must."""
+def _count(array) -> int:
+    """Number of elements of a tensor or a NumPy array."""
+    return math.prod(array.shape)
+
+
+def _stack(ops, arrays: list):
+    """A stack of float32 arrays of one shape, converting only when it must."""
     try:
-        return torch.stack(tensors)
-    except (RuntimeError, TypeError):
-        return torch.stack([torch.as_tensor(t, dtype=torch.float32).reshape(tensors[0].shape)
-                            for t in tensors])
+        return ops.stack(arrays)
+    except (RuntimeError, TypeError, ValueError):
+        return ops.stack([ops.f32(t).reshape(arrays[0].shape) for t in arrays])
 
 
 def pack_scene(scene: Scene, width: int, height: int) -> Packed:

@@ -5,80 +5,17 @@ covers [x, x+1) x [y, y+1) in pixel units.
 """
 from __future__ import annotations
 
-import math
-
 import torch
 
 from vecfit import _core
-from vecfit.errors import NonFiniteScene, VecfitError
-from vecfit.limits import MAX_PIXELS
+from vecfit.errors import VecfitError
 
 from vecfit.scene import Scene
 
 from . import device as devices
+from .forward import FLOAT_INPUTS, _core_render, check_finite, output_size, packed_for_core  # noqa: F401
 from .options import RenderOptions, background_rgba
-from .pack import pack_scene
 from .stopwatch import add_core_phases, phase
-
-
-
-def output_size(scene: Scene, width: int | None, height: int | None) -> tuple[int, int]:
-    """Pixel size to render at: the scene's own size, or the given width and/or height
-    (given only one, the other keeps the scene's aspect ratio, rounded to a pixel).
-    VecfitError for a scene without a finite positive size, or a size over MAX_PIXELS."""
-    sw, sh = float(scene.width), float(scene.height)
-    if not (0 < sw < math.inf and 0 < sh < math.inf):
-        raise VecfitError(f"the canvas size {sw:g} x {sh:g} is not a positive finite size")
-    w = float(sw if width is None and height is None else width if width is not None else height * sw / sh)
-    h = float(sh if width is None and height is None else height if height is not None else width * sh / sw)
-    if math.isfinite(w * h):
-        w, h = max(1.0, float(round(w))), max(1.0, float(round(h)))  # floats: printed with :g
-    if not w * h <= MAX_PIXELS:
-        raise VecfitError(f"{w:.10g} x {h:.10g} pixels is too large to render "
-                          f"(at most {MAX_PIXELS // 1_000_000} million pixels)")
-    return int(w), int(h)
-
-
-FLOAT_INPUTS = ("points", "point_widths", "ellipses", "draw_params", "paint_params", "stop_offsets",
-                "stop_colors", "layer_opacity")
-
-
-def _core_render(options, device: int, structure: dict, floats, keep: bool = False):
-    """The core's forward pass on the packed arrays (``options``: the core's
-    RenderOptions): (the arrays it saw, image), and with ``keep`` the scene as the core
-    prepared it, for the backward pass of these arrays."""
-    scene = dict(structure)
-    for name, t in zip(FLOAT_INPUTS, floats):
-        scene[name] = t.detach().cpu().numpy()
-    try:
-        with phase("call forward"):
-            if keep:
-                image, prepared = _core.render_keeping(scene, options, device)
-            else:
-                image = _core.render(scene, options, device)
-        add_core_phases()
-        return (scene, image, prepared) if keep else (scene, image)
-    except ValueError as e:  # the core refused the scene (e.g. layers nested too deeply)
-        raise VecfitError(str(e)) from None
-    except RuntimeError as e:  # the GPU failed (out of memory, driver)
-        raise VecfitError(f"rendering on {devices.device_name(device)} failed: {e}") from None
-
-
-def packed_for_core(scene: Scene, width: int, height: int) -> tuple[dict, list]:
-    """The scene packed at width x height: the integer tables (structure) and the float
-    arrays in FLOAT_INPUTS order (differentiable), checked to be finite."""
-    with phase("pack"):
-        arrays = pack_scene(scene, width, height).arrays()
-    floats = [arrays[name].to(torch.float32) for name in FLOAT_INPUTS]
-    check_finite(floats)
-    return {k: v for k, v in arrays.items() if k not in FLOAT_INPUTS}, floats
-
-
-def check_finite(floats) -> None:
-    """NonFiniteScene unless every float array (FLOAT_INPUTS order) is finite."""
-    for name, value in zip(FLOAT_INPUTS, floats):
-        if not torch.isfinite(value.detach()).all():
-            raise NonFiniteScene(f"the scene has non-finite values ({name})")
 
 
 class _Render(torch.autograd.Function):

@@ -1,37 +1,42 @@
-"""Shape geometry in torch, in a shape's own space: rects as paths, bounding boxes, the
-control points of a path's segments. Differentiable where the renderer needs it (rect
-corners and radii reach the core as path points)."""
+"""Shape geometry in a shape's own space: rects as paths, bounding boxes, the control
+points of a path's segments. In torch, differentiable where the renderer needs it (rect
+corners and radii reach the core as path points); rects as paths and the placement in
+NumPy too, for a Scene of NumPy arrays (ops.py). The rest computes in torch (imported
+when first needed)."""
 from __future__ import annotations
 
 import numpy as np
-import torch
 
+from .arrays import as_torch, is_tensor
 from .model import Circle, Ellipse, Path, Rect
+from .ops import ops_for
 
 KAPPA = 0.5522847498307936  # cubic approximation of a quarter ellipse
 
 
 def value(t) -> float:
     """A tensor's value as a float, outside the autograd graph (for decisions only)."""
-    return float(t.detach()) if isinstance(t, torch.Tensor) else float(t)
+    if is_tensor(t):
+        return float(t.detach())
+    return float(np.asarray(t).reshape(())) if isinstance(t, np.ndarray) else float(t)
 
 
-def affine_apply(m: torch.Tensor, p: torch.Tensor) -> torch.Tensor:
+def affine_apply(m, p):
     """Apply a 3x3 affine matrix to points [n, 2]."""
     return p @ m[:2, :2].T + m[:2, 2]
 
 
-def rect_path(rect: Rect) -> tuple[torch.Tensor, list[int]]:
+def rect_path(rect: Rect) -> tuple:
     """A rect as a closed path: four lines, with quarter-ellipse cubics for round corners."""
+    stack = ops_for(rect.p_min).stack
     x0, y0 = rect.p_min[0], rect.p_min[1]
     x1, y1 = rect.p_max[0], rect.p_max[1]
     rx, ry = rect.corner_radii[0], rect.corner_radii[1]
     if value(rx) <= 0 or value(ry) <= 0:
-        pts = torch.stack([torch.stack([x0, y0]), torch.stack([x1, y0]),
-                           torch.stack([x1, y1]), torch.stack([x0, y1])])
+        pts = stack([stack([x0, y0]), stack([x1, y0]), stack([x1, y1]), stack([x0, y1])])
         return pts, [1, 1, 1, 1]
     kx, ky = KAPPA * rx, KAPPA * ry
-    P = lambda x, y: torch.stack([x, y])  # noqa: E731
+    P = lambda x, y: stack([x, y])  # noqa: E731
     pts = [
         P(x0 + rx, y0), P(x1 - rx, y0),
         P(x1 - rx + kx, y0), P(x1, y0 + ry - ky), P(x1, y0 + ry),
@@ -42,11 +47,16 @@ def rect_path(rect: Rect) -> tuple[torch.Tensor, list[int]]:
         P(x0, y0 + ry),
         P(x0, y0 + ry - ky), P(x0 + rx - kx, y0),  # closing cubic ends at the start point
     ]
-    return torch.stack(pts), [1, 3, 1, 3, 1, 3, 1, 3]
+    return stack(pts), [1, 3, 1, 3, 1, 3, 1, 3]
 
 
-def local_bbox(geometry) -> tuple[torch.Tensor, torch.Tensor] | None:
-    """Tight bounds (min, max) of the geometry in its local space, for bounding-box units."""
+def local_bbox(geometry) -> tuple | None:
+    """Tight bounds (min, max) of the geometry in its local space, for bounding-box units
+    (of a NumPy geometry: computed in torch, given back as NumPy)."""
+    import torch
+    if not isinstance(geometry, Rect) and not is_tensor(getattr(geometry, "points", getattr(geometry, "center", None))):
+        box = local_bbox(as_torch(geometry))
+        return None if box is None else (box[0].numpy(), box[1].numpy())
     if isinstance(geometry, (Circle, Ellipse)):
         r = geometry.radius.expand(2) if isinstance(geometry, Circle) else geometry.radii
         return geometry.center - r, geometry.center + r
@@ -106,6 +116,7 @@ def ellipse_as_path(geometry: Circle | Ellipse) -> Path | None:
     """A circle or an ellipse as a closed path of four quarter-ellipse cubics, from
     (cx + rx, cy) through (cx, cy + ry) (SVG 2's start point and direction, as resvg),
     differentiable in the centre and radii; None when a radius is not positive."""
+    import torch
     r = geometry.radius.reshape(1).expand(2) if isinstance(geometry, Circle) else geometry.radii
     if value(r.min()) <= 0:
         return None
@@ -121,6 +132,7 @@ def ellipse_as_path(geometry: Circle | Ellipse) -> Path | None:
 
 def local_bbox_size(geometry) -> float | None:
     """Geometric mean of the geometry's bounding-box sides (for bounding-box units)."""
+    import torch
     with torch.no_grad():
         box = local_bbox(geometry)
     if box is None:

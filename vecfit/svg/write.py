@@ -20,10 +20,10 @@ import warnings
 import xml.etree.ElementTree as ET
 
 import numpy as np
-import torch
 
 from vecfit.errors import VecfitError
 from vecfit.io.images import atomic_write
+from vecfit.scene.arrays import to_numpy
 from vecfit.scene import (Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect,
                                    Scene, Solid)
 
@@ -54,7 +54,7 @@ def path_data(path: Path) -> str:
 def _same(a, b) -> bool:
     if a is None or b is None:
         return a is b
-    return a.shape == b.shape and torch.equal(a.detach().cpu(), b.detach().cpu())
+    return a.shape == b.shape and np.array_equal(to_numpy(a), to_numpy(b))  # tensors or NumPy
 
 
 def _same_geometry(a, b) -> bool:
