@@ -313,7 +313,7 @@ def test_interrupt_keeps_the_best_so_far():
 
 
 def test_interrupted_cli_run_writes_best_result(tmp_path, monkeypatch):
-    import vecfit.jobs.fit as fit_module
+    import vecfit.fitting.loop as fit_module  # jobs.fit imports the loop where it runs it
     real = fit_module.optimize
 
     def interrupted(scene, target, settings, progress=None, **kwargs):
