@@ -14,10 +14,15 @@ import argparse
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
+import resvg_py
+from common import SHARED
+
 ROOT = Path(__file__).resolve().parents[1]
+EMOJI = SHARED / "realworld" / "cases" / "noto-emoji-000.svg"
 
 
 def wall(argv: list[str], repeats: int) -> float:
@@ -42,12 +47,18 @@ def main():
     ap.add_argument("--repeats", type=int, default=7)
     args = ap.parse_args()
     tiger = str(ROOT / "examples" / "tiger.svg")
+    emoji = Path(tempfile.mkdtemp()) / "emoji.png"  # a 512-px emoji as `trace --no-refine` gets it
+    emoji.write_bytes(bytes(resvg_py.svg_to_bytes(svg_path=str(EMOJI), width=512)))
+    traced = str(emoji.with_suffix(".svg"))
     small = str(ROOT / "tests" / "oracles" / "golden" / "caps.svg")
     rows = [("import numpy", [sys.executable, "-c", "import numpy"], None),
             ("import torch", [sys.executable, "-c", "import torch"], None),
             ("vecfit --version", [sys.executable, "-m", "vecfit", "--version"], ["--version"]),
             ("vecfit info (1 shape)", [sys.executable, "-m", "vecfit", "info", small], ["info", small]),
-            ("vecfit info tiger.svg", [sys.executable, "-m", "vecfit", "info", tiger], ["info", tiger])]
+            ("vecfit info tiger.svg", [sys.executable, "-m", "vecfit", "info", tiger], ["info", tiger]),
+            ("vecfit trace emoji.png --no-refine (512 px)",
+             [sys.executable, "-m", "vecfit", "trace", str(emoji), "--no-refine", "-q", "-o", traced],
+             ["trace", str(emoji), "--no-refine", "-q", "-o", traced])]
     print(f"| command | median wall s ({args.repeats} runs) | imports torch |")
     print("|---|---|---|")
     for label, argv, cli in rows:
