@@ -146,3 +146,19 @@ def test_trace_without_refining_runs_without_torch(tmp_path):
     assert svg == (tmp_path / "cli.svg").read_text()
     written = json.loads((tmp_path / "cli.report.json").read_text())
     assert written["optimized"] == report["optimized"] and report["optimized"]["psnr"] > 25
+
+
+@pytest.mark.parametrize("table, refused", [('loss = "nope"', "loss must be one of"),
+                                            ('[optimize.lr]\npoints = -1.0', "learning rate of points"),
+                                            ('[optimize.lr]\nwiggle = 1.0', "unknown setting")])
+def test_trace_without_refining_still_checks_the_loop_settings(tmp_path, table, refused):
+    """The [optimize] table is checked (vecfit.fitting.settings) even where no loop will
+    run, and checking it imports no torch: a bad file is refused as it is for refine."""
+    Image.fromarray(np.full((24, 24, 3), 200, np.uint8)).save(tmp_path / "flat.png")
+    config = tmp_path / "bad.toml"
+    config.write_text(f"[optimize]\n{table}\n" if not table.startswith("[") else table + "\n")
+    output, torch_imported = _modules_after("trace", tmp_path / "flat.png", "--no-refine", "--config", config,
+                                            "-o", tmp_path / "out.svg")
+    assert refused in output and "Traceback" not in output, output
+    assert not (tmp_path / "out.svg").exists()
+    assert not torch_imported, output

@@ -30,6 +30,7 @@ from vecfit.renderer.stopwatch import lap, phase
 from vecfit.scene import Scene
 
 from . import losses
+from .settings import PARAMETER_KINDS, Settings  # noqa: F401  (re-exported: the loop's settings)
 from .adam import Adam
 from .outline import OutlineCost
 from .rates import parameter_kinds
@@ -45,70 +46,6 @@ PERSISTENT_PACK = True
 # outlines are several times as long as its image is wide, and past this budget the samples
 # go where the pixel adjoints are (RenderOptions.boundary_budget; still unbiased).
 BOUNDARY_BUDGET = 2.0
-
-PARAMETER_KINDS = ("points", "colors", "stroke_widths", "opacities", "radii", "gradient_points",
-                   "gradient_radii", "stop_offsets", "transforms")
-
-
-@dataclass
-class Settings:
-    """The loop's settings. Their defaults are configs/refine.toml's [optimize] table
-    (``defaults()``), so the Python API and the CLI start alike."""
-    iterations: int
-    loss: str
-    mode: str
-    samples: int
-    boundary_samples: float
-    interior_samples: int  # of the N x N samples per pixel, those the backward revisits (0: all)
-    seed: int
-    threads: int
-    device: str
-    lr_decay: float
-    lr_warmup: int
-    fixed_alpha: bool
-    coarse: float  # fraction of the iterations run at half the size (coarse to fine)
-    outline: float  # weight of the cost on outlines growing (outline.py), per px of growth per px
-    lr: dict
-
-    @classmethod
-    def defaults(cls, **changes) -> "Settings":
-        """configs/refine.toml's [optimize] settings, with ``changes`` (``lr`` replaces the
-        whole table of rates)."""
-        return cls.from_config({**defaults("refine", "optimize"), **changes})
-
-    @classmethod
-    def from_config(cls, table: dict) -> "Settings":
-        """From the [optimize] table; its other keys (max_size, background, ...) belong
-        to the job around the loop."""
-        names = {f.name for f in fields(cls)}
-        s = cls(**{k: v for k, v in table.items() if k in names and k != "lr"},
-                lr=dict(table.get("lr", {})))
-        s.check()
-        return s
-
-    def check(self) -> None:
-        if self.iterations < 0:
-            raise VecfitError("iterations must be 0 or more")
-        losses.get(self.loss)
-        if self.mode not in MODES:
-            raise VecfitError(f"mode must be one of {', '.join(MODES)}, not {self.mode!r}")
-        if self.samples < 1:
-            raise VecfitError("samples must be at least 1")
-        if not 0 < self.lr_decay <= 1:
-            raise VecfitError("lr_decay must be in (0, 1]")
-        if self.lr_warmup < 0:
-            raise VecfitError("lr_warmup must be 0 or more")
-        if not 0 <= self.coarse < 1:  # the last iterations must be at full size
-            raise VecfitError(f"coarse must be at least 0 and below 1, not {self.coarse}")
-        if not (math.isfinite(self.outline) and self.outline >= 0):
-            raise VecfitError(f"outline must be a number >= 0, not {self.outline}")
-        devices.resolve(self.device)
-        for kind, value in self.lr.items():
-            if kind not in PARAMETER_KINDS:
-                raise VecfitError(f"unknown parameter kind {kind!r} (known: {', '.join(PARAMETER_KINDS)})")
-            if not (math.isfinite(value) and value >= 0):
-                raise VecfitError(f"learning rate of {kind} must be a number >= 0, not {value}")
-
 
 @dataclass
 class Target:

@@ -110,11 +110,8 @@ def validate(settings: dict) -> None:
 
     if settings["optimize"]["background"].strip().lower() != "auto":
         fitting_background(settings["optimize"]["background"])
-    # (the loop's settings are checked where it will run: their module imports torch, which
-    # a run of 0 iterations, e.g. `trace --no-refine`, never needs)
-    if settings["optimize"]["iterations"] != 0:
-        from vecfit.fitting.loop import Settings
-        Settings.from_config(settings["optimize"])
+    from vecfit.fitting.settings import Settings  # (torch-free: trace --no-refine never imports it)
+    Settings.from_config(settings["optimize"])
     seed = settings["optimize"]["seed"]
     if "trace" in settings:
         from vecfit.initial.tracer import TraceSettings
