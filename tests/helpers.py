@@ -37,3 +37,16 @@ def photo_png(tmp_path_factory, name: str, size: tuple[int, int]) -> Path:
     folder = tmp_path_factory.mktemp(name)
     Image.fromarray(getattr(skimage.data, name)()).resize(size, Image.LANCZOS).save(folder / f"{name}.png")
     return folder / f"{name}.png"
+
+
+def two_shapes_png(path: Path):
+    """A 48 x 36 PNG of a red disc and a blue square on off-white, saved at ``path``: a
+    small target the jobs trace and refine in a few iterations. Returns the PIL image."""
+    from PIL import Image, ImageDraw
+
+    image = Image.new("RGB", (48, 36), (240, 240, 235))
+    draw = ImageDraw.Draw(image)
+    draw.ellipse((6, 5, 30, 29), fill=(200, 60, 40))
+    draw.rectangle((26, 14, 44, 32), fill=(40, 90, 180))
+    image.save(path)
+    return image

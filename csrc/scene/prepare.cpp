@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/float_bounds.h"
 #include "scene/layers.h"
 #include "scene/scene.h"
 #include "scene/stroke.h"
@@ -21,19 +22,6 @@ bool finite(double v) { return std::isfinite(v); }
 
 }  // namespace
 
-namespace {
-
-// A double range's ends as floats, rounded outwards.
-float float_below(double v) {
-    float f = (float)v;
-    return (double)f > v ? std::nextafter(f, -INFINITY) : f;
-}
-float float_above(double v) {
-    float f = (float)v;
-    return (double)f < v ? std::nextafter(f, INFINITY) : f;
-}
-
-}  // namespace
 
 PreparedSegment prepare_segment(const Segment& s, const int32_t* idx) {
     PreparedSegment ps;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/float_bounds.h"
 #include "common/thread_pool.h"
 #include "scene/coverage.h"
 #include "scene/draw_runs.h"
@@ -11,14 +12,6 @@
 namespace vf {
 namespace {
 
-float float_below(double v) {
-    float f = (float)v;
-    return (double)f > v ? std::nextafter(f, -INFINITY) : f;
-}
-float float_above(double v) {
-    float f = (float)v;
-    return (double)f < v ? std::nextafter(f, INFINITY) : f;
-}
 
 struct TileRange {
     int x0 = 0, y0 = 0, x1 = -1, y1 = -1;

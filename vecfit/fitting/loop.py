@@ -13,18 +13,16 @@ import contextlib
 import gc
 import math
 import time
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from typing import Callable, Optional
 
 import torch
 
 from vecfit.errors import NonFiniteScene, VecfitError
 from vecfit.io.compositing import composite_torch
-from vecfit.io.configs import defaults
 from vecfit.io.images import downscaled, downscaled_weight
 from vecfit.renderer import device as devices
 from vecfit.renderer.persistent import PersistentPack
-from vecfit.renderer.options import MODES
 from vecfit.renderer.raster import render
 from vecfit.renderer.stopwatch import lap, phase
 from vecfit.scene import Scene

@@ -15,6 +15,7 @@ import copy
 import dataclasses
 
 from vecfit.errors import VecfitError
+from vecfit.fitting.settings import Settings  # torch-free: trace --no-refine checks it too
 from vecfit.io.configs import configs_dir, read_toml
 
 
@@ -110,7 +111,6 @@ def validate(settings: dict) -> None:
 
     if settings["optimize"]["background"].strip().lower() != "auto":
         fitting_background(settings["optimize"]["background"])
-    from vecfit.fitting.settings import Settings  # (torch-free: trace --no-refine never imports it)
     Settings.from_config(settings["optimize"])
     seed = settings["optimize"]["seed"]
     if "trace" in settings:

@@ -226,7 +226,7 @@ class Packer:
                 solid_colors.append(paint.color)
                 solid_alphas.append(factors)
                 return len(solid_colors) - 1
-            alpha = ops.tensor(1.0)
+            alpha = ops.f32(1.0)
             for f in factors:
                 alpha = alpha * f
             gradient_rows.append((paint, alpha, matrices[shape_index], geometry))
@@ -336,7 +336,7 @@ class Packer:
             colors = _stack(ops, solid_colors)
             # Multiply each paint's alpha factors: pad the lists with ones and stack once.
             depth = max(len(f) for f in solid_alphas)
-            one = ops.tensor(1.0)
+            one = ops.f32(1.0)
             columns = [_stack(ops, [f[k] if k < len(f) else one for f in solid_alphas]) for k in range(depth)]
             alphas = ops.prod(ops.stack(columns), 0).reshape(n_solid)
             colors = ops.cat([colors[:, :3], colors[:, 3:4] * alphas[:, None]], dim=1)
@@ -377,8 +377,8 @@ class Packer:
             # stroke space: the shape's local space, uniformly scaled (identity for similarities)
             inv = ops.stack([lin[:, 1, 1], -lin[:, 0, 1], -lin[:, 1, 0], lin[:, 0, 0]], dim=1) / det[:, None]
             metric = ops.where(ops.from_numpy(similar[idx])[:, None],
-                               ops.expand(ops.tensor([1.0, 0, 0, 1]), len(idx), 4), s[:, None] * inv)
-            limits = ops.tensor([float(self.scene.shapes[i].miter_limit) for i in idx])
+                               ops.expand(ops.f32([1.0, 0, 0, 1]), len(idx), 4), s[:, None] * inv)
+            limits = ops.f32([float(self.scene.shapes[i].miter_limit) for i in idx])
             stroke_params = ops.cat([(widths * s)[:, None], limits[:, None], metric], dim=1)
             params = ops.put_rows(params, rows, stroke_params)
         keep = getattr(self, "_keep_draws", [True] * n)

@@ -19,10 +19,6 @@ class NumpyOps:
         return np.asarray(a, dtype=np.float32)
 
     @staticmethod
-    def tensor(values):
-        return np.asarray(values, dtype=np.float32)
-
-    @staticmethod
     def index(values):
         return np.asarray(values, dtype=np.int64)
 
@@ -83,9 +79,6 @@ class TorchOps:
 
     def f32(self, a):
         return a.float() if is_tensor(a) else self.torch.as_tensor(a, dtype=self.torch.float32)
-
-    def tensor(self, values):
-        return self.torch.tensor(values)
 
     def index(self, values):
         return self.torch.as_tensor(values, dtype=self.torch.int64)

@@ -13,7 +13,7 @@ def canvas_matrix(scene: Scene, width: int, height: int):
     """Root user space -> pixels of a ``width`` x ``height`` render."""
     sx, sy = width / scene.width, height / scene.height
     ops = ops_for(scene.view)
-    return ops.diag(ops.tensor([sx, sy, 1.0])) @ ops.f32(scene.view)
+    return ops.diag(ops.f32([sx, sy, 1.0])) @ ops.f32(scene.view)
 
 
 def group_matrices(scene: Scene, canvas) -> list:

@@ -7,25 +7,15 @@ import io
 import os
 
 import numpy as np
-from PIL import Image, ImageDraw
 
 import vecfit
-from helpers import run
+from helpers import run, two_shapes_png
 
 FAST = {"optimize": {"iterations": 4, "threads": 1}}
 
 
-def _picture(path):
-    image = Image.new("RGB", (48, 36), (240, 240, 235))
-    draw = ImageDraw.Draw(image)
-    draw.ellipse((6, 5, 30, 29), fill=(200, 60, 40))
-    draw.rectangle((26, 14, 44, 32), fill=(40, 90, 180))
-    image.save(path)
-    return image
-
-
 def test_trace_returns_the_commands_svg_and_writes_nothing(tmp_path, monkeypatch):
-    image = _picture(tmp_path / "in.png")
+    image = two_shapes_png(tmp_path / "in.png")
     run("trace", tmp_path / "in.png", "-o", tmp_path / "cli.svg", "--iterations", 4, "--threads", 1,
         "--paths", 12, "-q")
     work = tmp_path / "work"
@@ -44,7 +34,7 @@ def test_trace_returns_the_commands_svg_and_writes_nothing(tmp_path, monkeypatch
 
 
 def test_refine_takes_svg_text_or_a_path_and_writes_when_asked(tmp_path):
-    _picture(tmp_path / "in.png")
+    two_shapes_png(tmp_path / "in.png")
     svg = tmp_path / "init.svg"
     svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="48" height="36">'
                    '<circle id="c" cx="20" cy="18" r="10" fill="#884444"/></svg>')

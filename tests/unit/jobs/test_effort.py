@@ -8,10 +8,10 @@ import json
 
 import numpy as np
 import pytest
-from PIL import Image, ImageDraw
+from PIL import Image
 
 import vecfit
-from helpers import run
+from helpers import run, two_shapes_png
 from vecfit.batch import DONE, EXIT_OK, EXIT_USAGE, run_batch
 from vecfit.errors import VecfitError
 from vecfit.io.configs import configs_dir, read_toml
@@ -81,17 +81,9 @@ def test_unknown_efforts_are_refused_clearly(tmp_path):
     assert r.exit_code == EXIT_USAGE and "fast" in r.output
 
 
-def _picture(path):
-    image = Image.new("RGB", (48, 36), (240, 240, 235))
-    draw = ImageDraw.Draw(image)
-    draw.ellipse((6, 5, 30, 29), fill=(200, 60, 40))
-    draw.rectangle((26, 14, 44, 32), fill=(40, 90, 180))
-    image.save(path)
-    return path
-
-
 def test_normal_writes_the_same_bytes_as_no_effort_and_quick_the_same_as_python(tmp_path):
-    image = _picture(tmp_path / "in.png")
+    image = tmp_path / "in.png"
+    two_shapes_png(image)
     common = ["--iterations", 6, "--threads", 1, "--paths", 12, "-q"]
     for name, extra in (("plain", []), ("normal", ["--effort", "normal"]), ("quick", ["--effort", "quick"])):
         r = run("trace", image, "-o", tmp_path / f"{name}.svg", *common, *extra)
@@ -108,7 +100,8 @@ def test_normal_writes_the_same_bytes_as_no_effort_and_quick_the_same_as_python(
 
 
 def test_refine_from_python_is_the_commands_svg(tmp_path):
-    image = _picture(tmp_path / "in.png")
+    image = tmp_path / "in.png"
+    two_shapes_png(image)
     init = tmp_path / "init.svg"
     init.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="48" height="36">'
                     '<circle id="c" cx="20" cy="18" r="10" fill="#884444"/>'
@@ -127,7 +120,7 @@ def test_refine_from_python_is_the_commands_svg(tmp_path):
 def test_batch_takes_the_effort_to_every_image_and_resume_sees_it(tmp_path):
     d = tmp_path / "in"
     d.mkdir()
-    _picture(d / "a.png")
+    two_shapes_png(d / "a.png")
     user = tmp_path / "c.toml"
     user.write_text("[optimize]\niterations = 3\n[trace]\npaths = 8\n")
     out = tmp_path / "out"
