@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
-from scipy import ndimage
+
+from .labels import bounding_boxes, fill_holes
 
 
 def crack_outlines(mask: np.ndarray, origin=(0, 0)) -> list[np.ndarray]:
@@ -36,7 +37,7 @@ def shape_outlines(mask: np.ndarray, transparent: np.ndarray, origin=(0, 0)):
     outline, hole, island in the hole..., and are filled even-odd. Returns (outlines as
     crack_outlines gives them, a bool per outline: is it a hole)."""
     # (filling holes costs more than the test for transparency, which most regions fail)
-    filled = ndimage.binary_fill_holes(mask) if transparent.any() else None
+    filled = fill_holes(mask) if transparent.any() else None
     cut = filled & ~mask & transparent if filled is not None else None
     if cut is None or not cut.any():  # nothing to cut: the outer outlines alone (the usual case)
         found = crack_outlines(mask, origin)
@@ -48,7 +49,7 @@ def shape_outlines(mask: np.ndarray, transparent: np.ndarray, origin=(0, 0)):
         outlines += found
         holes += [hole] * len(found)
         # what this level encloses without being part of it: the next level in
-        level = ndimage.binary_fill_holes(level) & ~level
+        level = fill_holes(level) & ~level
         hole = not hole
     return outlines, holes
 
@@ -60,7 +61,7 @@ def polygon_area(p: np.ndarray) -> float:
 
 def region_boxes(labels: np.ndarray, count: int) -> list:
     """Bounding slices (rows, cols) of each region."""
-    return ndimage.find_objects(labels + 1, max_label=count)
+    return bounding_boxes(labels, count)
 
 
 def drawing_order(labels: np.ndarray, count: int, boxes) -> np.ndarray:

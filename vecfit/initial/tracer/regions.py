@@ -18,9 +18,8 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from scipy import ndimage
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
+
+from .labels import bounding_boxes, connected_groups
 
 
 @dataclass
@@ -41,7 +40,7 @@ def components(classes: np.ndarray) -> tuple[np.ndarray, int]:
     comp = np.full(classes.shape, -1, np.int32)
     count = 0
     k = int(classes.max()) + 1 if classes.size else 0
-    for c, box in enumerate(ndimage.find_objects(classes + 1, max_label=k)):
+    for c, box in enumerate(bounding_boxes(classes, k)):
         if box is None:
             continue
         mask = classes[box] == c
@@ -142,8 +141,7 @@ def merge_specks(comp, count, area, color, edges, min_area):
     order = np.lexsort((cost, a))
     a, b = a[order], b[order]
     first = np.flatnonzero(np.r_[True, a[1:] != a[:-1]])  # cheapest neighbour of each speck
-    graph = coo_matrix((np.ones(len(first)), (a[first], b[first])), shape=(count, count))
-    groups, labels = connected_components(graph, directed=False)
+    groups, labels = connected_groups(count, a[first], b[first])
     merged = np.where(comp >= 0, labels[np.maximum(comp, 0)], -1).astype(np.int32)
     return merged, groups
 
