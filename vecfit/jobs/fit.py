@@ -174,9 +174,12 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     else:
         progress.start(0)
         result = _not_optimised(scene, opt)
-    final_image = initial_image if result.iterations == 0 else _render_full(scene, sw, sh, opt)
-    final_rgb = to_rgb(to_numpy(final_image), background)
-    final = compare(final_rgb, target_rgb)
+    if result.iterations == 0:  # nothing moved: the same picture and figures
+        final_image, final_rgb, final = initial_image, initial_rgb, dict(initial)
+    else:
+        final_image = _render_full(scene, sw, sh, opt)
+        final_rgb = to_rgb(to_numpy(final_image), background)
+        final = compare(final_rgb, target_rgb)
     if not all(math.isfinite(final[k]) or (k == "psnr" and final["mse"] == 0) for k in final):
         raise VecfitError(f"the optimised image has non-finite values ({final}); nothing written")
 
