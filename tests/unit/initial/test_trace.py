@@ -283,3 +283,19 @@ def test_tracing_imports_no_torch():
             "print('<path' in svg, 'torch' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.stdout.split() == ["True", "False"], out.stdout + out.stderr
+
+
+def test_lab_conversion_gives_the_known_values():
+    """tracer/quantize.to_lab by the formulas: CIELAB of sRGB white, black, the primaries
+    and mid grey (D65; Lindbloom's figures), and within OpenCV's interpolation of them."""
+    import cv2
+
+    from vecfit.initial.tracer.quantize import to_lab
+
+    rgb = np.array([[1, 1, 1], [0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0.5, 0.5, 0.5]], np.float32)
+    known = np.array([[100, 0, 0], [0, 0, 0], [53.24, 80.09, 67.20], [87.73, -86.18, 83.18],
+                      [32.30, 79.19, -107.86], [53.39, 0, 0]])
+    lab = to_lab(rgb[None])[0]
+    np.testing.assert_allclose(lab, known, atol=0.03)
+    colours = np.random.default_rng(0).random((1, 5000, 3)).astype(np.float32)
+    assert np.abs(to_lab(colours) - cv2.cvtColor(colours, cv2.COLOR_RGB2Lab)).max() < 0.6
