@@ -88,23 +88,27 @@ def test_info_on_non_svg_is_a_clear_error(tmp_path):
     assert r.exit_code == 1 and "notes.svg" in r.output and "Traceback" not in r.output
 
 
-def _modules_after(*args) -> tuple[str, bool]:
-    """Runs the command line in a fresh Python with ``args``; its output and whether torch
-    was imported by the end."""
+HEAVY = ("torch", "scipy", "skimage")  # over a second, 0.2 s and 0.1 s of start-up
+
+
+def _modules_after(*args) -> tuple[str, set]:
+    """Runs the command line in a fresh Python with ``args``; its output and which of the
+    HEAVY modules were imported by the end."""
     code = ("import sys\nfrom vecfit.cli.commands import main\n"
             f"sys.argv = ['vecfit', *{list(map(str, args))!r}]\n"
-            "try:\n    main()\nexcept SystemExit:\n    pass\nprint('torch' in sys.modules)")
+            "try:\n    main()\nexcept SystemExit:\n    pass\n"
+            f"print(','.join(m for m in {HEAVY!r} if m in sys.modules) or '-')")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     lines = out.stdout.split()
-    return out.stdout + out.stderr, bool(lines) and lines[-1] == "True"
+    return out.stdout + out.stderr, set(lines[-1].split(",")) - {"-"} if lines else set(HEAVY)
 
 
 @pytest.mark.parametrize("args", [["--version"], ["info", "--build"]])
 def test_version_starts_without_torch(args):
     """`vecfit --version` and `info --build` say the core's build without importing torch
     (a second of start-up)."""
-    output, torch_imported = _modules_after(*args)
-    assert "vecfit 0" in output and not torch_imported, output
+    output, imported = _modules_after(*args)
+    assert "vecfit 0" in output and not imported, output
 
 
 @pytest.mark.parametrize("name", ["tiger.svg", "golden"])
@@ -121,9 +125,9 @@ def test_info_runs_without_torch(name, tmp_path):
             'ry="3" stroke="blue"/></svg>')
     else:
         path = Path(__file__).resolve().parents[2] / "examples" / name
-    output, torch_imported = _modules_after("info", path)
+    output, imported = _modules_after("info", path)
     assert "shapes:" in output and "Traceback" not in output, output
-    assert not torch_imported, output
+    assert not imported, output
 
 
 def test_trace_without_refining_runs_without_torch(tmp_path):
@@ -136,9 +140,9 @@ def test_trace_without_refining_runs_without_torch(tmp_path):
     image[5:20, 30:44] = (20, 60, 200)
     png = tmp_path / "blobs.png"
     Image.fromarray(image).save(png)
-    output, torch_imported = _modules_after("trace", png, "--no-refine", "-o", tmp_path / "cli.svg")
+    output, imported = _modules_after("trace", png, "--no-refine", "-o", tmp_path / "cli.svg")
     assert "Traceback" not in output and "0 iterations" in output, output
-    assert not torch_imported, output
+    assert not imported, output  # no torch, and none of SciPy (tracer/labels.py) or scikit-image
     import json
 
     import vecfit
@@ -157,8 +161,8 @@ def test_trace_without_refining_still_checks_the_loop_settings(tmp_path, table, 
     Image.fromarray(np.full((24, 24, 3), 200, np.uint8)).save(tmp_path / "flat.png")
     config = tmp_path / "bad.toml"
     config.write_text(f"[optimize]\n{table}\n" if not table.startswith("[") else table + "\n")
-    output, torch_imported = _modules_after("trace", tmp_path / "flat.png", "--no-refine", "--config", config,
+    output, imported = _modules_after("trace", tmp_path / "flat.png", "--no-refine", "--config", config,
                                             "-o", tmp_path / "out.svg")
     assert refused in output and "Traceback" not in output, output
     assert not (tmp_path / "out.svg").exists()
-    assert not torch_imported, output
+    assert "torch" not in imported, output

@@ -22,7 +22,7 @@ import pytest
 from PIL import Image
 
 ROOT = Path(__file__).resolve().parents[2]
-DEV_ONLY = ("pytest", "hypothesis", "resvg_py", "distributed", "dask", "build")
+DEV_ONLY = ("pytest", "hypothesis", "resvg_py", "distributed", "dask", "build", "skimage", "scipy")
 
 pytestmark = pytest.mark.slow
 
