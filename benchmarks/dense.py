@@ -74,21 +74,23 @@ def refine(target: Path, svg: Path, overrides: dict, folder: Path):
     return report, watch.laps, outputs.svg
 
 
-def with_budget(budget: float | None):
-    """Sets the fitting loop's boundary budget (None: leaves the default)."""
-    from vecfit.fitting import loop
-    if budget is not None:
-        loop.BOUNDARY_BUDGET = budget
-    return loop.BOUNDARY_BUDGET
+def with_budget(overrides: dict, budget: float | None) -> tuple[dict, float]:
+    """The overrides with optimize.boundary_budget set (None: the configured one, as given
+    by --set or refine.toml), and the budget they give."""
+    from vecfit.io.configs import defaults
+
+    optimize = overrides.get("optimize", {})
+    used = budget if budget is not None else optimize.get("boundary_budget",
+                                                           defaults("refine", "optimize")["boundary_budget"])
+    return {**overrides, "optimize": {**optimize, "boundary_budget": used}}, used
 
 
 def curve(target: Path, svgs: dict, iterations: int, overrides: dict, folder: Path, budgets) -> None:
     rows = {}
     for n, svg in svgs.items():
         for budget in budgets:  # (alternating, so that the machine's load falls on both alike)
-            used = with_budget(budget)
-            changes = {**overrides, "optimize": {**overrides.get("optimize", {}), "iterations": iterations,
-                                                 "coarse": 0.0}}
+            changes, used = with_budget(overrides, budget)
+            changes["optimize"].update(iterations=iterations, coarse=0.0)
             report, laps, _ = refine(target, svg, changes, folder)
             parts = [split(lap) for lap in laps[SKIP:] or laps]
             label = f"{report['shapes']:,} shapes" + ("" if isinstance(n, int) else ", refined")
@@ -107,7 +109,7 @@ def curve(target: Path, svgs: dict, iterations: int, overrides: dict, folder: Pa
     print("| outside the core's passes | " + " | ".join(f"{o:.0%}" for o in outside) + " |")
 
 
-def job(target: Path, svg: Path, overrides: dict, folder: Path, budget: float) -> None:
+def job(target: Path, svg: Path, overrides: dict, budget: float, folder: Path) -> None:
     from PIL import Image
 
     from vecfit.fitting.metrics import compare, to_rgb
@@ -123,7 +125,8 @@ def job(target: Path, svg: Path, overrides: dict, folder: Path, budget: float) -
     after = compare(resvg_rgb(written, photo.shape[1], bg), goal)
     times = report["seconds"]["iterations"]
     n = max(1, len(times) // 10)
-    print(f"\nthe default refine job, {svg.name}, boundary budget {budget:g}\n")
+    print(f"\nthe default refine job, {svg.name}, boundary budget {budget:g}, point rate "
+          f"{report['point_rate']:.2f} px (outline density {report['outline_density']:.2f})\n")
     print("| shapes | iterations | job | s/iteration start -> end | PSNR before -> after (resvg) | gain |")
     print("|---:|---:|---:|---|---|---:|")
     print(f"| {report['shapes']:,} | {report['iterations']} | {wall:.1f} s "
@@ -142,7 +145,7 @@ def main() -> None:
     ap.add_argument("--refined", type=int, default=0,
                     help="also time the curve's iterations on the N-path trace as an earlier --job N refined "
                          "it (coffee_N.refined.svg in --inputs): the end of a run, where outlines have grown")
-    ap.add_argument("--budgets", default="", help="boundary budgets to compare, e.g. 0,1 (default: the loop's)")
+    ap.add_argument("--budgets", default="", help="boundary budgets to compare, e.g. 0,1 (default: the configured one)")
     ap.add_argument("--set", action="append", default=[], help="a config override, KEY=VALUE")
     args = ap.parse_args()
     overrides = parse_sets(args.set)
@@ -159,7 +162,7 @@ def main() -> None:
         if chosen:
             curve(target, chosen, args.iterations, overrides, Path(tmp), budgets)
         for budget in budgets if args.job else []:
-            job(target, svgs[args.job], overrides, folder, with_budget(budget))
+            job(target, svgs[args.job], *with_budget(overrides, budget), folder)
 
 
 if __name__ == "__main__":

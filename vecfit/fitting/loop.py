@@ -13,7 +13,7 @@ import contextlib
 import gc
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable, Optional
 
 import torch
@@ -28,10 +28,11 @@ from vecfit.renderer.stopwatch import lap, phase
 from vecfit.scene import Scene
 
 from . import losses
+from .result import Result
 from .settings import PARAMETER_KINDS, Settings  # noqa: F401  (re-exported: the loop's settings)
 from .adam import Adam
 from .outline import OutlineCost
-from .rates import parameter_kinds
+from .rates import dense_point_rate, outline_density, parameter_kinds
 
 # The coarse level must leave each shape some pixels (8 x 8 on average), or its small shapes
 # get no useful gradient there: the 128-px peppers trace (705 shapes) lost 1 dB coarse.
@@ -40,10 +41,6 @@ MIN_COARSE_SIDE = 32  # and a target this small at half size is cheap enough at 
 # Pack the scene once per size and refresh only its floats (renderer/persistent.py); off
 # packs it on every iteration (tests compare the two).
 PERSISTENT_PACK = True
-# The Monte Carlo backward's boundary samples per pixel of the image at most: a dense trace's
-# outlines are several times as long as its image is wide, and past this budget the samples
-# go where the pixel adjoints are (RenderOptions.boundary_budget; still unbiased).
-BOUNDARY_BUDGET = 2.0
 
 @dataclass
 class Target:
@@ -103,19 +100,6 @@ class Step:
     scene: Scene
     target: "Target"
     reset: Callable[[torch.Tensor], None]
-
-
-@dataclass
-class Result:
-    losses: list            # loss of each iteration (before its step)
-    best_loss: float
-    iterations: int         # steps taken
-    seconds: float
-    interrupted: bool = False
-    skipped_steps: int = 0  # steps refused for a non-finite loss, gradient or parameter
-    parameters: dict = field(default_factory=dict)  # kind -> number of floats optimised
-    iteration_seconds: list = field(default_factory=list)  # wall time of each iteration
-    coarse_iterations: int = 0  # the first ones, fitted at half the size
 
 
 def _levels(target: Target, settings: Settings, shapes: int):
@@ -180,7 +164,13 @@ class _Fit:
         height, width = target.image.shape[:2]
         self.fine_from, self.levels = _levels(target, settings, len(scene.shapes))
         self.device = devices.device_name(devices.resolve(settings.device))  # "auto" settled once
-        self.kinds = kinds = parameter_kinds(scene, settings.lr, width, height, settings.fixed_alpha, keep_alpha)
+        self.density = outline_density(scene, width, height)
+        lr = dict(settings.lr)
+        if "points" in lr:
+            lr["points"] = dense_point_rate(float(lr["points"]), self.density, settings.dense_outline,
+                                            settings.dense_points)
+        self.point_rate = lr.get("points")
+        self.kinds = kinds = parameter_kinds(scene, lr, width, height, settings.fixed_alpha, keep_alpha)
         if not kinds:
             raise VecfitError("nothing to optimise: the scene has no parameters with a learning rate above 0")
         self.adam = Adam(kinds, settings.iterations, settings.lr_decay, settings.lr_warmup)
@@ -219,7 +209,7 @@ class _Fit:
             image = render(self.scene, w, h, samples=settings.samples, mode=settings.mode,
                            seed=settings.seed + iteration, background=self.target.background,
                            threads=settings.threads, boundary_samples=settings.boundary_samples,
-                           interior_samples=settings.interior_samples, boundary_budget=BOUNDARY_BUDGET,
+                           interior_samples=settings.interior_samples, boundary_budget=settings.boundary_budget,
                            device=self.device,
                            packed=self.packed(w, h))
             self.image = image.detach()
@@ -343,4 +333,5 @@ class _Fit:
         return Result(losses=curve, best_loss=self.best_loss, iterations=len(curve),
                       seconds=time.perf_counter() - start, interrupted=interrupted, skipped_steps=self.skipped,
                       parameters={k.name: int(k.flat.numel()) for k in kinds}, iteration_seconds=times,
-                      coarse_iterations=min(self.fine_from, len(curve)))
+                      coarse_iterations=min(self.fine_from, len(curve)), outline_density=self.density,
+                      point_rate=self.point_rate)

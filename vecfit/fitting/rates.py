@@ -10,7 +10,7 @@ import torch
 
 from vecfit.scene.geometry import local_bbox_size
 from vecfit.scene.placement import canvas_matrix, group_matrices, shape_matrices
-from vecfit.scene import LinearGradient, RadialGradient, Scene
+from vecfit.scene import LinearGradient, Path, RadialGradient, Scene
 
 from .adam import ParameterKind
 
@@ -103,3 +103,39 @@ def parameter_kinds(scene: Scene, lr: dict, width: int, height: int, fixed_alpha
                 offset += t.numel()
         kinds.append(kind)
     return kinds
+
+
+def outline_density(scene: Scene, width: int, height: int) -> float:
+    """Control-polygon length of the scene's paths, in pixels of a width x height image,
+    per pixel of it (closed subpaths include their closing edge). Illustrator's traces of
+    kitty and peppers: 0.22 and 0.20; vecfit's 3,000-path traces of skimage's photos:
+    0.6-0.8. The Monte Carlo backward's boundary samples are counted by this length."""
+    scales = shape_pixel_scales(scene, width, height)
+    total = 0.0
+    for shape, scale in zip(scene.shapes, scales):
+        g = shape.geometry
+        if not isinstance(g, Path):
+            continue
+        p = g.points.detach().double().numpy() if isinstance(g.points, torch.Tensor) else np.asarray(g.points, np.float64)
+        for (first, count, closed), (p0, n) in zip(g.subpaths, g.subpath_point_ranges()):
+            q = p[p0:p0 + n]
+            if closed and n > 1:
+                q = np.concatenate([q, q[:1]])
+            total += scale * float(np.sqrt(((q[1:] - q[:-1]) ** 2).sum(1)).sum())
+    return total / max(width * height, 1)
+
+
+def dense_point_rate(rate: float, density: float, dense_outline: float, dense_points: float) -> float:
+    """The point rate (pixels a step) for a scene of this outline_density: ``rate`` up to
+    ``dense_outline``, falling linearly to ``dense_points`` at twice that, never above
+    ``rate`` (dense_outline 0: always ``rate``).
+
+    Where outlines are dense, neighbouring shapes' noisy steps push on the same pixels and
+    control polygons grow (coffee's 3,000-path trace: 2.2x over a default run), and each
+    iteration costs more. At 1.25 px, trace's own rate, the run took 79.8 s for +7.04 dB
+    against 109.5 s for +6.73 dB at 2.0; on Illustrator's sparse traces 2.0 still gains
+    0.3-0.4 dB more, so the rate follows the density (benchmarks/RESULTS.md, "Dense scenes")."""
+    if dense_outline <= 0 or density <= dense_outline:
+        return rate
+    share = min((density - dense_outline) / dense_outline, 1.0)
+    return min(rate, rate + share * (dense_points - rate))

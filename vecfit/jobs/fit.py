@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +13,7 @@ import numpy as np
 from vecfit import __version__
 from vecfit.errors import VecfitError
 from vecfit.fitting.metrics import compare, to_rgb
+from vecfit.fitting.result import Result
 from vecfit.io.colors import fitting_background
 from vecfit.io.images import downscaled, image_rgba
 from vecfit.io.report import save_comparison, save_report
@@ -111,21 +111,7 @@ def _render_full(scene, w, h, config):
                       threads=config["threads"], device=config["device"])
 
 
-@dataclass
-class _NotOptimised:
-    """What the report takes from the loop's Result (vecfit.fitting.loop) for a Scene of
-    NumPy arrays, written as it is (optimize.iterations 0): the loop, and torch, never run."""
-    parameters: dict
-    losses: list = field(default_factory=list)
-    iterations: int = 0
-    coarse_iterations: int = 0
-    interrupted: bool = False
-    skipped_steps: int = 0
-    seconds: float = 0.0
-    iteration_seconds: list = field(default_factory=list)
-
-
-def _not_optimised(scene: Scene, opt: dict) -> _NotOptimised:
+def _not_optimised(scene: Scene, opt: dict) -> Result:
     """The counts the loop would report for 0 iterations (vecfit.fitting.rates.parameter_kinds:
     the kinds with a positive rate and tensors), and its refusal of a scene without any."""
     if opt["iterations"] != 0:
@@ -134,7 +120,7 @@ def _not_optimised(scene: Scene, opt: dict) -> _NotOptimised:
               if float(opt["lr"].get(name, 0.0)) > 0 and tensors}
     if not counts:
         raise VecfitError("nothing to optimise: the scene has no parameters with a learning rate above 0")
-    return _NotOptimised(parameters=counts)
+    return Result(parameters=counts)
 
 
 def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, config: dict, outputs: Outputs,
@@ -206,6 +192,10 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         "coarse_iterations": result.coarse_iterations,  # their losses are at half the size
         "interrupted": result.interrupted,
         "skipped_steps": result.skipped_steps,
+        # the point rate after the density rule (configs/refine.toml: dense_outline), and
+        # the density it followed
+        "point_rate": result.point_rate,
+        "outline_density": result.outline_density,
         "seconds": {"total": seconds, "optimize": result.seconds,
                     "per_iteration": result.seconds / max(result.iterations, 1),
                     "iterations": [round(t, 4) for t in result.iteration_seconds]},
