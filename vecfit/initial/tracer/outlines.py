@@ -27,19 +27,24 @@ def crack_outlines(mask: np.ndarray, origin=(0, 0)) -> list[np.ndarray]:
     return [c[:, 0, :].astype(np.float64) * 0.5 + (x0 - 0.5, y0 - 0.5) for c in contours]
 
 
-def shape_outlines(mask: np.ndarray, transparent: np.ndarray, origin=(0, 0)):
+def shape_outlines(mask: np.ndarray, below: np.ndarray, origin=(0, 0)):
     """The outlines of the shape that draws a region, and which of them are holes.
 
-    A hole of the region that holds other regions needs no outline: they are drawn later,
-    on top. Only its transparent pixels must be cut out, or the shape would paint over
-    them (a ring on a transparent canvas would become a disc). So the shape is the mask
-    with its holes filled except for their transparent pixels; its boundaries alternate,
-    outline, hole, island in the hole..., and are filled even-odd. Returns (outlines as
-    crack_outlines gives them, a bool per outline: is it a hole)."""
-    # (filling holes costs more than the test for transparency, which most regions fail)
-    filled = fill_holes(mask) if transparent.any() else None
-    cut = filled & ~mask & transparent if filled is not None else None
-    if cut is None or not cut.any():  # nothing to cut: the outer outlines alone (the usual case)
+    below: the pixels the shape must leave showing: transparent ones and those of
+    regions drawn before it. A hole of the region that holds only regions drawn later
+    needs no outline: they go on top. But the filled outline must not paint over what
+    lies below: transparent pixels in a hole (a ring on a transparent canvas would
+    become a disc), nor pixels of an earlier region that the outline encloses although
+    that region reaches outside. The last happens because outlines join pixels that
+    touch at a corner: where two regions cross at a corner (both 8-connected through
+    it), or a region grown by the overlap closes a corner gap, the outline of one
+    encloses part of the other, which was drawn first, being larger. Those pixels are
+    cut out: the shape is the mask with its holes filled except for them; its
+    boundaries alternate, outline, hole, island in the hole..., and are filled even-odd.
+    Returns (outlines as crack_outlines gives them, a bool per outline: is it a hole)."""
+    filled = fill_holes(mask)
+    cut = filled & ~mask & below
+    if not cut.any():  # nothing to cut: the outer outlines alone (the usual case)
         found = crack_outlines(mask, origin)
         return found, [False] * len(found)
     outlines, holes = [], []

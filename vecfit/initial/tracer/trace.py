@@ -91,9 +91,11 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
         if i == background:
             continue
         mask, (x0, y0) = masks.pop(i)
-        # pixels no region draws (transparent, or an isolated speck that was dropped)
-        transparent = regions.labels[y0:y0 + mask.shape[0], x0:x0 + mask.shape[1]] < 0
-        found, is_hole = shape_outlines(mask, transparent, (x0, y0))
+        # what the shape must not paint over: pixels no region draws (transparent, or an
+        # isolated speck that was dropped) and those of the regions drawn before it
+        crop = regions.labels[y0:y0 + mask.shape[0], x0:x0 + mask.shape[1]]
+        below = (crop < 0) | (rank[np.maximum(crop, 0)] < j)
+        found, is_hole = shape_outlines(mask, below, (x0, y0))
         shapes.append((i, slice(len(outlines), len(outlines) + len(found))))
         outlines.extend(found)
         holes.extend(is_hole)
