@@ -234,22 +234,29 @@ def test_regions_crossing_at_a_corner_are_both_drawn(tmp_path):
 
 
 def test_shape_leaves_what_is_drawn_below_showing():
-    """shape_outlines on a ring enclosing pixels drawn before it (`below`), with an island
-    of the ring's own colour inside them: outline, hole, island, filled even-odd."""
+    """shape_outlines on a ring enclosing pixels drawn before it, with an island of the
+    ring's own colour inside them: outline, hole, island, filled even-odd. A piece of an
+    earlier region under min_piece pixels is not cut out; transparent pixels always are."""
     mask = np.zeros((12, 12), bool)
     mask[1:11, 1:11] = True
     mask[3:9, 3:9] = False
     mask[5:7, 5:7] = True        # the island
-    below = np.zeros_like(mask)
-    below[3:9, 3:9] = True       # an earlier region fills the ring's hole...
-    below[3, 3] = False          # ...but for a pixel of a region drawn later
-    outlines, holes = shape_outlines(mask, below & ~mask, (10, 20))
+    earlier = np.zeros_like(mask)
+    earlier[3:9, 3:9] = True     # an earlier region fills the ring's hole (32 pixels)...
+    earlier[3, 3] = False        # ...but for a pixel of a region drawn later
+    earlier &= ~mask
+    none = np.zeros_like(mask)
+    outlines, holes = shape_outlines(mask, none, earlier, (10, 20), min_piece=8)
     assert holes == [False, True, False]
     assert [round(polygon_area(p)) for p in outlines] == [100, 35, 4]
     assert min(p[:, 0].min() for p in outlines) == 11 and min(p[:, 1].min() for p in outlines) == 21
     # nothing below: the ring's outer outline alone, its hole filled (later regions go on top)
-    outlines, holes = shape_outlines(mask, np.zeros_like(mask), (0, 0))
-    assert holes == [False] and round(polygon_area(outlines[0])) == 100
+    for transparent, earlier_pixels, piece in [(none, none, 0), (none, earlier, 33)]:
+        outlines, holes = shape_outlines(mask, transparent, earlier_pixels, (0, 0), min_piece=piece)
+        assert holes == [False] and round(polygon_area(outlines[0])) == 100
+    # as transparent pixels, the same hole is cut out at any size
+    outlines, holes = shape_outlines(mask, earlier, none, (0, 0), min_piece=33)
+    assert holes == [False, True, False]
 
 
 def test_overlap_closes_seams_on_a_photo(tmp_path):

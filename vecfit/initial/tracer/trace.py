@@ -3,8 +3,9 @@
 Pipeline: colour quantisation (k-means in CIELAB) -> connected regions of each colour ->
 speckles and slivers merged into neighbours, then merges until the path budget holds ->
 regions stacked by filled area, largest first, each drawn as its filled outer outline
-(less any transparent pixels it encloses, cut out even-odd), grown a pixel under the
-regions on top of it -> outlines fitted with cubic Béziers.
+(less any transparent pixels, or pieces of regions drawn before it, that it encloses,
+cut out even-odd), grown a pixel under the regions on top of it -> outlines fitted with
+cubic Béziers.
 """
 from __future__ import annotations
 
@@ -94,8 +95,9 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
         # what the shape must not paint over: pixels no region draws (transparent, or an
         # isolated speck that was dropped) and those of the regions drawn before it
         crop = regions.labels[y0:y0 + mask.shape[0], x0:x0 + mask.shape[1]]
-        below = (crop < 0) | (rank[np.maximum(crop, 0)] < j)
-        found, is_hole = shape_outlines(mask, below, (x0, y0))
+        transparent = crop < 0
+        earlier = ~transparent & (rank[np.maximum(crop, 0)] < j)
+        found, is_hole = shape_outlines(mask, transparent, earlier, (x0, y0), s.min_area)
         shapes.append((i, slice(len(outlines), len(outlines) + len(found))))
         outlines.extend(found)
         holes.extend(is_hole)
