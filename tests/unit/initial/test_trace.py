@@ -240,22 +240,21 @@ def test_shape_leaves_what_is_drawn_below_showing():
     mask = np.zeros((12, 12), bool)
     mask[1:11, 1:11] = True
     mask[3:9, 3:9] = False
-    mask[5:7, 5:7] = True        # the island
-    earlier = np.zeros_like(mask)
-    earlier[3:9, 3:9] = True     # an earlier region fills the ring's hole (32 pixels)...
-    earlier[3, 3] = False        # ...but for a pixel of a region drawn later
-    earlier &= ~mask
-    none = np.zeros_like(mask)
-    outlines, holes = shape_outlines(mask, none, earlier, (10, 20), min_piece=8)
+    mask[5:7, 5:7] = True            # the island
+    ranks = np.full(mask.shape, 5)   # the ring's own rank, and around it what it covers
+    ranks[3:9, 3:9] = 2              # an earlier region fills the ring's hole (32 pixels)...
+    ranks[3, 3] = 7                  # ...but for a pixel of a region drawn later
+    outlines, holes = shape_outlines(mask, ranks, 5, (10, 20), min_piece=8)
     assert holes == [False, True, False]
     assert [round(polygon_area(p)) for p in outlines] == [100, 35, 4]
     assert min(p[:, 0].min() for p in outlines) == 11 and min(p[:, 1].min() for p in outlines) == 21
-    # nothing below: the ring's outer outline alone, its hole filled (later regions go on top)
-    for transparent, earlier_pixels, piece in [(none, none, 0), (none, earlier, 33)]:
-        outlines, holes = shape_outlines(mask, transparent, earlier_pixels, (0, 0), min_piece=piece)
+    # the ring's outer outline alone, its hole filled: when what it encloses is drawn
+    # later (on top), or is an earlier piece under min_piece
+    for ring_rank, piece in [(1, 0), (5, 33)]:
+        outlines, holes = shape_outlines(mask, ranks, ring_rank, (0, 0), min_piece=piece)
         assert holes == [False] and round(polygon_area(outlines[0])) == 100
-    # as transparent pixels, the same hole is cut out at any size
-    outlines, holes = shape_outlines(mask, earlier, none, (0, 0), min_piece=33)
+    # transparent pixels are cut out at any size
+    outlines, holes = shape_outlines(mask, np.where(ranks == 2, -1, ranks), 5, (0, 0), min_piece=33)
     assert holes == [False, True, False]
 
 

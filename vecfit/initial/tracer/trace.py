@@ -88,16 +88,15 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     shapes, outlines, holes = [], [], []  # shapes: (region, its outlines' slice of `outlines`)
     drawn = [i for i in order.tolist() if i != background]
     masks = dict(zip(drawn, grown_masks(regions.labels, rank, drawn, boxes, int(s.overlap))))
+    drawn_rank = np.append(rank, -1)[regions.labels]  # each pixel's region's rank; -1: none
     for j, i in enumerate(order):
         if i == background:
             continue
         mask, (x0, y0) = masks.pop(i)
-        # what the shape must not paint over: pixels no region draws (transparent, or an
-        # isolated speck that was dropped) and those of the regions drawn before it
-        crop = regions.labels[y0:y0 + mask.shape[0], x0:x0 + mask.shape[1]]
-        transparent = crop < 0
-        earlier = ~transparent & (rank[np.maximum(crop, 0)] < j)
-        found, is_hole = shape_outlines(mask, transparent, earlier, (x0, y0), s.min_area)
+        # the shape must not paint over pixels no region draws (transparent, or an isolated
+        # speck that was dropped) nor, mostly, those of the regions drawn before it
+        ranks = drawn_rank[y0:y0 + mask.shape[0], x0:x0 + mask.shape[1]]
+        found, is_hole = shape_outlines(mask, ranks, j, (x0, y0), s.min_area)
         shapes.append((i, slice(len(outlines), len(outlines) + len(found))))
         outlines.extend(found)
         holes.extend(is_hole)
