@@ -3,6 +3,7 @@
     python benchmarks/trace.py [--budgets 250,500,1000,2000] [--images astronaut,...]
                                [--emoji N] [--repeats 3] [--overlap-check]
                                [--refine 1000[,...]] [--iterations N] [--set KEY=VALUE ...]
+                               [--colors-scan 16:128:8]
 
 For each image and path budget: the paths and segments written, the trace time in-process
 (median of --repeats; wall and the process's CPU time, which a machine shared with other
@@ -17,6 +18,10 @@ under their neighbours (overlap 0), which shows the seams that overlap closes. -
 runs the whole `vecfit trace` job (trace, then refine with the defaults) at budget B and
 scores the written SVG as resvg renders it, next to vecfit's own figures, with wall times,
 and where each run's iterations spend their time at its start and its end.
+--colors-scan FIRST:LAST:STEP traces each image at the default budget with each colour
+count (the k of the k-means) and scores the trace as resvg renders it: a colour count
+where a photo's PSNR falls well below its neighbours' shows a tracer bug that a
+particular clustering exposes (one painted the coffee in a cup white at 88 colours).
 """
 from __future__ import annotations
 
@@ -123,7 +128,12 @@ def main():
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--set", action="append", default=[],
                     help="with --refine: a config override, KEY=VALUE (e.g. optimize.coarse=0.3)")
+    ap.add_argument("--colors-scan", default="", help="FIRST:LAST:STEP colour counts, e.g. 16:128:8")
     args = ap.parse_args()
+    if args.colors_scan:
+        first, last, step = (int(v) for v in args.colors_scan.split(":"))
+        colors_scan(args.images.split(","), list(range(first, last + 1, step)))
+        return
     if args.refine:
         refine_table([int(b) for b in args.refine.split(",")], args.images.split(","),
                      args.iterations, args.threads, args.set)
@@ -172,6 +182,30 @@ def main():
             rows.append((r0["psnr"], r1["psnr"]))
             print(f"{name:16s} {r0['psnr']:8.2f} {r1['psnr']:8.2f}", flush=True)
         print(f"{'mean':16s} {np.mean([r[0] for r in rows]):8.2f} {np.mean([r[1] for r in rows]):8.2f}")
+
+
+def colors_scan(images, counts):
+    """PSNR by resvg (over white, float RGB) of each image traced with each colour count,
+    then each image's worst and default-setting figures."""
+    from common import resvg_rgb
+    from vecfit.initial.tracer import TraceSettings, trace_image
+
+    default = TraceSettings.defaults().colors
+    print(f"{'image':12s} " + " ".join(f"{k:>6d}" for k in counts))
+    worst = {}
+    with tempfile.TemporaryDirectory() as folder:
+        for name in images:
+            image = load(name)
+            rgb = image[..., :3].astype(np.float64)
+            row = {}
+            for k in sorted(set(counts) | {default}):
+                path = Path(folder) / "trace.svg"
+                path.write_text(trace_image(image, TraceSettings.defaults(colors=k)).svg)
+                row[k] = -10 * np.log10(np.mean((resvg_rgb(path, image.shape[1]) - rgb) ** 2))
+            print(f"{name:12s} " + " ".join(f"{row[k]:6.2f}" for k in counts), flush=True)
+            worst[name] = (min((row[k], k) for k in counts), row[default])
+    for name, ((value, k), at_default) in worst.items():
+        print(f"{name:12s} worst {value:.2f} dB at {k} colours; {at_default:.2f} dB at the default {default}")
 
 
 def refine_table(budgets, images, iterations, threads, sets=()):

@@ -27,18 +27,40 @@ def crack_outlines(mask: np.ndarray, origin=(0, 0)) -> list[np.ndarray]:
     return [c[:, 0, :].astype(np.float64) * 0.5 + (x0 - 0.5, y0 - 0.5) for c in contours]
 
 
-def shape_outlines(mask: np.ndarray, transparent: np.ndarray, origin=(0, 0)):
+def shape_outlines(mask: np.ndarray, ranks: np.ndarray, rank: int, origin=(0, 0),
+                   min_piece: float = 0):
     """The outlines of the shape that draws a region, and which of them are holes.
 
-    A hole of the region that holds other regions needs no outline: they are drawn later,
-    on top. Only its transparent pixels must be cut out, or the shape would paint over
-    them (a ring on a transparent canvas would become a disc). So the shape is the mask
-    with its holes filled except for their transparent pixels; its boundaries alternate,
-    outline, hole, island in the hole..., and are filled even-odd. Returns (outlines as
+    ranks: the drawing rank of the region at each pixel of the mask's box (-1 where no
+    region draws: transparent); rank: the rank of this shape's region.
+
+    A hole of the region that holds only regions drawn later needs no outline: they go
+    on top. But the filled outline must not paint over what lies below it: transparent
+    pixels in a hole (a ring on a transparent canvas would become a disc), nor pixels of
+    regions drawn before this one that the outline encloses although their region
+    reaches outside. That happens because outlines join pixels that touch at a corner:
+    where two regions cross at a corner (both 8-connected through it), or where a region
+    grown by the overlap closes a corner gap, the outline of one encloses part of the
+    other, which was drawn first, being larger. Those pixels are cut out, but for pieces
+    of earlier regions under `min_piece` pixels: like the specks the regions merged
+    away, they cost less error than the outlines that would cut them. The shape is the
+    mask with its holes filled except for the cut; its boundaries alternate, outline,
+    hole, island in the hole..., and are filled even-odd. Returns (outlines as
     crack_outlines gives them, a bool per outline: is it a hole)."""
-    # (filling holes costs more than the test for transparency, which most regions fail)
-    filled = fill_holes(mask) if transparent.any() else None
-    cut = filled & ~mask & transparent if filled is not None else None
+    filled = fill_holes(mask)
+    enclosed = filled & ~mask
+    cut = None
+    if enclosed.any():  # (most regions have no hole: they skip this)
+        below = ranks[enclosed]
+        cut = np.zeros_like(mask)
+        cut[enclosed] = below < 0  # transparent
+        covered = np.zeros_like(mask)
+        covered[enclosed] = (below >= 0) & (below < rank)
+        if covered.any():
+            _, pieces, stats, _ = cv2.connectedComponentsWithStats(covered.view(np.uint8), connectivity=8)
+            large = stats[:, cv2.CC_STAT_AREA] >= min_piece
+            large[0] = False  # the background label
+            cut |= large[pieces]
     if cut is None or not cut.any():  # nothing to cut: the outer outlines alone (the usual case)
         found = crack_outlines(mask, origin)
         return found, [False] * len(found)
@@ -67,7 +89,8 @@ def region_boxes(labels: np.ndarray, count: int) -> list:
 def drawing_order(labels: np.ndarray, count: int, boxes) -> np.ndarray:
     """Regions sorted by filled area (pixels plus holes), largest first: a region that
     encloses another always comes before it, so its holes need no cutting out where other
-    regions fill them (only their transparent pixels are cut, see shape_outlines)."""
+    regions fill them (only transparent pixels, and regions crossing it at a corner, are
+    cut: see shape_outlines)."""
     filled = np.zeros(count)
     for i, box in enumerate(boxes):
         mask = labels[box] == i

@@ -3,8 +3,9 @@
 Pipeline: colour quantisation (k-means in CIELAB) -> connected regions of each colour ->
 speckles and slivers merged into neighbours, then merges until the path budget holds ->
 regions stacked by filled area, largest first, each drawn as its filled outer outline
-(less any transparent pixels it encloses, cut out even-odd), grown a pixel under the
-regions on top of it -> outlines fitted with cubic Béziers.
+(less any transparent pixels, or pieces of regions drawn before it, that it encloses,
+cut out even-odd), grown a pixel under the regions on top of it -> outlines fitted with
+cubic Béziers.
 """
 from __future__ import annotations
 
@@ -87,13 +88,15 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     shapes, outlines, holes = [], [], []  # shapes: (region, its outlines' slice of `outlines`)
     drawn = [i for i in order.tolist() if i != background]
     masks = dict(zip(drawn, grown_masks(regions.labels, rank, drawn, boxes, int(s.overlap))))
+    drawn_rank = np.append(rank, -1)[regions.labels]  # each pixel's region's rank; -1: none
     for j, i in enumerate(order):
         if i == background:
             continue
         mask, (x0, y0) = masks.pop(i)
-        # pixels no region draws (transparent, or an isolated speck that was dropped)
-        transparent = regions.labels[y0:y0 + mask.shape[0], x0:x0 + mask.shape[1]] < 0
-        found, is_hole = shape_outlines(mask, transparent, (x0, y0))
+        # the shape must not paint over pixels no region draws (transparent, or an isolated
+        # speck that was dropped) nor, mostly, those of the regions drawn before it
+        ranks = drawn_rank[y0:y0 + mask.shape[0], x0:x0 + mask.shape[1]]
+        found, is_hole = shape_outlines(mask, ranks, j, (x0, y0), s.min_area)
         shapes.append((i, slice(len(outlines), len(outlines) + len(found))))
         outlines.extend(found)
         holes.extend(is_hole)
