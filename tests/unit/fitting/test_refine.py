@@ -448,25 +448,32 @@ def small_trace(tmp_path_factory):
 
 
 @pytest.mark.slow
-def test_coarse_to_fine_gains_like_full_size(small_trace, tmp_path):
+def test_coarse_to_fine_gains_like_full_size(small_trace, tmp_path, monkeypatch):
     """Half the iterations at half size, then full size: a small trace gains within 0.5 dB
-    of a full-size run of the same length, and the coarse iterations cost less (a quarter
-    of the pixels)."""
+    of a full-size run of the same length, and the coarse iterations render a quarter of
+    the pixels (what they save; the time itself is benchmarks/refine.py's to show)."""
+    from vecfit.fitting import loop
+
     image, svg = small_trace
     (tmp_path / "t.svg").write_text(svg)
     target = Target(torch.from_numpy(image), (1.0, 1.0, 1.0, 1.0))
-    gains, times, initial = {}, {}, None
+    sizes: list = []
+    real = loop.render
+    monkeypatch.setattr(loop, "render", lambda scene, w, h, **kw: sizes.append((w, h)) or real(scene, w, h, **kw))
+    gains, rendered, initial = {}, {}, None
     for coarse in (0.0, 0.5):
         scene = quiet_load(tmp_path / "t.svg")
+        sizes.clear()
         result = optimize(scene, target, Settings.defaults(iterations=60, threads=2, seed=3, coarse=coarse))
         assert len(result.losses) == len(result.iteration_seconds) == 60
         assert result.coarse_iterations == (30 if coarse else 0)
         initial = initial or result.losses[0]  # at full size (the first run has no coarse part)
         gains[coarse] = 10 * math.log10(initial / result.best_loss)
-        times[coarse] = result.iteration_seconds
+        rendered[coarse] = list(sizes)
     assert gains[0.5] > gains[0.0] - 0.5, gains
     assert gains[0.5] > 1.5, gains  # (measured: 2.11 dB at full size, 1.96 coarse to fine)
-    assert np.median(times[0.5][2:28]) < 0.8 * np.median(times[0.0][2:28]), times
+    assert rendered[0.0] == [(160, 106)] * 61  # 60 iterations and the last step's measure
+    assert rendered[0.5] == [(80, 53)] * 30 + [(160, 106)] * 31
 
 
 def test_coarse_needs_pixels_for_every_shape(small_peppers):
