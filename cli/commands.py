@@ -365,8 +365,6 @@ def trace(target, preset, paths, colors, min_area, tolerance, refine, output, re
 
     if not refine:
         options["iterations"] = 0  # the trace written as it is
-    else:
-        _import_torch_holding_ctrl_c()  # (the settings' checks import it too)
     config = _resolve_config("trace", preset, config_file, options, extra={"trace": {
         "paths": paths, "colors": colors, "min_area": min_area, "tolerance": tolerance}})
     if config["optimize"]["iterations"] > 0:

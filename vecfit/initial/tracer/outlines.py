@@ -11,7 +11,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from .labels import bounding_boxes, fill_holes
+from .labels import fill_holes
 
 
 def crack_outlines(mask: np.ndarray, origin=(0, 0)) -> list[np.ndarray]:
@@ -79,11 +79,6 @@ def shape_outlines(mask: np.ndarray, ranks: np.ndarray, rank: int, origin=(0, 0)
 def polygon_area(p: np.ndarray) -> float:
     x, y = p[:, 0], p[:, 1]
     return 0.5 * abs(float(x @ np.roll(y, -1) - y @ np.roll(x, -1)))
-
-
-def region_boxes(labels: np.ndarray, count: int) -> list:
-    """Bounding slices (rows, cols) of each region."""
-    return bounding_boxes(labels, count)
 
 
 def drawing_order(labels: np.ndarray, count: int, boxes) -> np.ndarray:

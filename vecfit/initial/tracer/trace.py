@@ -17,7 +17,8 @@ from vecfit.errors import VecfitError
 from vecfit.svg.numbers import hex_color
 
 from .bezier import fit_outlines
-from .outlines import drawing_order, grown_masks, region_boxes, shape_outlines
+from .labels import bounding_boxes
+from .outlines import drawing_order, grown_masks, shape_outlines
 from .quantize import OPAQUE, prefilter, quantize_colors
 from .regions import build_regions, palette_colors
 from .settings import TraceResult, TraceSettings, check_settings
@@ -76,7 +77,7 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     report("regions", 0.15)
     regions = build_regions(classes, rgb, int(s.paths), s.min_area, s.merge_thin)
     report("order", 0.35)
-    boxes = region_boxes(regions.labels, regions.count)
+    boxes = bounding_boxes(regions.labels, regions.count)  # each region's (rows, cols) slices
     order = drawing_order(regions.labels, regions.count, boxes)
     rank = np.empty(regions.count, np.int64)
     rank[order] = np.arange(regions.count)
