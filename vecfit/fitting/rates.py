@@ -134,8 +134,9 @@ def dense_point_rate(rate: float, density: float, dense_outline: float, dense_po
     Where outlines are dense, neighbouring shapes' noisy steps push on the same pixels and
     control polygons grow (coffee's 3,000-path trace: 2.2x over a default run), and each
     iteration costs more. At 1.25 px, trace's own rate, the run took 79.8 s for +7.04 dB
-    against 109.5 s for +6.73 dB at 2.0; on Illustrator's sparse traces 2.0 still gains
-    0.3-0.4 dB more, so the rate follows the density (benchmarks/RESULTS.md, "Dense scenes")."""
+    against 109.5 s for +6.73 dB at 2.0, and at 1.0 px (the default floor) 2-7% faster
+    again for 0.00-0.06 dB; on Illustrator's sparse traces 2.0 still gains 0.3-0.4 dB
+    more, so the rate follows the density (benchmarks/RESULTS.md, "Dense scenes")."""
     if dense_outline <= 0 or density <= dense_outline:
         return rate
     share = min((density - dense_outline) / dense_outline, 1.0)

@@ -48,10 +48,10 @@ def _target(size: int = 64) -> Target:
     return Target(torch.from_numpy(img), (1.0, 1.0, 1.0, 1.0))
 
 
-@pytest.mark.parametrize("count, rate", [(4, 2.0), (60, 1.25)])
+@pytest.mark.parametrize("count, rate", [(4, 2.0), (60, 1.0)])
 def test_the_loop_uses_and_reports_the_rate_of_the_scene(count, rate):
     """4 squares of 12 px: 0.047 px of outline per pixel (sparse: refine's 2 px); 60: 0.70
-    (dense: 1.25 px). Adam's first step moves each coordinate by its rate."""
+    (dense: 1 px, configs/refine.toml's dense_points). Adam's first step moves each coordinate by its rate."""
     scene = squares(count, 12.0)
     before = scene.shapes[0].geometry.points.clone()
     result = optimize(scene, _target(), Settings.defaults(iterations=1, lr_warmup=0, lr_decay=1.0, threads=1,
