@@ -1,5 +1,6 @@
 """Start-up: how long the command takes to answer when it has little to do, and whether it
-imported torch (over a second of start-up by itself).
+imported torch (over a second of start-up by itself). The commands run byte-compiled, as
+a user's install has them (common.user_environment).
 
     python benchmarks/startup.py [--repeats 7]
 
@@ -19,17 +20,17 @@ import time
 from pathlib import Path
 
 import resvg_py
-from common import SHARED
+from common import SHARED, user_environment
 
 ROOT = Path(__file__).resolve().parents[1]
 EMOJI = SHARED / "realworld" / "cases" / "noto-emoji-000.svg"
 
 
 def wall(argv: list[str], repeats: int) -> float:
-    times = []
+    times, env = [], user_environment()
     for _ in range(repeats):
         start = time.perf_counter()
-        subprocess.run(argv, capture_output=True, check=False)
+        subprocess.run(argv, capture_output=True, check=False, env=env)
         times.append(time.perf_counter() - start)
     return statistics.median(times)
 
