@@ -133,3 +133,11 @@ def test_batch_takes_the_effort_to_every_image_and_resume_sees_it(tmp_path):
     normal = run("batch", d, "-o", out, "--mode", "trace", "--config", user, "-q")
     assert normal.exit_code == EXIT_OK and "1 done" in normal.output  # another effort: redone
     assert json.loads((out / "a.report.json").read_text())["effort"] == "normal"
+
+
+def test_quick_trace_changes_the_tracer_too_and_normal_does_not():
+    """trace.toml's [efforts.quick.trace]: a short run starts from a closer trace."""
+    quick, normal = resolve("trace", effort="quick"), resolve("trace")
+    assert (quick["trace"]["overlap"], quick["trace"]["smoothing"]) == (2, 0.5)
+    assert (normal["trace"]["overlap"], normal["trace"]["smoothing"]) == (1, 1.0)
+    assert resolve("trace", effort="quick", overrides={"trace": {"overlap": 1}})["trace"]["overlap"] == 1
