@@ -6,6 +6,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <memory>
@@ -24,6 +25,7 @@
 #include "python/interrupt.h"
 #include "python/test_hooks.h"
 #include "scene/scene.h"
+#include "trace/merge.h"
 
 namespace py = pybind11;
 using namespace vf;
@@ -371,6 +373,35 @@ py::dict layout() {
     return l;
 }
 
+// The tracer's greedy region merger (trace/merge.h): (parent, alive) of each region.
+py::tuple merge_regions_py(const Array<double>& area, const Array<double>& sums, const Array<bool>& thin,
+                           const Array<int64_t>& pairs, double min_area, int64_t budget) {
+    MergeInput in;
+    in.count = (int64_t)area.size();
+    if (sums.size() != 3 * in.count || thin.size() != in.count || pairs.size() % 2 != 0)
+        throw std::invalid_argument("merge_regions: expected area [n], sums [n, 3], thin [n] and pairs [m, 2]");
+    in.area = area.data();
+    in.sums = sums.data();
+    in.thin = reinterpret_cast<const uint8_t*>(thin.data());
+    in.edges = (int64_t)pairs.size() / 2;
+    in.pairs = pairs.data();
+    for (int64_t k = 0; k < 2 * in.edges; ++k)
+        if (in.pairs[k] < 0 || in.pairs[k] >= in.count)
+            throw std::invalid_argument("merge_regions: pairs name a region out of range");
+    in.min_area = min_area;
+    in.budget = budget;
+    MergeResult r;
+    {
+        py::gil_scoped_release release;
+        r = merge_regions(in);
+    }
+    py::array_t<int64_t> parent(in.count);
+    py::array_t<bool> alive(in.count);
+    std::copy(r.parent.begin(), r.parent.end(), parent.mutable_data());
+    std::copy(r.alive.begin(), r.alive.end(), reinterpret_cast<uint8_t*>(alive.mutable_data()));
+    return py::make_tuple(parent, alive);
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_core, m) {
@@ -442,6 +473,9 @@ PYBIND11_MODULE(_core, m) {
             out[phase_name(p)] = phase_nanoseconds()[p].exchange(0) * 1e-9;
         return out;
     }, "Seconds spent in each of the core's phases since the last call (and resets them)");
+    m.def("merge_regions", &merge_regions_py,
+          "The tracer's greedy region merging (vecfit/initial/tracer/regions.py): (parent, alive) of each region",
+          py::arg("area"), py::arg("sums"), py::arg("thin"), py::arg("pairs"), py::arg("min_area"), py::arg("budget"));
     m.def("hardware_threads", &ThreadPool::hardware_threads);
     m.def("has_cuda", &gpu::compiled, "Whether this build has the CUDA kernels");
     m.def("cuda_device_count", &gpu::device_count, "CUDA devices usable now (0 without a CUDA build)");
