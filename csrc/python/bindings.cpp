@@ -25,6 +25,7 @@
 #include "python/interrupt.h"
 #include "python/test_hooks.h"
 #include "scene/scene.h"
+#include "trace/fit.h"
 #include "trace/merge.h"
 
 namespace py = pybind11;
@@ -373,6 +374,47 @@ py::dict layout() {
     return l;
 }
 
+// The tracer's Bézier fit of outline stretches (trace/fit.h): (segments [S, 4, 2], stretch of each).
+py::tuple fit_stretches_py(const Array<double>& points, const Array<double>& tangents, const Array<double>& heading,
+                           const Array<double>& arc, const Array<int64_t>& first, const Array<int64_t>& lengths,
+                           const Array<double>& t1, const Array<double>& t2, double tolerance, double max_turn,
+                           double newton_range, int newton_steps) {
+    FitInput in;
+    const int64_t m = (int64_t)heading.size(), k = (int64_t)first.size();
+    if (points.size() != 2 * m || tangents.size() != 2 * m || arc.size() != m || lengths.size() != k ||
+        t1.size() != 2 * k || t2.size() != 2 * k)
+        throw std::invalid_argument("fit_stretches: expected points and tangents [M, 2], heading and arc [M], "
+                                    "first and lengths [K], t1 and t2 [K, 2]");
+    for (int64_t i = 0; i < k; ++i)
+        if (lengths.data()[i] < 1 || first.data()[i] < 0 || first.data()[i] + lengths.data()[i] > m)
+            throw std::invalid_argument("fit_stretches: a stretch reaches outside the points");
+    if (!(tolerance > 0)) throw std::invalid_argument("fit_stretches: tolerance must be positive");
+    in.points = points.data();
+    in.tangents = tangents.data();
+    in.heading = heading.data();
+    in.arc = arc.data();
+    in.stretches = k;
+    in.first = first.data();
+    in.lengths = lengths.data();
+    in.t1 = t1.data();
+    in.t2 = t2.data();
+    in.tolerance = tolerance;
+    in.max_turn = max_turn;
+    in.newton_range = newton_range;
+    in.newton_steps = newton_steps;
+    FitResult r;
+    {
+        py::gil_scoped_release release;
+        r = fit_stretches(in);
+    }
+    const py::ssize_t s = (py::ssize_t)r.owner.size();
+    py::array_t<double> ctrl({s, (py::ssize_t)4, (py::ssize_t)2});
+    py::array_t<int64_t> owner(s);
+    std::copy(r.ctrl.begin(), r.ctrl.end(), ctrl.mutable_data());
+    std::copy(r.owner.begin(), r.owner.end(), owner.mutable_data());
+    return py::make_tuple(ctrl, owner);
+}
+
 // The tracer's greedy region merger (trace/merge.h): (parent, alive) of each region.
 py::tuple merge_regions_py(const Array<double>& area, const Array<double>& sums, const Array<bool>& thin,
                            const Array<int64_t>& pairs, double min_area, int64_t budget) {
@@ -473,6 +515,11 @@ PYBIND11_MODULE(_core, m) {
             out[phase_name(p)] = phase_nanoseconds()[p].exchange(0) * 1e-9;
         return out;
     }, "Seconds spent in each of the core's phases since the last call (and resets them)");
+    m.def("fit_stretches", &fit_stretches_py,
+          "The tracer's Bézier fit (vecfit/initial/tracer/bezier.py): (segments [S, 4, 2], stretch of each)",
+          py::arg("points"), py::arg("tangents"), py::arg("heading"), py::arg("arc"), py::arg("first"),
+          py::arg("lengths"), py::arg("t1"), py::arg("t2"), py::arg("tolerance"), py::arg("max_turn"),
+          py::arg("newton_range"), py::arg("newton_steps"));
     m.def("merge_regions", &merge_regions_py,
           "The tracer's greedy region merging (vecfit/initial/tracer/regions.py): (parent, alive) of each region",
           py::arg("area"), py::arg("sums"), py::arg("thin"), py::arg("pairs"), py::arg("min_area"), py::arg("budget"));
