@@ -42,13 +42,16 @@ class Loops:
         self.first = np.concatenate([[0], np.cumsum(lengths)[:-1]]).astype(np.int64)
         self.owner = np.repeat(np.arange(len(lengths)), lengths)
         self.pos = np.arange(len(points)) - self.first[self.owner]
+        # each point's loop's first point and length (shifted is called dozens of times)
+        self.start = self.first[self.owner]
+        self.size = self.lengths[self.owner]
 
     def shifted(self, by: int, rows=None) -> np.ndarray:
         """Index of the point `by` places further along each point's own loop (of the
         points `rows`, all by default)."""
-        owner = self.owner if rows is None else self.owner[rows]
-        pos = self.pos if rows is None else self.pos[rows]
-        return self.first[owner] + (pos + by) % self.lengths[owner]
+        if rows is None:
+            return self.start + (self.pos + by) % self.size
+        return self.start[rows] + (self.pos[rows] + by) % self.size[rows]
 
     def smoothed(self, sigma: float, which=None) -> np.ndarray:
         """Gaussian smoothing of each loop (sigma in samples; the kernel reaches at most

@@ -4,25 +4,37 @@ from __future__ import annotations
 import numpy as np
 
 from vecfit.svg.document import NewDocument, SvgDocument
-from vecfit.svg.pathdata import format_path_data
+from vecfit.svg.numbers import fmt_many
 
 DECIMALS = 2  # a trace is placed to a hundredth of a pixel, its refinement finer
 
 
-def path_data(subpaths) -> str:
-    """'M x y C ... Z' for each closed subpath of cubic segments [S, 4, 2] (each closed by
-    a Z after its last cubic, as the reader closes it: a line of zero length)."""
-    points, degrees, spans = [], [], []
-    for segs in subpaths:
-        if len(segs) == 0:
-            continue
-        spans.append((len(degrees), len(segs) + 1, True))
-        points.append(np.asarray(segs[:1, 0]))
-        points.append(np.asarray(segs[:, 1:]).reshape(-1, 2))
-        degrees += [3] * len(segs) + [1]
-    if not spans:
-        return ""
-    return format_path_data(np.concatenate(points), degrees, spans, decimals=DECIMALS, compact=True)
+def path_data_many(shapes) -> list[str]:
+    """The path data of each shape, a list of closed subpaths of cubic segments [S, 4, 2]:
+    'M x y C x y x y x y ... Z' for each subpath (closed by a Z after its last cubic, as
+    the reader closes it: a line of zero length), as format_path_data writes it (compact,
+    DECIMALS decimals). All shapes' numbers are formatted in one pass, and each segment's
+    text made by one call: a trace writes 50,000 numbers, and a call per path or per
+    number is what costs."""
+    subpaths = [segs for shape in shapes for segs in shape if len(segs)]
+    if not subpaths:
+        return ["" for _ in shapes]
+    segs = np.concatenate(subpaths).reshape(-1, 4, 2)
+    counts = np.array([len(sp) for sp in subpaths])
+    first = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    # the numbers of every segment's three points, then of every subpath's start
+    numbers = fmt_many(np.concatenate([segs[:, 1:].reshape(-1), segs[first, 0].reshape(-1)]), DECIMALS)
+    cubic = numbers[:6 * len(segs)]
+    cubics = list(map("C{} {} {} {} {} {}".format, *(cubic[k::6] for k in range(6))))
+    start = numbers[6 * len(segs):]
+    texts = [f"M{x} {y}" + "".join(cubics[a:a + n]) + "Z"
+             for x, y, a, n in zip(start[0::2], start[1::2], first.tolist(), counts.tolist())]
+    out, k = [], 0
+    for shape in shapes:
+        n = sum(1 for segs in shape if len(segs))
+        out.append("".join(texts[k:k + n]))
+        k += n
+    return out
 
 
 def new_document(width: int, height: int) -> NewDocument:
