@@ -27,6 +27,7 @@
 #include "scene/scene.h"
 #include "trace/fit.h"
 #include "trace/merge.h"
+#include "trace/subpixel.h"
 
 namespace py = pybind11;
 using namespace vf;
@@ -415,6 +416,54 @@ py::tuple fit_stretches_py(const Array<double>& points, const Array<double>& tan
     return py::make_tuple(ctrl, owner);
 }
 
+// The tracer's sub-pixel placement of outline edges (trace/subpixel.h): the points moved.
+py::array_t<double> refine_outlines_py(const Array<double>& points, const Array<int64_t>& lengths,
+                                       const Array<int64_t>& region, const Array<bool>& hole,
+                                       const Array<int32_t>& labels, const Array<int64_t>& rank,
+                                       const Array<double>& colors, const Array<float>& rgb,
+                                       const Array<float>& alpha, double min_contrast, double max_shift, int reach) {
+    SubpixelInput in;
+    in.points = (int64_t)points.size() / 2;
+    in.outlines = (int64_t)lengths.size();
+    in.regions = (int64_t)rank.size();
+    if (labels.ndim() != 2) throw std::invalid_argument("refine_outlines: labels must be [H, W]");
+    in.height = labels.shape(0);
+    in.width = labels.shape(1);
+    const int64_t pixels = in.width * in.height;
+    int64_t total = 0;
+    for (int64_t k = 0; k < in.outlines; ++k) total += lengths.data()[k] >= 0 ? lengths.data()[k] : -1;
+    if (points.size() % 2 != 0 || total != in.points || region.size() != in.outlines || hole.size() != in.outlines ||
+        colors.size() != 3 * in.regions || rgb.size() != 3 * pixels || alpha.size() != pixels || reach < 0)
+        throw std::invalid_argument("refine_outlines: expected points [M, 2] in outlines of the given lengths, "
+                                    "region and hole per outline, labels and alpha [H, W], rgb [H, W, 3], rank "
+                                    "and colors [R] and [R, 3], reach >= 0");
+    for (int64_t k = 0; k < in.outlines; ++k)
+        if (region.data()[k] < 0 || region.data()[k] >= in.regions)
+            throw std::invalid_argument("refine_outlines: an outline's region is out of range");
+    for (int64_t i = 0; i < pixels; ++i)
+        if (labels.data()[i] >= in.regions) throw std::invalid_argument("refine_outlines: a label is out of range");
+    in.xy = points.data();
+    in.lengths = lengths.data();
+    in.region = region.data();
+    in.hole = reinterpret_cast<const uint8_t*>(hole.data());
+    in.labels = labels.data();
+    in.rank = rank.data();
+    in.colors = colors.data();
+    in.rgb = rgb.data();
+    in.alpha = alpha.data();
+    in.min_contrast = min_contrast;
+    in.max_shift = max_shift;
+    in.reach = reach;
+    std::vector<double> moved;
+    {
+        py::gil_scoped_release release;
+        moved = refine_outlines(in);
+    }
+    py::array_t<double> out({(py::ssize_t)in.points, (py::ssize_t)2});
+    std::copy(moved.begin(), moved.end(), out.mutable_data());
+    return out;
+}
+
 // The tracer's greedy region merger (trace/merge.h): (parent, alive) of each region.
 py::tuple merge_regions_py(const Array<double>& area, const Array<double>& sums, const Array<bool>& thin,
                            const Array<int64_t>& pairs, double min_area, int64_t budget) {
@@ -520,6 +569,11 @@ PYBIND11_MODULE(_core, m) {
           py::arg("points"), py::arg("tangents"), py::arg("heading"), py::arg("arc"), py::arg("first"),
           py::arg("lengths"), py::arg("t1"), py::arg("t2"), py::arg("tolerance"), py::arg("max_turn"),
           py::arg("newton_range"), py::arg("newton_steps"));
+    m.def("refine_outlines", &refine_outlines_py,
+          "The tracer's sub-pixel placement of outline edges (vecfit/initial/tracer/subpixel.py): the points moved",
+          py::arg("points"), py::arg("lengths"), py::arg("region"), py::arg("hole"), py::arg("labels"),
+          py::arg("rank"), py::arg("colors"), py::arg("rgb"), py::arg("alpha"), py::arg("min_contrast"),
+          py::arg("max_shift"), py::arg("reach"));
     m.def("merge_regions", &merge_regions_py,
           "The tracer's greedy region merging (vecfit/initial/tracer/regions.py): (parent, alive) of each region",
           py::arg("area"), py::arg("sums"), py::arg("thin"), py::arg("pairs"), py::arg("min_area"), py::arg("budget"));
