@@ -27,6 +27,7 @@
 #include "scene/scene.h"
 #include "trace/fit.h"
 #include "trace/merge.h"
+#include "trace/stretches.h"
 #include "trace/subpixel.h"
 
 namespace py = pybind11;
@@ -464,6 +465,60 @@ py::array_t<double> refine_outlines_py(const Array<double>& points, const Array<
     return out;
 }
 
+// Stretches laid end to end (trace/stretches.h): their first points and lengths, checked.
+void check_stretches(int64_t points, const Array<int64_t>& first, const Array<int64_t>& lengths, const char* name) {
+    if (first.size() != lengths.size())
+        throw std::invalid_argument(std::string(name) + ": expected first and lengths of equal size");
+    for (py::ssize_t k = 0; k < first.size(); ++k)
+        if (lengths.data()[k] < 1 || first.data()[k] < 0 || first.data()[k] + lengths.data()[k] > points)
+            throw std::invalid_argument(std::string(name) + ": a stretch reaches outside the points");
+}
+
+py::array_t<double> points_array(const std::vector<double>& v) {
+    py::array_t<double> out({(py::ssize_t)(v.size() / 2), (py::ssize_t)2});
+    std::copy(v.begin(), v.end(), out.mutable_data());
+    return out;
+}
+
+py::array_t<double> smooth_stretches_py(const Array<double>& points, const Array<int64_t>& first,
+                                        const Array<int64_t>& lengths, const Array<double>& kernel) {
+    check_stretches((int64_t)points.size() / 2, first, lengths, "smooth_stretches");
+    if (kernel.size() % 2 != 1) throw std::invalid_argument("smooth_stretches: the kernel must have 2r + 1 weights");
+    std::vector<double> out;
+    {
+        py::gil_scoped_release release;
+        out = smooth_stretches(points.data(), (int64_t)first.size(), first.data(), lengths.data(), kernel.data(),
+                               (int64_t)kernel.size());
+    }
+    return points_array(out);
+}
+
+py::array_t<double> stretch_tangents_py(const Array<double>& points, const Array<int64_t>& first,
+                                        const Array<int64_t>& lengths, int64_t window) {
+    check_stretches((int64_t)points.size() / 2, first, lengths, "stretch_tangents");
+    std::vector<double> out;
+    {
+        py::gil_scoped_release release;
+        out = stretch_tangents(points.data(), (int64_t)first.size(), first.data(), lengths.data(), window);
+    }
+    return points_array(out);
+}
+
+py::array_t<double> group_medians_py(const Array<double>& values, const Array<int64_t>& group,
+                                     const Array<bool>& valid, const Array<bool>& wanted) {
+    const int64_t n = (int64_t)values.size(), groups = (int64_t)wanted.size();
+    if (group.size() != n || valid.size() != n)
+        throw std::invalid_argument("group_medians: expected values, group and valid of equal size");
+    for (int64_t i = 0; i < n; ++i)
+        if (group.data()[i] < 0 || group.data()[i] >= groups)
+            throw std::invalid_argument("group_medians: a group is out of range");
+    std::vector<double> out = group_medians(values.data(), group.data(), reinterpret_cast<const uint8_t*>(valid.data()),
+                                            n, reinterpret_cast<const uint8_t*>(wanted.data()), groups);
+    py::array_t<double> a((py::ssize_t)out.size());
+    std::copy(out.begin(), out.end(), a.mutable_data());
+    return a;
+}
+
 // The tracer's greedy region merger (trace/merge.h): (parent, alive) of each region.
 py::tuple merge_regions_py(const Array<double>& area, const Array<double>& sums, const Array<bool>& thin,
                            const Array<int64_t>& pairs, double min_area, int64_t budget) {
@@ -574,6 +629,15 @@ PYBIND11_MODULE(_core, m) {
           py::arg("points"), py::arg("lengths"), py::arg("region"), py::arg("hole"), py::arg("labels"),
           py::arg("rank"), py::arg("colors"), py::arg("rgb"), py::arg("alpha"), py::arg("min_contrast"),
           py::arg("max_shift"), py::arg("reach"));
+    m.def("smooth_stretches", &smooth_stretches_py,
+          "The tracer's stretches smoothed with a kernel, extended past their ends by point reflection, ends held",
+          py::arg("points"), py::arg("first"), py::arg("lengths"), py::arg("kernel"));
+    m.def("stretch_tangents", &stretch_tangents_py,
+          "Unit forward tangent at each point of the tracer's stretches, from the points `window` away",
+          py::arg("points"), py::arg("first"), py::arg("lengths"), py::arg("window"));
+    m.def("group_medians", &group_medians_py,
+          "np.median of the valid values of each wanted group, for groups with a valid value",
+          py::arg("values"), py::arg("group"), py::arg("valid"), py::arg("wanted"));
     m.def("merge_regions", &merge_regions_py,
           "The tracer's greedy region merging (vecfit/initial/tracer/regions.py): (parent, alive) of each region",
           py::arg("area"), py::arg("sums"), py::arg("thin"), py::arg("pairs"), py::arg("min_area"), py::arg("budget"));

@@ -1,7 +1,8 @@
 """The tracer's Bézier fit in the compiled core (csrc/trace/fit.cpp) gives, bit for bit,
 what the NumPy fit it replaced gave (kept here as the reference): on the outlines of a
 photo's colour regions, raw and moved off the pixel grid, at several tolerances, and on
-smooth and sharp synthetic curves; and bad input is refused."""
+smooth and sharp synthetic curves; likewise the stretches' smoothing and tangents and
+the spacing medians; and bad input is refused."""
 from __future__ import annotations
 
 import numpy as np
@@ -10,7 +11,8 @@ import skimage.data
 
 from vecfit import _core
 from vecfit.initial.tracer import bezier
-from vecfit.initial.tracer.bezier import MAX_TURN, NEWTON_RANGE, NEWTON_STEPS, fit_outlines
+from vecfit.initial.tracer.bezier import (MAX_TURN, NEWTON_RANGE, NEWTON_STEPS, Stretches, _medians, _unit,
+                                          fit_outlines)
 from vecfit.initial.tracer.outlines import crack_outlines
 from vecfit.initial.tracer.quantize import quantize_colors
 
@@ -197,6 +199,73 @@ def _fit_all(st: Stretches, s: np.ndarray, tangents: np.ndarray, t1, t2, tol: fl
     return ctrl[order], own[order]
 
 
+class ReferenceStretches:
+    """bezier.Stretches' smoothing and tangents as NumPy computed them."""
+
+    def __init__(self, points, lengths):
+        self.lengths = lengths.astype(np.int64)
+        self.first = np.concatenate([[0], np.cumsum(self.lengths)[:-1]]).astype(np.int64)
+        self.points = points
+        self.owner = np.repeat(np.arange(len(lengths)), self.lengths)
+        self.pos = np.arange(len(self.points)) - self.first[self.owner]
+
+    def smoothed(self, sigma: float) -> np.ndarray:
+        """Gaussian smoothing of each stretch, its ends held and the stretch extended past
+        them by point reflection (which keeps a straight run into a corner straight)."""
+        p = self.points
+        if sigma <= 0 or len(p) == 0:
+            return p.copy()
+        r = int(3 * sigma + 1)
+        k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
+        k /= k.sum()
+        # every stretch extended by r points at each end, all laid end to end
+        n = self.lengths
+        ext_len = n + 2 * r
+        ext_first = np.concatenate([[0], np.cumsum(ext_len)[:-1]])
+        owner = np.repeat(np.arange(len(n)), ext_len)
+        q = np.arange(ext_len.sum()) - ext_first[owner] - r  # index within the stretch
+        m = n[owner]
+        before, after = q < 0, q >= m
+        src = np.clip(np.where(before, -q, np.where(after, 2 * (m - 1) - q, q)), 0, m - 1)
+        start = self.first[owner]
+        ext = p[start + src]
+        ext[before] = 2 * p[start[before]] - ext[before]
+        ext[after] = 2 * p[start[after] + m[after] - 1] - ext[after]
+        # the weighted sums over every window of ext (contiguous slices), then each
+        # point's own window: where it begins in ext
+        windows = len(ext) - 2 * r
+        acc = np.zeros((windows, 2))
+        for j, w in enumerate(k):
+            acc += w * ext[j:j + windows]
+        out = acc[ext_first[self.owner] + self.pos]
+        ends = (self.pos == 0) | (self.pos == n[self.owner] - 1)
+        out[ends] = p[ends]
+        return out
+
+    def tangents(self, s: np.ndarray, window: int) -> np.ndarray:
+        """Unit forward tangent at each point, from the points `window` away along its
+        stretch (one-sided near the ends)."""
+        n = self.lengths[self.owner]
+        start = self.first[self.owner]
+        ahead = start + np.minimum(self.pos + window, n - 1)
+        behind = start + np.maximum(self.pos - window, 0)
+        return _unit(s[ahead] - s[behind])
+
+
+def reference_medians(values: np.ndarray, group: np.ndarray, valid: np.ndarray, wanted: np.ndarray) -> np.ndarray:
+    """np.median of the valid values of each group in `wanted` (a mask over the groups),
+    in group order, for groups with at least one value."""
+    values, group = values[valid], group[valid]
+    order = np.lexsort((values, group))
+    values, group = values[order], group[order]
+    count = np.bincount(group, minlength=len(wanted))
+    start = np.concatenate([[0], np.cumsum(count)[:-1]])
+    ids = np.flatnonzero(wanted & (count > 0))
+    lo = values[start[ids] + (count[ids] - 1) // 2]
+    hi = values[start[ids] + count[ids] // 2]
+    return np.where(count[ids] % 2 == 1, lo, (lo + hi) / 2)
+
+
 # ------------------------------------------------------------------------- the tests
 
 def outlines_of_a_photo(classes=24, crop=(slice(40, 200), slice(100, 300))):
@@ -261,3 +330,27 @@ def test_bad_input_is_refused():
         _core.fit_stretches(first=np.array([1]), lengths=np.array([3]), **args)
     with pytest.raises(ValueError, match="expected"):
         _core.fit_stretches(first=np.array([0, 1]), lengths=np.array([3]), **args)
+
+
+@pytest.mark.parametrize("sigma", [0.5, 2.0, 5.0])
+def test_stretch_smoothing_and_tangents_are_numpys(sigma):
+    rng = np.random.default_rng(int(sigma * 10))
+    lengths = rng.integers(1, 60, 300)
+    lengths[:5] = [1, 2, 3, 1, 2]  # stretches shorter than the kernel
+    points = np.cumsum(rng.normal(0, 0.5, (lengths.sum(), 2)), 0)
+    got, expected = Stretches(points, lengths), ReferenceStretches(points, lengths)
+    s = got.smoothed(sigma)
+    np.testing.assert_array_equal(s, expected.smoothed(sigma))
+    assert np.abs(s - points).max() > 0.1
+    for window in (1, 4):
+        np.testing.assert_array_equal(got.tangents(s, window), expected.tangents(s, window))
+
+
+def test_group_medians_are_numpys():
+    rng = np.random.default_rng(5)
+    group = np.sort(rng.integers(0, 400, 5000))
+    values = np.round(rng.normal(0.5, 0.2, 5000), 2)  # ties
+    valid, wanted = rng.random(5000) < 0.8, rng.random(400) < 0.7
+    got = _medians(values, group, valid, wanted)
+    np.testing.assert_array_equal(got, reference_medians(values, group, valid, wanted))
+    assert len(got) > 200

@@ -191,8 +191,6 @@ class Stretches:
         self.lengths = lengths.astype(np.int64)
         self.first = np.concatenate([[0], np.cumsum(self.lengths)[:-1]]).astype(np.int64)
         self.points = points
-        self.owner = np.repeat(np.arange(len(lengths)), self.lengths)     # stretch of each point
-        self.pos = np.arange(len(self.points)) - self.first[self.owner]  # index within it
 
     def smoothed(self, sigma: float) -> np.ndarray:
         """Gaussian smoothing of each stretch, its ends held and the stretch extended past
@@ -203,38 +201,12 @@ class Stretches:
         r = int(3 * sigma + 1)
         k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
         k /= k.sum()
-        # every stretch extended by r points at each end, all laid end to end
-        n = self.lengths
-        ext_len = n + 2 * r
-        ext_first = np.concatenate([[0], np.cumsum(ext_len)[:-1]])
-        owner = np.repeat(np.arange(len(n)), ext_len)
-        q = np.arange(ext_len.sum()) - ext_first[owner] - r  # index within the stretch
-        m = n[owner]
-        before, after = q < 0, q >= m
-        src = np.clip(np.where(before, -q, np.where(after, 2 * (m - 1) - q, q)), 0, m - 1)
-        start = self.first[owner]
-        ext = p[start + src]
-        ext[before] = 2 * p[start[before]] - ext[before]
-        ext[after] = 2 * p[start[after] + m[after] - 1] - ext[after]
-        # the weighted sums over every window of ext (contiguous slices), then each
-        # point's own window: where it begins in ext
-        windows = len(ext) - 2 * r
-        acc = np.zeros((windows, 2))
-        for j, w in enumerate(k):
-            acc += w * ext[j:j + windows]
-        out = acc[ext_first[self.owner] + self.pos]
-        ends = (self.pos == 0) | (self.pos == n[self.owner] - 1)
-        out[ends] = p[ends]
-        return out
+        return _core.smooth_stretches(np.ascontiguousarray(p, np.float64), self.first, self.lengths, k)
 
     def tangents(self, s: np.ndarray, window: int) -> np.ndarray:
         """Unit forward tangent at each point, from the points `window` away along its
         stretch (one-sided near the ends)."""
-        n = self.lengths[self.owner]
-        start = self.first[self.owner]
-        ahead = start + np.minimum(self.pos + window, n - 1)
-        behind = start + np.maximum(self.pos - window, 0)
-        return _unit(s[ahead] - s[behind])
+        return _core.stretch_tangents(np.ascontiguousarray(s, np.float64), self.first, self.lengths, int(window))
 
 
 def _basis(u: np.ndarray):
@@ -268,15 +240,8 @@ def _fit_all(st: Stretches, s: np.ndarray, tangents: np.ndarray, t1, t2, tol: fl
 def _medians(values: np.ndarray, group: np.ndarray, valid: np.ndarray, wanted: np.ndarray) -> np.ndarray:
     """np.median of the valid values of each group in `wanted` (a mask over the groups),
     in group order, for groups with at least one value."""
-    values, group = values[valid], group[valid]
-    order = np.lexsort((values, group))
-    values, group = values[order], group[order]
-    count = np.bincount(group, minlength=len(wanted))
-    start = np.concatenate([[0], np.cumsum(count)[:-1]])
-    ids = np.flatnonzero(wanted & (count > 0))
-    lo = values[start[ids] + (count[ids] - 1) // 2]
-    hi = values[start[ids] + count[ids] // 2]
-    return np.where(count[ids] % 2 == 1, lo, (lo + hi) / 2)
+    return _core.group_medians(np.ascontiguousarray(values, np.float64), np.ascontiguousarray(group, np.int64),
+                               np.ascontiguousarray(valid, bool), np.ascontiguousarray(wanted, bool))
 
 
 def fit_outlines(outlines: list[np.ndarray], tolerance: float, corner_angle: float,
