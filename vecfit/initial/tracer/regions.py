@@ -139,9 +139,13 @@ def merge_specks(comp, count, area, color, edges, min_area):
     a, b = a[speck], b[speck]
     d = color[a] - color[b]
     cost = area[a] * area[b] / (area[a] + area[b]) * (d * d).sum(1)
-    order = np.lexsort((cost, a))
-    a, b = a[order], b[order]
-    first = np.flatnonzero(np.r_[True, a[1:] != a[:-1]])  # cheapest neighbour of each speck
+    # the cheapest neighbour of each speck, of equal costs the first listed (what a
+    # stable sort by speck, then cost, puts first), without sorting all the edges
+    best = np.full(count, np.inf)
+    np.minimum.at(best, a, cost)
+    cheapest = np.flatnonzero(cost == best[a])
+    _, first = np.unique(a[cheapest], return_index=True)
+    first = cheapest[first]
     groups, labels = connected_groups(count, a[first], b[first])
     merged = np.where(comp >= 0, labels[np.maximum(comp, 0)], -1).astype(np.int32)
     return merged, groups
