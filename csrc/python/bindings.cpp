@@ -504,6 +504,39 @@ py::array_t<double> stretch_tangents_py(const Array<double>& points, const Array
     return points_array(out);
 }
 
+py::array_t<double> smooth_loops_py(const Array<double>& points, const Array<int64_t>& first,
+                                    const Array<int64_t>& lengths, const Array<int64_t>& reach,
+                                    const Array<double>& kernels, const Array<int64_t>& kernel_at) {
+    check_stretches((int64_t)points.size() / 2, first, lengths, "smooth_loops");
+    if (reach.size() != first.size()) throw std::invalid_argument("smooth_loops: expected a reach per loop");
+    for (py::ssize_t k = 0; k < reach.size(); ++k) {
+        const int64_t r = reach.data()[k];
+        if (r > 0 && (r >= kernel_at.size() || kernel_at.data()[r] < 0 ||
+                      kernel_at.data()[r] + 2 * r + 1 > (int64_t)kernels.size()))
+            throw std::invalid_argument("smooth_loops: a loop's reach has no kernel");
+    }
+    std::vector<double> out;
+    {
+        py::gil_scoped_release release;
+        out = smooth_loops(points.data(), (int64_t)first.size(), first.data(), lengths.data(), reach.data(),
+                           kernels.data(), kernel_at.data());
+    }
+    return points_array(out);
+}
+
+py::array_t<double> loop_window_min_py(const Array<double>& values, const Array<int64_t>& first,
+                                       const Array<int64_t>& lengths, int64_t window) {
+    check_stretches((int64_t)values.size(), first, lengths, "loop_window_min");
+    std::vector<double> out;
+    {
+        py::gil_scoped_release release;
+        out = loop_window_min(values.data(), (int64_t)first.size(), first.data(), lengths.data(), window);
+    }
+    py::array_t<double> a((py::ssize_t)out.size());
+    std::copy(out.begin(), out.end(), a.mutable_data());
+    return a;
+}
+
 py::array_t<double> group_medians_py(const Array<double>& values, const Array<int64_t>& group,
                                      const Array<bool>& valid, const Array<bool>& wanted) {
     const int64_t n = (int64_t)values.size(), groups = (int64_t)wanted.size();
@@ -635,6 +668,13 @@ PYBIND11_MODULE(_core, m) {
     m.def("stretch_tangents", &stretch_tangents_py,
           "Unit forward tangent at each point of the tracer's stretches, from the points `window` away",
           py::arg("points"), py::arg("first"), py::arg("lengths"), py::arg("window"));
+    m.def("smooth_loops", &smooth_loops_py,
+          "The tracer's closed loops each smoothed with the kernel of its reach, wrapping round",
+          py::arg("points"), py::arg("first"), py::arg("lengths"), py::arg("reach"), py::arg("kernels"),
+          py::arg("kernel_at"));
+    m.def("loop_window_min", &loop_window_min_py,
+          "For each point of the loops, the least value within `window` places either side along its loop",
+          py::arg("values"), py::arg("first"), py::arg("lengths"), py::arg("window"));
     m.def("group_medians", &group_medians_py,
           "np.median of the valid values of each wanted group, for groups with a valid value",
           py::arg("values"), py::arg("group"), py::arg("valid"), py::arg("wanted"));

@@ -2,7 +2,8 @@
 what the NumPy fit it replaced gave (kept here as the reference): on the outlines of a
 photo's colour regions, raw and moved off the pixel grid, at several tolerances, and on
 smooth and sharp synthetic curves; likewise the stretches' smoothing and tangents and
-the spacing medians; and bad input is refused."""
+the loops' smoothing, the sliding minimum of corner angles and the spacing medians; and
+bad input is refused."""
 from __future__ import annotations
 
 import numpy as np
@@ -11,8 +12,8 @@ import skimage.data
 
 from vecfit import _core
 from vecfit.initial.tracer import bezier
-from vecfit.initial.tracer.bezier import (MAX_TURN, NEWTON_RANGE, NEWTON_STEPS, Stretches, _medians, _unit,
-                                          fit_outlines)
+from vecfit.initial.tracer.bezier import (MAX_TURN, NEWTON_RANGE, NEWTON_STEPS, Loops, Stretches, _medians,
+                                          _unit, fit_outlines)
 from vecfit.initial.tracer.outlines import crack_outlines
 from vecfit.initial.tracer.quantize import quantize_colors
 
@@ -266,6 +267,50 @@ def reference_medians(values: np.ndarray, group: np.ndarray, valid: np.ndarray, 
     return np.where(count[ids] % 2 == 1, lo, (lo + hi) / 2)
 
 
+class ReferenceLoops(Loops):
+    """bezier.Loops' smoothing as NumPy computed it."""
+
+    def smoothed(self, sigma: float, which=None) -> np.ndarray:
+        """Gaussian smoothing of each loop (sigma in samples; the kernel reaches at most
+        half way round, and loops under 5 points stay as they are); of the loops
+        `which` (a mask) only, the others left as they are."""
+        out = self.points.copy()
+        if sigma <= 0:
+            return out
+        reach = np.minimum(int(3 * sigma + 1), (self.lengths - 1) // 2)
+        reach[self.lengths < 5] = 0
+        if which is not None:
+            reach[~which] = 0
+        for r in np.unique(reach[reach > 0]).tolist():
+            loops = np.flatnonzero(reach == r)
+            k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
+            k /= k.sum()
+            # the loops, each extended by r points at either end round itself, end to end:
+            # every window is then a contiguous slice
+            n = self.lengths[loops]
+            ext_n = n + 2 * r
+            ext_first = np.concatenate([[0], np.cumsum(ext_n)[:-1]])
+            which = np.repeat(np.arange(len(loops)), ext_n)
+            t = np.arange(ext_n.sum()) - ext_first[which] - r
+            ext = self.points[self.first[loops][which] + t % n[which]]
+            windows = len(ext) - 2 * r
+            acc = np.zeros((windows, 2))
+            for j, weight in enumerate(k):
+                acc += weight * ext[j:j + windows]
+            inside = t >= 0
+            inside[t >= n[which]] = False
+            rows = self.first[loops][which[inside]] + t[inside]
+            out[rows] = acc[np.flatnonzero(inside) - r]
+        return out
+
+
+def reference_window_min(loops, values, window):
+    sharpest = values.copy()
+    for j in range(-window, window + 1):
+        np.minimum(sharpest, values[loops.shifted(j)], out=sharpest)
+    return sharpest
+
+
 # ------------------------------------------------------------------------- the tests
 
 def outlines_of_a_photo(classes=24, crop=(slice(40, 200), slice(100, 300))):
@@ -354,3 +399,22 @@ def test_group_medians_are_numpys():
     got = _medians(values, group, valid, wanted)
     np.testing.assert_array_equal(got, reference_medians(values, group, valid, wanted))
     assert len(got) > 200
+
+
+@pytest.mark.parametrize("sigma", [0.5, 2.0, 6.0])
+def test_loop_smoothing_and_window_minimum_are_numpys(sigma):
+    rng = np.random.default_rng(int(sigma * 10))
+    lengths = rng.integers(3, 80, 300)
+    lengths[:4] = [3, 4, 5, 6]  # under 5 points: left alone; short ones: the kernel reaches half way
+    points = np.cumsum(rng.normal(0, 0.5, (lengths.sum(), 2)), 0)
+    which = rng.random(300) < 0.6
+    got, expected = Loops(points, lengths), ReferenceLoops(points, lengths)
+    for mask in (None, which):
+        s = got.smoothed(sigma, mask)
+        np.testing.assert_array_equal(s, expected.smoothed(sigma, mask))
+        assert np.abs(s - points).max() > 0.1
+    values = np.round(rng.normal(size=lengths.sum()), 1)
+    values[7] = np.nan
+    for window in (1, 3, 50):  # 50: round loops shorter than the window
+        np.testing.assert_array_equal(_core.loop_window_min(values, got.first, lengths, window),
+                                      reference_window_min(got, values, window))

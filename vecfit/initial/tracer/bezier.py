@@ -57,34 +57,24 @@ class Loops:
         """Gaussian smoothing of each loop (sigma in samples; the kernel reaches at most
         half way round, and loops under 5 points stay as they are); of the loops
         `which` (a mask) only, the others left as they are."""
-        out = self.points.copy()
         if sigma <= 0:
-            return out
+            return self.points.copy()
         reach = np.minimum(int(3 * sigma + 1), (self.lengths - 1) // 2)
         reach[self.lengths < 5] = 0
         if which is not None:
             reach[~which] = 0
+        # the kernel of each reach, end to end
+        kernels, kernel_at = [np.zeros(0)], np.full(max(int(reach.max(initial=0)), 0) + 1, -1, np.int64)
+        at = 0
         for r in np.unique(reach[reach > 0]).tolist():
-            loops = np.flatnonzero(reach == r)
             k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
             k /= k.sum()
-            # the loops, each extended by r points at either end round itself, end to end:
-            # every window is then a contiguous slice
-            n = self.lengths[loops]
-            ext_n = n + 2 * r
-            ext_first = np.concatenate([[0], np.cumsum(ext_n)[:-1]])
-            which = np.repeat(np.arange(len(loops)), ext_n)
-            t = np.arange(ext_n.sum()) - ext_first[which] - r
-            ext = self.points[self.first[loops][which] + t % n[which]]
-            windows = len(ext) - 2 * r
-            acc = np.zeros((windows, 2))
-            for j, weight in enumerate(k):
-                acc += weight * ext[j:j + windows]
-            inside = t >= 0
-            inside[t >= n[which]] = False
-            rows = self.first[loops][which[inside]] + t[inside]
-            out[rows] = acc[np.flatnonzero(inside) - r]
-        return out
+            kernels.append(k)
+            kernel_at[r] = at
+            at += len(k)
+        return _core.smooth_loops(np.ascontiguousarray(self.points, np.float64), self.first,
+                                  np.asarray(self.lengths, np.int64), np.asarray(reach, np.int64),
+                                  np.concatenate(kernels), kernel_at)
 
 
 def find_corners(loops: Loops, s: np.ndarray, window: int, corner_angle: float) -> list[np.ndarray]:
@@ -95,9 +85,8 @@ def find_corners(loops: Loops, s: np.ndarray, window: int, corner_angle: float) 
     b = s[loops.shifted(window)] - s
     cos = (a * b).sum(1) / np.maximum(np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1), 1e-12)
     angle = np.degrees(np.arccos(np.clip(cos, -1, 1)))
-    sharpest = angle.copy()
-    for j in range(-window, window + 1):
-        np.minimum(sharpest, angle[loops.shifted(j)], out=sharpest)
+    sharpest = _core.loop_window_min(np.ascontiguousarray(angle, np.float64), loops.first,
+                                     np.asarray(loops.lengths, np.int64), int(window))
     long_enough = (loops.lengths >= 4 * window)[loops.owner]
     cand = np.flatnonzero((angle < corner_angle) & (angle <= sharpest) & long_enough)
     out = [[] for _ in loops.lengths]
