@@ -1,12 +1,14 @@
 """The tracer's path data (svgtext.path_data_many) is what vecfit's path-data writer
-(vecfit.svg.pathdata.format_path_data) writes for the same closed cubic subpaths."""
+(vecfit.svg.pathdata.format_path_data) writes for the same closed cubic subpaths, and
+its numbers (format_hundredths) are fmt_many's."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
 from vecfit.errors import VecfitError
-from vecfit.initial.tracer.svgtext import DECIMALS, path_data_many
+from vecfit.initial.tracer.svgtext import DECIMALS, format_hundredths, path_data_many
+from vecfit.svg.numbers import fmt_many
 from vecfit.svg.pathdata import format_path_data
 
 
@@ -53,3 +55,19 @@ def test_no_shapes_and_empty_shapes():
 def test_non_finite_numbers_are_refused():
     with pytest.raises(VecfitError, match="non-finite"):
         path_data_many([[np.full((1, 4, 2), np.nan)]])
+
+
+def test_hundredths_are_fmt_manys():
+    rng = np.random.default_rng(1)
+    values = np.concatenate([
+        rng.uniform(-1000, 1000, 100_000),
+        np.round(rng.uniform(-1000, 1000, 20_000), 3),          # many half hundredths: ties
+        np.round(rng.uniform(-50, 50, 20_000), 2),              # whole hundredths
+        np.arange(-2000, 2000) * 0.005,                         # every half hundredth near 0
+        [0.0, -0.0, 1e-9, -1e-9, 0.004999, -0.004999, 0.005, -0.005, 0.015, 2.675, 1.005, 99.995,
+         -99.995, 1e9, -1e9, 123456789.125, 1e15, -3e17, 5e-324]])
+    got = format_hundredths(values)
+    assert got == fmt_many(values, 2)
+    assert "-0" not in got and "0" in got
+    with pytest.raises(VecfitError, match="non-finite"):
+        format_hundredths([1.0, np.inf])
