@@ -107,24 +107,30 @@ def drawing_order(labels: np.ndarray, count: int, boxes) -> np.ndarray:
 
 def grown_masks(labels: np.ndarray, rank: np.ndarray, regions, boxes, overlap: int):
     """grown_mask of each of `regions`, their corner notches filled all at once."""
-    grown = [grown_mask(labels, rank, i, boxes[i], overlap, notches=False) for i in regions]
+    ranks = np.append(rank, -1)[labels]  # each pixel's region's rank (-1: none), looked up once
+    grown = [grown_mask(labels, rank, i, boxes[i], overlap, notches=False, ranks=ranks) for i in regions]
     filled = fill_corner_notches_many([mask for mask, _ in grown])
     return [(mask, origin) for mask, (_, origin) in zip(filled, grown)]
 
 
-def grown_mask(labels: np.ndarray, rank: np.ndarray, i: int, box, overlap: int, notches: bool = True):
+def grown_mask(labels: np.ndarray, rank: np.ndarray, i: int, box, overlap: int, notches: bool = True,
+               ranks: np.ndarray | None = None):
     """Region i's mask, grown by `overlap` pixels into the regions drawn after it (on
     top). Two regions that meet side by side both have anti-aliased edges there, which
     would let the background show through as a faint seam; growing the lower one under
     the upper one hides it, and also absorbs the curve fit's error. Returns the mask (its
-    corner notches filled, with `notches`) and its (x0, y0) in the image."""
+    corner notches filled, with `notches`) and its (x0, y0) in the image. ranks: each
+    pixel's region's rank (-1 for none), if already at hand."""
     h, w = labels.shape
     r0, r1 = max(box[0].start - overlap, 0), min(box[0].stop + overlap, h)
     c0, c1 = max(box[1].start - overlap, 0), min(box[1].stop + overlap, w)
     crop = labels[r0:r1, c0:c1]
     mask = crop == i
     if overlap > 0:
-        later = np.where(crop >= 0, rank[np.maximum(crop, 0)], -1) > rank[i]
+        if ranks is None:
+            later = np.where(crop >= 0, rank[np.maximum(crop, 0)], -1) > rank[i]
+        else:
+            later = ranks[r0:r1, c0:c1] > rank[i]
         size = 2 * overlap + 1
         mask = mask | (cv2.dilate(mask.astype(np.uint8), np.ones((size, size), np.uint8)) > 0) & later
     return (fill_corner_notches(mask) if notches else mask), (c0, r0)
