@@ -63,17 +63,22 @@ std::vector<double> smooth_loops(const double* p, int64_t count, const int64_t* 
     int64_t total = 0;
     for (int64_t k = 0; k < count; ++k) total += lengths[k];
     std::vector<double> out(p, p + 2 * total);
+    std::vector<double> ext;
     for (int64_t k = 0; k < count; ++k) {
         const int64_t n = lengths[k], start = first[k], r = reach[k];
         if (r <= 0) continue;
         const double* kernel = kernels + kernel_at[r];
+        // the loop extended by r points at either end round itself: each window is a run
+        ext.resize(2 * (n + 2 * r));
+        for (int64_t q = 0; q < n + 2 * r; ++q) {
+            const int64_t t = ((q - r) % n + n) % n;
+            ext[2 * q] = p[2 * (start + t)];
+            ext[2 * q + 1] = p[2 * (start + t) + 1];
+        }
         for (int64_t i = 0; i < n; ++i)
             for (int c = 0; c < 2; ++c) {
                 double acc = 0.0;
-                for (int64_t j = 0; j <= 2 * r; ++j) {
-                    const int64_t t = ((i + j - r) % n + n) % n;
-                    acc += kernel[j] * p[2 * (start + t) + c];
-                }
+                for (int64_t j = 0; j <= 2 * r; ++j) acc += kernel[j] * ext[2 * (i + j) + c];
                 out[2 * (start + i) + c] = acc;
             }
     }
@@ -85,12 +90,15 @@ std::vector<double> loop_window_min(const double* values, int64_t count, const i
     int64_t total = 0;
     for (int64_t k = 0; k < count; ++k) total += lengths[k];
     std::vector<double> out(values, values + total);
+    std::vector<double> ext;
     for (int64_t k = 0; k < count; ++k) {
         const int64_t n = lengths[k], start = first[k];
+        ext.resize(n + 2 * window);  // the loop extended round itself, as in smooth_loops
+        for (int64_t q = 0; q < n + 2 * window; ++q) ext[q] = values[start + ((q - window) % n + n) % n];
         for (int64_t i = 0; i < n; ++i) {
             double m = values[start + i];
-            for (int64_t j = -window; j <= window; ++j) {
-                const double v = values[start + ((i + j) % n + n) % n];
+            for (int64_t j = 0; j <= 2 * window; ++j) {
+                const double v = ext[i + j];
                 if (std::isnan(v) || v < m) m = v;  // np.minimum: NaN wins
             }
             out[start + i] = m;

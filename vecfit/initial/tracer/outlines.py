@@ -22,13 +22,16 @@ def crack_outlines(mask: np.ndarray, origin=(0, 0)) -> list[np.ndarray]:
     return [c[:, 0, :].astype(np.float64) * 0.5 + (x0 - 0.5, y0 - 0.5) for c in _grid_contours(mask)]
 
 
+_CELL = np.ones((3, 3), np.uint8)  # a pixel's centre and the eight grid cells round it
+
+
 def _grid_contours(mask: np.ndarray):
     """crack_outlines' polygons in the cells of its grid (int32 [N, 1, 2]): cell j is at
     coordinate (j - 1) / 2 of the mask."""
     h, w = mask.shape
     grid = np.zeros((2 * h + 3, 2 * w + 3), np.uint8)
     grid[2:2 * h + 1:2, 2:2 * w + 1:2] = mask
-    grid = cv2.dilate(grid, np.ones((3, 3), np.uint8))
+    grid = cv2.dilate(grid, _CELL)
     contours, _ = cv2.findContours(grid, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     return contours
 
