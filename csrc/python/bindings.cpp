@@ -496,6 +496,7 @@ py::array_t<double> smooth_stretches_py(const Array<double>& points, const Array
 py::array_t<double> stretch_tangents_py(const Array<double>& points, const Array<int64_t>& first,
                                         const Array<int64_t>& lengths, int64_t window) {
     check_stretches((int64_t)points.size() / 2, first, lengths, "stretch_tangents");
+    if (window < 0) throw std::invalid_argument("stretch_tangents: window must not be negative");
     std::vector<double> out;
     {
         py::gil_scoped_release release;
@@ -527,6 +528,7 @@ py::array_t<double> smooth_loops_py(const Array<double>& points, const Array<int
 py::array_t<double> loop_window_min_py(const Array<double>& values, const Array<int64_t>& first,
                                        const Array<int64_t>& lengths, int64_t window) {
     check_stretches((int64_t)values.size(), first, lengths, "loop_window_min");
+    if (window < 0) throw std::invalid_argument("loop_window_min: window must not be negative");
     std::vector<double> out;
     {
         py::gil_scoped_release release;
