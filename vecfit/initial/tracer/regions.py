@@ -13,11 +13,12 @@ most similar neighbour 28.1 dB; into the neighbour with the longest shared borde
 """
 from __future__ import annotations
 
-import heapq
 from dataclasses import dataclass
 
 import cv2
 import numpy as np
+
+from vecfit import _core
 
 from .labels import bounding_boxes, connected_groups
 
@@ -60,16 +61,16 @@ def components(classes: np.ndarray) -> tuple[np.ndarray, int]:
     return comp, count
 
 
-def adjacency(comp: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
-    """Pairs (a < b) of 4-adjacent components and the length of their shared border."""
+def adjacency(comp: np.ndarray, count: int) -> np.ndarray:
+    """Pairs (a < b) of 4-adjacent components, sorted."""
     pairs = []
     for a, b in ((comp[:, :-1], comp[:, 1:]), (comp[:-1, :], comp[1:, :])):
         a, b = a.ravel(), b.ravel()
         keep = (a != b) & (a >= 0) & (b >= 0)
         a, b = a[keep].astype(np.int64), b[keep].astype(np.int64)
         pairs.append(np.minimum(a, b) * count + np.maximum(a, b))
-    keys, lengths = np.unique(np.concatenate(pairs), return_counts=True)
-    return np.stack([keys // count, keys % count], 1), lengths
+    keys = np.unique(np.concatenate(pairs))
+    return np.stack([keys // count, keys % count], 1)
 
 
 def interior(labels: np.ndarray) -> np.ndarray:
@@ -138,154 +139,50 @@ def merge_specks(comp, count, area, color, edges, min_area):
     a, b = a[speck], b[speck]
     d = color[a] - color[b]
     cost = area[a] * area[b] / (area[a] + area[b]) * (d * d).sum(1)
-    order = np.lexsort((cost, a))
-    a, b = a[order], b[order]
-    first = np.flatnonzero(np.r_[True, a[1:] != a[:-1]])  # cheapest neighbour of each speck
+    # the cheapest neighbour of each speck, of equal costs the first listed (what a
+    # stable sort by speck, then cost, puts first), without sorting all the edges
+    best = np.full(count, np.inf)
+    np.minimum.at(best, a, cost)
+    cheapest = np.flatnonzero(cost == best[a])
+    _, first = np.unique(a[cheapest], return_index=True)
+    first = cheapest[first]
     groups, labels = connected_groups(count, a[first], b[first])
     merged = np.where(comp >= 0, labels[np.maximum(comp, 0)], -1).astype(np.int32)
     return merged, groups
 
 
-class _Merger:
-    """Greedy region merging on the component adjacency graph.
+def merge_regions(area, color, thin, edges, min_area: float, budget: int) -> np.ndarray:
+    """Greedy region merging on the adjacency graph (edges: sorted pairs a < b), in the
+    compiled core (csrc/trace/merge.cpp): the cheapest merge first, until nothing must
+    merge (regions under min_area, thin ones) and at most `budget` regions are left.
 
-    Heap entries are (must_merge, cost, region, its version, target, target's version);
-    an entry is stale once either region changed, and is then recomputed when it comes
-    up rather than eagerly (a large region may have thousands of neighbours)."""
+    The heap holds one entry per live region, (must_merge, cost, region, its version,
+    target, target's version), ordered as that tuple; an entry is stale once either
+    region changed, and is then recomputed when it comes up rather than eagerly (a large
+    region may have thousands of neighbours). A region with no neighbour left is dropped
+    (at the cost of the white then showing), unless it is the last one. Returns the final
+    region of each one given, as compact indices (-1 where dropped)."""
+    parent, alive = _core.merge_regions(np.ascontiguousarray(area, np.float64),
+                                        np.ascontiguousarray(color * area[:, None], np.float64),
+                                        np.ascontiguousarray(thin, bool),
+                                        np.ascontiguousarray(edges, np.int64).reshape(-1, 2),
+                                        float(min_area), int(budget))
+    return roots(parent, alive)
 
-    def __init__(self, area, color, thin, edges, lengths, min_area):
-        n = len(area)
-        self.min_area = min_area
-        # plain Python floats: the merge loop touches them one at a time
-        self.area = area.tolist()
-        self.sum = (color * area[:, None]).tolist()
-        self.thin = thin.tolist()
-        self.small = (thin | (area < min_area)).tolist()  # must be merged, whatever the budget
-        self.parent = list(range(n))
-        self.alive = [True] * n
-        self.version = [0] * n
-        self.adj: list[dict[int, int]] = [dict() for _ in range(n)]
-        for (a, b), length in zip(edges.tolist(), lengths.tolist()):
-            self.adj[a][b] = length
-            self.adj[b][a] = length
-        self.live = n
-        self.heap = self._first_entries(area, color * area[:, None], edges)
-        heapq.heapify(self.heap)
 
-    def _first_entries(self, area, sums, edges) -> list:
-        """Every region's first heap entry, as push makes it, for all regions at once: the
-        cost of each edge both ways in push's own float arithmetic, and each region's
-        cheapest neighbour (of equal costs the lowest index, the first that push meets:
-        adjacency lists hold neighbours in ascending order)."""
-        n = len(area)
-        best, target = np.full(n, np.inf), np.full(n, -1, np.int64)
-        if len(edges):
-            r = np.concatenate([edges[:, 0], edges[:, 1]])
-            t = np.concatenate([edges[:, 1], edges[:, 0]])
-            ar, at = area[r], area[t]
-            d = [sums[r, k] / ar - sums[t, k] / at for k in range(3)]
-            cost = ar * at / (ar + at) * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-            order = np.lexsort((t, cost, r))
-            r, t, cost = r[order], t[order], cost[order]
-            first = np.r_[True, r[1:] != r[:-1]]
-            best[r[first]], target[r[first]] = cost[first], t[first]
-        entries = []
-        for i, (c, j) in enumerate(zip(best.tolist(), target.tolist())):
-            if j < 0:
-                c = self.cost(i, -1)
-            must = self.small[i] and (j >= 0 or self.area[i] < self.min_area)
-            entries.append((0 if must else 1, c, i, 0, j, 0))
-        return entries
-
-    def cost(self, r: int, t: int) -> float:
-        ar, (sr, sg, sb) = self.area[r], self.sum[r]
-        if t < 0:  # dropping an isolated region leaves white showing (composited over white)
-            return ((sr - ar) ** 2 + (sg - ar) ** 2 + (sb - ar) ** 2) / ar
-        at, (tr, tg, tb) = self.area[t], self.sum[t]
-        dr, dg, db = sr / ar - tr / at, sg / ar - tg / at, sb / ar - tb / at
-        return ar * at / (ar + at) * (dr * dr + dg * dg + db * db)
-
-    def push(self, r: int) -> None:
-        best, target = np.inf, -1
-        for t in self.adj[r]:
-            c = self.cost(r, t)
-            if c < best:
-                best, target = c, t
-        if target < 0:
-            best = self.cost(r, -1)
-        # an isolated sliver (a thin line on transparency) is not forced out: only specks are
-        must = self.small[r] and (target >= 0 or self.area[r] < self.min_area)
-        tv = self.version[target] if target >= 0 else 0
-        heapq.heappush(self.heap, (0 if must else 1, best, r, self.version[r], target, tv))
-
-    def run(self, budget: int) -> None:
-        """Merge until nothing must merge any more and at most `budget` regions are left."""
-        while self.heap:
-            must, cost, r, rv, t, tv = self.heap[0]
-            if must == 1 and self.live <= budget:
-                return
-            heapq.heappop(self.heap)
-            if not self.alive[r]:
-                continue
-            if rv != self.version[r] or (t >= 0 and (not self.alive[t] or tv != self.version[t])):
-                self.push(r)
-                continue
-            if t < 0:
-                if self.live == 1:  # never drop everything: a lone speck is the whole picture
-                    return
-                self.drop(r)
-            else:
-                self.merge(r, t, cost)
-
-    def drop(self, r: int) -> None:
-        self.alive[r] = False
-        self.parent[r] = -1
-        self.live -= 1
-
-    def merge(self, r: int, t: int, cost: float) -> None:
-        # the region with fewer neighbours is folded into the other (cheaper dict merge)
-        keep, gone = (t, r) if len(self.adj[t]) >= len(self.adj[r]) else (r, t)
-        # a sliver joined to a real region is real; two slivers together are still one
-        self.thin[keep] = self.thin[r] and self.thin[t]
-        self.area[keep] += self.area[gone]
-        self.sum[keep] = [a + b for a, b in zip(self.sum[keep], self.sum[gone])]
-        self.small[keep] = self.thin[keep] or self.area[keep] < self.min_area
-        self.alive[gone] = False
-        self.parent[gone] = keep
-        self.live -= 1
-        adj_keep = self.adj[keep]
-        for n, length in self.adj[gone].items():
-            if n == keep:
-                continue
-            adj_keep[n] = adj_keep.get(n, 0) + length
-            an = self.adj[n]
-            an[keep] = an.get(keep, 0) + an.pop(gone)
-            self.version[n] += 1
-        adj_keep.pop(gone, None)
-        self.adj[gone] = {}
-        self.version[keep] += 1
-        # Every live region keeps one entry in the heap. t's old entry is now stale and
-        # gets refreshed when it comes up; r's entry was just used up, so r needs a new one:
-        # exact when cheap, else a stale placeholder keyed by this merge's cost.
-        if keep == r:
-            if len(adj_keep) <= 64:
-                self.push(keep)
-            else:
-                heapq.heappush(self.heap, (0 if self.small[keep] else 1, cost, keep,
-                                           self.version[keep] - 1, -1, 0))
-
-    def roots(self) -> np.ndarray:
-        """Final region of each component (-1 where dropped), as compact indices."""
-        root = np.array(self.parent, np.int64)
-        for _ in range(64):  # path halving by array indexing until stable
-            nxt = np.where(root >= 0, root[np.maximum(root, 0)], -1)
-            if np.array_equal(nxt, root):
-                break
-            root = nxt
-        alive = np.flatnonzero(np.array(self.alive, bool))
-        compact = np.full(len(root), -1, np.int64)
-        compact[alive] = np.arange(len(alive))
-        return np.where(root >= 0, compact[np.maximum(root, 0)], -1)
+def roots(parent: np.ndarray, alive: np.ndarray) -> np.ndarray:
+    """Final region of each region (-1 where dropped), as compact indices, from the
+    region each was merged into (itself if kept, -1 if dropped)."""
+    root = np.asarray(parent, np.int64)
+    for _ in range(64):  # path halving by array indexing until stable
+        nxt = np.where(root >= 0, root[np.maximum(root, 0)], -1)
+        if np.array_equal(nxt, root):
+            break
+        root = nxt
+    alive = np.flatnonzero(alive)
+    compact = np.full(len(root), -1, np.int64)
+    compact[alive] = np.arange(len(alive))
+    return np.where(root >= 0, compact[np.maximum(root, 0)], -1)
 
 
 def build_regions(classes: np.ndarray, rgb: np.ndarray, budget: int, min_area: float,
@@ -297,17 +194,15 @@ def build_regions(classes: np.ndarray, rgb: np.ndarray, budget: int, min_area: f
     if count == 0:
         return Regions(comp, 0, np.zeros(0), np.zeros((0, 3)))
     area, color = region_stats(comp, count, rgb)
-    edges, lengths = adjacency(comp, count)
+    edges = adjacency(comp, count)
     if (area < min_area).any() and len(edges):
         comp, count = merge_specks(comp, count, area, color, edges, min_area)
         area, color = region_stats(comp, count, rgb)
-        edges, lengths = adjacency(comp, count)
+        edges = adjacency(comp, count)
     thin = np.zeros(count, bool)
     if merge_thin:
         thin = blends(thin_components(comp, count), edges, color, blend_tol)
-    merger = _Merger(area, color, thin, edges, lengths, min_area)
-    merger.run(budget)
-    lut = merger.roots()
+    lut = merge_regions(area, color, thin, edges, min_area, budget)
     labels = np.where(comp >= 0, lut[np.maximum(comp, 0)], -1).astype(np.int32)
     n = int(lut.max()) + 1 if len(lut) and lut.max() >= 0 else 0
     area, color = region_stats(labels, n, rgb)

@@ -23,7 +23,7 @@ from .quantize import OPAQUE, prefilter, quantize_colors
 from .regions import build_regions, palette_colors
 from .settings import TraceResult, TraceSettings, check_settings
 from .subpixel import refine_outlines
-from .svgtext import add_path, add_rect, new_document, path_data
+from .svgtext import add_path, add_rect, new_document, path_data_many
 
 
 def check_image(image) -> np.ndarray:
@@ -117,14 +117,13 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
         fills.add(hex_color(paint[background]))
         add_rect(document, "p0", w, h, hex_color(paint[background]))
         segments += 4
-    for i, sl in shapes:
-        subpaths = [sp for sp in fitted[sl] if len(sp)]
-        if not subpaths:
-            continue
+    painted = [(i, sl, [sp for sp in fitted[sl] if len(sp)]) for i, sl in shapes]
+    painted = [(i, sl, subpaths) for i, sl, subpaths in painted if subpaths]
+    for (i, sl, subpaths), d in zip(painted, path_data_many([subpaths for _, _, subpaths in painted])):
         fill = hex_color(paint[i])
         fills.add(fill)
         cut = any(holes[sl])
-        add_path(document, f"p{len(document.root)}", path_data(subpaths), fill, evenodd=cut)
+        add_path(document, f"p{len(document.root)}", d, fill, evenodd=cut)
         segments += sum(len(sp) for sp in subpaths)
     report("fit", 1.0)
     return TraceResult(document=document, paths=len(document.root), colors=len(fills),
