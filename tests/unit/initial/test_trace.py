@@ -4,6 +4,7 @@ from __future__ import annotations
 import re
 import warnings
 
+import cv2
 import numpy as np
 import pytest
 from skimage.metrics import peak_signal_noise_ratio
@@ -12,7 +13,7 @@ import vecfit
 from vecfit import VecfitError
 from vecfit.initial.tracer import TraceResult, TraceSettings, trace_image
 from vecfit.initial.tracer.bezier import bezier_at, fit_closed
-from vecfit.initial.tracer.outlines import polygon_area, shape_outlines
+from vecfit.initial.tracer.outlines import shape_outlines
 
 
 # ----------------------------------------------------------------------------- helpers
@@ -65,7 +66,6 @@ def count_shapes(svg: str) -> int:
 
 
 def small_photo(name: str, size) -> np.ndarray:
-    import cv2
     import skimage.data
 
     photo = cv2.resize(getattr(skimage.data, name)(), size, interpolation=cv2.INTER_AREA)
@@ -148,7 +148,6 @@ def test_transparent_background_stays_transparent(tmp_path):
     out = render(result, 64, 48, tmp_path, background=None)
     alpha = out[..., 3]
     # the fit may stray up to the tolerance (1 px) past the edge, not further
-    import cv2
     near = cv2.dilate((image[..., 3] > 0).astype(np.uint8), np.ones((5, 5), np.uint8)) > 0
     assert alpha[~near].max() == 0
     solid = cv2.erode((image[..., 3] == 1).astype(np.uint8), np.ones((5, 5), np.uint8)) > 0
@@ -167,7 +166,6 @@ def test_transparent_holes_are_cut_out(tmp_path):
     result = trace_image(image)
     assert result.paths == 2 and 'fill-rule="evenodd"' in result.svg
     out = render(result, 64, 64, tmp_path, background=None)
-    import cv2
     gap = cv2.erode((image[..., 3] == 0).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
     gap[:, :] &= np.hypot(*np.mgrid[-32:32, -32:32]) < 12  # the hole, not the outside
     assert gap.sum() > 60 and out[..., 3][gap].max() == 0
@@ -261,13 +259,13 @@ def test_shape_leaves_what_is_drawn_below_showing():
     ranks[3, 3] = 7                  # ...but for a pixel of a region drawn later
     outlines, holes = shape_outlines(mask, ranks, 5, (10, 20), min_piece=8)
     assert holes == [False, True, False]
-    assert [round(polygon_area(p)) for p in outlines] == [100, 35, 4]
+    assert [round(cv2.contourArea(p.astype(np.float32))) for p in outlines] == [100, 35, 4]
     assert min(p[:, 0].min() for p in outlines) == 11 and min(p[:, 1].min() for p in outlines) == 21
     # the ring's outer outline alone, its hole filled: when what it encloses is drawn
     # later (on top), or is an earlier piece under min_piece
     for ring_rank, piece in [(1, 0), (5, 33)]:
         outlines, holes = shape_outlines(mask, ranks, ring_rank, (0, 0), min_piece=piece)
-        assert holes == [False] and round(polygon_area(outlines[0])) == 100
+        assert holes == [False] and round(cv2.contourArea(outlines[0].astype(np.float32))) == 100
     # transparent pixels are cut out at any size
     outlines, holes = shape_outlines(mask, np.where(ranks == 2, -1, ranks), 5, (0, 0), min_piece=33)
     assert holes == [False, True, False]
@@ -363,7 +361,6 @@ def test_tracing_imports_no_torch():
 def test_lab_conversion_gives_the_known_values():
     """tracer/quantize.to_lab by the formulas: CIELAB of sRGB white, black, the primaries
     and mid grey (D65; Lindbloom's figures), and within OpenCV's interpolation of them."""
-    import cv2
 
     from vecfit.initial.tracer.quantize import to_lab
 

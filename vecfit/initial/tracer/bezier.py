@@ -33,6 +33,12 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return np.where(n > 1e-12, v / np.maximum(n, 1e-12), np.array([1.0, 0.0]))
 
 
+def gaussian_kernel(reach: int, sigma: float) -> np.ndarray:
+    """Normalised Gaussian weights of offsets -reach..reach (sigma in samples)."""
+    k = np.exp(-0.5 * (np.arange(-reach, reach + 1) / sigma) ** 2)
+    return k / k.sum()
+
+
 class Loops:
     """Closed polylines stored end to end (points [M, 2]), with each point's outline and
     its neighbours along it, so that per-outline work runs on all outlines at once."""
@@ -67,8 +73,7 @@ class Loops:
         kernels, kernel_at = [np.zeros(0)], np.full(max(int(reach.max(initial=0)), 0) + 1, -1, np.int64)
         at = 0
         for r in np.unique(reach[reach > 0]).tolist():
-            k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
-            k /= k.sum()
+            k = gaussian_kernel(r, sigma)
             kernels.append(k)
             kernel_at[r] = at
             at += len(k)
@@ -189,9 +194,7 @@ class Stretches:
         p = self.points
         if sigma <= 0 or len(p) == 0:
             return p.copy()
-        r = int(3 * sigma + 1)
-        k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
-        k /= k.sum()
+        k = gaussian_kernel(int(3 * sigma + 1), sigma)
         return _core.smooth_stretches(np.ascontiguousarray(p, np.float64), self.first, self.lengths, k)
 
     def tangents(self, s: np.ndarray, window: int) -> np.ndarray:

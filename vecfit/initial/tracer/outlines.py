@@ -85,16 +85,6 @@ def shape_outlines(mask: np.ndarray, ranks: np.ndarray, rank: int, origin=(0, 0)
     return outlines, holes
 
 
-def polygon_area(p: np.ndarray) -> float:
-    if len(p) == 0:
-        return 0.0
-    x, y = p[:, 0], p[:, 1]
-    # the shoelace sum, its closing edge added apart (np.roll costs more than the sums);
-    # on outlines with vertices every half pixel every term and sum is exact
-    cross = x[:-1] @ y[1:] - y[:-1] @ x[1:] + (x[-1] * y[0] - y[-1] * x[0])
-    return 0.5 * abs(float(cross))
-
-
 def drawing_order(labels: np.ndarray, count: int, boxes) -> np.ndarray:
     """Regions sorted by filled area (pixels plus holes), largest first: a region that
     encloses another always comes before it, so its holes need no cutting out where other
@@ -103,40 +93,35 @@ def drawing_order(labels: np.ndarray, count: int, boxes) -> np.ndarray:
     filled = np.zeros(count)
     for i, box in enumerate(boxes):
         # the outlines' areas in grid cells (a quarter pixel each): on integer vertices
-        # every sum is exact, so this is polygon_area of crack_outlines to the last bit
+        # every sum is exact, so this is the area of crack_outlines' polygons to the bit
         filled[i] = 0.25 * sum(cv2.contourArea(c) for c in _grid_contours(labels[box] == i))
     return np.argsort(-filled, kind="stable")
 
 
-def grown_masks(labels: np.ndarray, rank: np.ndarray, regions, boxes, overlap: int):
-    """grown_mask of each of `regions`, their corner notches filled all at once."""
-    ranks = np.append(rank, -1)[labels]  # each pixel's region's rank (-1: none), looked up once
-    grown = [grown_mask(labels, rank, i, boxes[i], overlap, notches=False, ranks=ranks) for i in regions]
+def grown_masks(labels: np.ndarray, rank: np.ndarray, ranks: np.ndarray, regions, boxes, overlap: int):
+    """grown_mask of each of `regions`, their corner notches filled all at once (rank:
+    each region's drawing rank; ranks: each pixel's region's, -1 where none)."""
+    grown = [grown_mask(labels, ranks, i, rank[i], boxes[i], overlap) for i in regions]
     filled = fill_corner_notches_many([mask for mask, _ in grown])
     return [(mask, origin) for mask, (_, origin) in zip(filled, grown)]
 
 
-def grown_mask(labels: np.ndarray, rank: np.ndarray, i: int, box, overlap: int, notches: bool = True,
-               ranks: np.ndarray | None = None):
+def grown_mask(labels: np.ndarray, ranks: np.ndarray, i: int, rank_i: int, box, overlap: int):
     """Region i's mask, grown by `overlap` pixels into the regions drawn after it (on
-    top). Two regions that meet side by side both have anti-aliased edges there, which
-    would let the background show through as a faint seam; growing the lower one under
-    the upper one hides it, and also absorbs the curve fit's error. Returns the mask (its
-    corner notches filled, with `notches`) and its (x0, y0) in the image. ranks: each
-    pixel's region's rank (-1 for none), if already at hand."""
+    top; ranks: each pixel's region's drawing rank, -1 where none; rank_i: region i's). Two regions that meet
+    side by side both have anti-aliased edges there, which would let the background show
+    through as a faint seam; growing the lower one under the upper one hides it, and also
+    absorbs the curve fit's error. Returns the mask (corner notches not yet filled:
+    grown_masks fills them) and its (x0, y0) in the image."""
     h, w = labels.shape
     r0, r1 = max(box[0].start - overlap, 0), min(box[0].stop + overlap, h)
     c0, c1 = max(box[1].start - overlap, 0), min(box[1].stop + overlap, w)
-    crop = labels[r0:r1, c0:c1]
-    mask = crop == i
+    mask = labels[r0:r1, c0:c1] == i
     if overlap > 0:
-        if ranks is None:
-            later = np.where(crop >= 0, rank[np.maximum(crop, 0)], -1) > rank[i]
-        else:
-            later = ranks[r0:r1, c0:c1] > rank[i]
+        later = ranks[r0:r1, c0:c1] > rank_i
         size = 2 * overlap + 1
         mask = mask | (cv2.dilate(mask.astype(np.uint8), np.ones((size, size), np.uint8)) > 0) & later
-    return (fill_corner_notches(mask) if notches else mask), (c0, r0)
+    return mask, (c0, r0)
 
 
 def fill_corner_notches_many(masks: list[np.ndarray], arm: int = 3, width: int = 1024) -> list[np.ndarray]:

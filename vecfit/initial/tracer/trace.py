@@ -23,7 +23,7 @@ from .quantize import OPAQUE, prefilter, quantize_colors
 from .regions import build_regions, palette_colors
 from .settings import TraceResult, TraceSettings, check_settings
 from .subpixel import refine_outlines
-from .svgtext import add_path, add_rect, new_document, path_data_many
+from .svgtext import add_path, add_rect, new_document, path_data
 
 
 def check_image(image) -> np.ndarray:
@@ -88,8 +88,8 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     report("outline", 0.4)
     shapes, outlines, holes = [], [], []  # shapes: (region, its outlines' slice of `outlines`)
     drawn = [i for i in order.tolist() if i != background]
-    masks = dict(zip(drawn, grown_masks(regions.labels, rank, drawn, boxes, int(s.overlap))))
     drawn_rank = np.append(rank, -1)[regions.labels]  # each pixel's region's rank; -1: none
+    masks = dict(zip(drawn, grown_masks(regions.labels, rank, drawn_rank, drawn, boxes, int(s.overlap))))
     for j, i in enumerate(order):
         if i == background:
             continue
@@ -117,13 +117,14 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
         fills.add(hex_color(paint[background]))
         add_rect(document, "p0", w, h, hex_color(paint[background]))
         segments += 4
-    painted = [(i, sl, [sp for sp in fitted[sl] if len(sp)]) for i, sl in shapes]
-    painted = [(i, sl, subpaths) for i, sl, subpaths in painted if subpaths]
-    for (i, sl, subpaths), d in zip(painted, path_data_many([subpaths for _, _, subpaths in painted])):
+    for i, sl in shapes:
+        subpaths = [sp for sp in fitted[sl] if len(sp)]
+        if not subpaths:
+            continue
         fill = hex_color(paint[i])
         fills.add(fill)
         cut = any(holes[sl])
-        add_path(document, f"p{len(document.root)}", d, fill, evenodd=cut)
+        add_path(document, f"p{len(document.root)}", path_data(subpaths), fill, evenodd=cut)
         segments += sum(len(sp) for sp in subpaths)
     report("fit", 1.0)
     return TraceResult(document=document, paths=len(document.root), colors=len(fills),
