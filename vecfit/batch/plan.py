@@ -93,7 +93,7 @@ def empty_row(name: str, file: str, status: str, reason: str = "", init_svg=None
     row = {k: None for k in ROW_FIELDS}
     row.update(name=name, file=file, status=status, reason=reason,
                init_svg=None if init_svg is None else str(init_svg))
-    row.update(iterations=None, shapes=None, warnings=[], traceback=None)  # summary.json only
+    row.update(iterations=None, shapes=None, orientation=None, warnings=[], traceback=None)  # summary.json only
     return row
 
 
@@ -240,4 +240,5 @@ def result_row(task: Task, status: str, reason: str = "", report: dict | None = 
         row.update(svg=out.svg.name, report=out.report.name, comparison=out.comparison.name)
         row["iterations"] = report.get("iterations")
         row["shapes"] = report.get("shapes")
+        row["orientation"] = report.get("orientation")  # the EXIF orientation the job applied
     return row

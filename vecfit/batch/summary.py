@@ -6,12 +6,14 @@ import csv
 import html
 import io
 import math
+import warnings
 from pathlib import Path
 from urllib.parse import quote
 
 from PIL import Image
 
 from vecfit.io.images import atomic_write, atomic_write_text
+from vecfit.io.orientation import upright_rgba
 from vecfit.io.report import GAP, save_report
 
 from .plan import DONE, INTERRUPTED, NOT_RUN, ROW_FIELDS, SKIPPED, STATUSES
@@ -54,9 +56,9 @@ def _target_thumb(image: Path, path: Path) -> bool:
     if _fresh(path, image):
         return True
     try:
-        with Image.open(image) as im:
-            im.load()
-            rgba = im.convert("RGBA")
+        with Image.open(image) as im, warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # (the job has warned of a broken EXIF block)
+            rgba, _ = upright_rgba(im, str(image))  # as the job read it
     except Exception:  # a corrupt image has no thumbnail
         return False
     flat = Image.new("RGBA", rgba.size, (255, 255, 255, 255))

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import sys
 import tempfile
+import warnings
 from pathlib import Path
 
 import cv2
@@ -13,6 +14,8 @@ from PIL import Image, UnidentifiedImageError
 
 from vecfit.errors import VecfitError
 from vecfit.limits import MAX_IMAGE_PIXELS
+
+from .orientation import upright_rgba
 
 
 def to_uint8(image: torch.Tensor | np.ndarray) -> np.ndarray:
@@ -56,48 +59,77 @@ def save_png(image, path: str | os.PathLike) -> None:
 
 
 def load_rgba(path: str | os.PathLike) -> np.ndarray:
-    """An image file as float32 straight RGBA in [0, 1], [H, W, 4]; VecfitError naming
-    the file and the reason when it cannot be read."""
-    path = Path(path)
+    """An image file as float32 straight RGBA in [0, 1], [H, W, 4], turned upright by its
+    EXIF orientation (vecfit.io.orientation); VecfitError naming the file and the reason
+    when it cannot be read."""
+    return _read_file(Path(path))[0]
+
+
+def _read_file(path: Path) -> tuple[np.ndarray, dict | None]:
     if not path.exists():
         raise VecfitError(f"{path}: no such file")
     if path.is_dir():
         raise VecfitError(f"{path}: is a folder, not an image")
     too_large = f"{path}: the image is larger than {MAX_IMAGE_PIXELS // 1_000_000} million pixels (the limit)"
     try:
-        with Image.open(path) as im:
+        with _open(path) as im:
             if im.width * im.height > MAX_IMAGE_PIXELS:  # from the header, before decoding
                 raise VecfitError(f"{path}: the image is {im.width}x{im.height} pixels; at most "
                                   f"{MAX_IMAGE_PIXELS // 1_000_000} million pixels (the limit)")
-            im.load()
-            rgba = im.convert("RGBA")
+            return _upright_rgba(im, str(path))
     except Image.DecompressionBombError:  # Pillow's own limit, met before ours
         raise VecfitError(too_large) from None
     except UnidentifiedImageError:
         raise VecfitError(f"{path}: not an image file (or a format that cannot be read)") from None
     except (OSError, ValueError) as e:
         raise VecfitError(f"{path}: cannot read the image ({e})") from None
-    return np.asarray(rgba, dtype=np.float32) / 255.0
+
+
+def _open(file) -> Image.Image:
+    """Image.open without Pillow's nameless warnings of a corrupt EXIF block (JPEG's opener
+    reads EXIF for its dpi; the parser is TIFF's): orientation_of says it again, naming the
+    image."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", category=UserWarning, module=r"PIL\.TiffImagePlugin")
+        return Image.open(file)
+
+
+def _upright_rgba(im: Image.Image, name: str) -> tuple[np.ndarray, dict | None]:
+    """The image as float32 RGBA, upright, and its "orientation" report entry."""
+    rgba, orientation = upright_rgba(im, name)
+    return np.asarray(rgba, dtype=np.float32) / 255.0, orientation
 
 
 def image_rgba(source) -> np.ndarray:
     """An image given as a file path, the bytes of an image file, a PIL image or a NumPy
     array ([H, W], [H, W, 3] or [H, W, 4]; uint8, or floats in [0, 1]) as float32 straight
-    RGBA in [0, 1]; VecfitError saying what is wrong with it."""
+    RGBA in [0, 1], upright (a file's, bytes' or PIL image's EXIF orientation applied);
+    VecfitError saying what is wrong with it."""
+    return read_image(source)[0]
+
+
+def read_image(source) -> tuple[np.ndarray, dict | None]:
+    """image_rgba's image and the report's "orientation" entry (vecfit.io.orientation:
+    None for an array, or an image without an EXIF orientation)."""
     if isinstance(source, (str, os.PathLike)):
-        return load_rgba(source)
+        return _read_file(Path(source))
     if isinstance(source, (bytes, bytearray, memoryview)):
         import io
         try:
-            with Image.open(io.BytesIO(bytes(source))) as im:
+            with _open(io.BytesIO(bytes(source))) as im:
                 if im.width * im.height > MAX_IMAGE_PIXELS:
                     raise VecfitError(f"the image is {im.width}x{im.height} pixels; at most "
                                       f"{MAX_IMAGE_PIXELS // 1_000_000} million pixels (the limit)")
-                return np.asarray(im.convert("RGBA"), dtype=np.float32) / 255.0
+                return _upright_rgba(im, "the image bytes given")
         except (UnidentifiedImageError, OSError, ValueError, Image.DecompressionBombError) as e:
             raise VecfitError(f"the image bytes cannot be read as an image ({e})") from None
     if isinstance(source, Image.Image):
-        return np.asarray(source.convert("RGBA"), dtype=np.float32) / 255.0
+        return _upright_rgba(source, "the PIL image given")
+    return _array_rgba(source), None
+
+
+def _array_rgba(source) -> np.ndarray:
+    """A NumPy array (as image_rgba takes it) as float32 straight RGBA."""
     a = np.asarray(source)
     if a.ndim == 2:
         a = a[..., None].repeat(3, axis=2)

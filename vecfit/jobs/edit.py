@@ -95,7 +95,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     progress = listener(progress)
     outputs.check_against(inputs)
     outputs.forget_report()
-    target = load_target(inputs.image)
+    target, orientation = load_target(inputs.image, return_orientation=True)
     scene, document = load_scene_to_fit(inputs.svg)
     fit_canvas(scene, target, svg_path, edited_path)
     edit = settings_of(EditSettings, config["edit"])
@@ -161,6 +161,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
         "vecfit": __version__,
         "command": "edit",
         "target": str(edited_path),
+        "orientation": orientation,  # the edited image's EXIF orientation, applied
         "init": str(svg_path),
         "mask": None if mask is None else str(mask),
         **outputs.names(),

@@ -15,7 +15,7 @@ from vecfit.errors import VecfitError
 from vecfit.fitting.metrics import compare, to_rgb
 from vecfit.fitting.result import Result
 from vecfit.io.colors import fitting_background
-from vecfit.io.images import downscaled, image_rgba
+from vecfit.io.images import downscaled, read_image
 from vecfit.io.report import save_comparison, save_report
 from vecfit.renderer import device as devices
 from vecfit.renderer.forward import render_numpy
@@ -35,15 +35,16 @@ MIN_SIDE = 11
 
 # ------------------------------------------------------------------------- target
 
-def load_target(source) -> np.ndarray:
-    """The target image (a path, or an image itself: vecfit.io.images.image_rgba), big
-    enough to be measured: SSIM's Gaussian window is 11 x 11 pixels."""
-    a = image_rgba(source)
+def load_target(source, return_orientation: bool = False):
+    """The target image (a path, or an image itself: vecfit.io.images.image_rgba), upright,
+    big enough to be measured: SSIM's Gaussian window is 11 x 11 pixels. With
+    ``return_orientation``, (the image, the report's "orientation" entry: read_image's)."""
+    a, orientation = read_image(source)
     name = str(source) if isinstance(source, (str, Path)) else "the image given"
     if min(a.shape[:2]) < MIN_SIDE:
         raise VecfitError(f"{name}: the image is too small ({a.shape[1]}x{a.shape[0]} pixels; "
                           f"at least {MIN_SIDE}x{MIN_SIDE})")
-    return a
+    return (a, orientation) if return_orientation else a
 
 
 def corner_color(image: np.ndarray) -> tuple:

@@ -16,7 +16,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     inputs.need("paint", "image")
     target_path, frames = inputs.name("image"), outputs.frames
     outputs.check_against(inputs)
-    target = load_target(inputs.image)
+    target, orientation = load_target(inputs.image, return_orientation=True)
     settings = settings_of(PaintSettings, config["paint"], seed=config["optimize"]["seed"])
     reseeder = Reseeder(settings, config["optimize"]["iterations"])
     hooks = [reseeder]
@@ -34,7 +34,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
         return {"folder": str(frames), "count": len(saver.files), "gif": str(gif) if gif else None}
 
     return fit_and_write(scene, document, target, config, outputs, progress, hooks=hooks,
-                         inputs={"command": "paint", "target": str(target_path),
+                         inputs={"command": "paint", "target": str(target_path), "orientation": orientation,
                                  "paint": lambda: {"kind": settings.kind, "paths": settings.paths,
                                                    "reseeded": reseeder.reseeded,
                                                    "reseed_history": reseeder.history},

@@ -12,8 +12,9 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     inputs.need("refine", "image", "svg")
     target_path, svg_path = inputs.name("image"), inputs.name("svg")
     outputs.check_against(inputs)
-    target = load_target(inputs.image)
+    target, orientation = load_target(inputs.image, return_orientation=True)
     scene, document = load_scene_to_fit(inputs.svg)
     check_sizes(scene, target, svg_path, target_path)
     return fit_and_write(scene, document, target, config, outputs, progress,
-               inputs={"command": "refine", "target": str(target_path), "init": str(svg_path)})
+               inputs={"command": "refine", "target": str(target_path), "orientation": orientation,
+                       "init": str(svg_path)})

@@ -20,7 +20,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     inputs.need("trace", "image")
     target_path, progress = inputs.name("image"), listener(progress)
     outputs.check_against(inputs)
-    target = load_target(inputs.image)
+    target, orientation = load_target(inputs.image, return_orientation=True)
     settings = settings_of(TraceSettings, config["trace"], seed=config["optimize"]["seed"])
     progress.status(f"tracing {target_path} ({target.shape[1]}x{target.shape[0]})")
     traced = trace_image(target, settings)
@@ -37,6 +37,6 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     backdrop = [s.fill.color for s in scene.shapes[:1]
                 if isinstance(s.geometry, Rect) and isinstance(s.fill, Solid)]
     return fit_and_write(scene, traced.document, target, config, outputs, progress, keep_alpha=backdrop,
-                         inputs={"command": "trace", "target": str(target_path),
+                         inputs={"command": "trace", "target": str(target_path), "orientation": orientation,
                                  "trace": {"paths": traced.paths, "segments": traced.segments,
                                            "colors": traced.colors, "seconds": traced.seconds}})
