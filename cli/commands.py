@@ -220,6 +220,9 @@ def optimize_options(f):
         click.option("--seed", type=int, help="Random seed."),
         click.option("--threads", type=click.IntRange(min=0), help="Threads (0: all cores)."),
         click.option("--device", **DEVICE_OPTION),
+        click.option("--precision", type=click.IntRange(0, 6),
+                     help="Decimals of the coordinates written (default: what the canvas needs, "
+                          "a hundredth of a pixel up to 1,024 px)."),
         click.option("-q", "--quiet", is_flag=True, help="No progress bar."),
     ]
     for option in reversed(options):
@@ -251,7 +254,7 @@ def _resolve_config(command, preset, config_file, options, extra=None):
         "background": options["background"], "seed": options["seed"],
         "threads": options["threads"], "device": options["device"],
         "lr": _parse_learning_rates(options["learning_rates"]),
-    }, **(extra or {})}
+    }, "output": {"precision": options["precision"]}, **(extra or {})}
     try:
         return resolve(command, preset=preset, config_file=config_file, overrides=overrides,
                        effort=options["effort"])

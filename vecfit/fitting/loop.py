@@ -32,6 +32,7 @@ from .result import Result
 from .settings import PARAMETER_KINDS, Settings  # noqa: F401  (re-exported: the loop's settings)
 from .adam import Adam
 from .outline import OutlineCost
+from .opacity import colors_kept_opaque, translucency_wanted
 from .rates import dense_point_rate, outline_density, parameter_kinds
 
 # The coarse level must leave each shape some pixels (8 x 8 on average), or its small shapes
@@ -144,7 +145,7 @@ def optimize(scene: Scene, target: Target, settings: Settings,
     ends at the best parameters seen. Ctrl-C stops early (``Result.interrupted``).
     ``hooks`` run after every iteration (see Step): re-seeding, saving frames.
     ``keep_alpha``: colour tensors whose alpha must not change (e.g. a backdrop that
-    has to keep the canvas covered). ``penalty``: a term added to every iteration's loss,
+    has to keep the canvas covered), beside those ``settings.alpha`` keeps (opacity.py). ``penalty``: a term added to every iteration's loss,
     computed from the Scene's tensors (its gradient reaches them with the image's), e.g.
     `vecfit edit`'s cost of moving what the edit did not touch."""
     settings.check()
@@ -170,7 +171,9 @@ class _Fit:
             lr["points"] = dense_point_rate(float(lr["points"]), self.density, settings.dense_outline,
                                             settings.dense_points)
         self.point_rate = lr.get("points")
-        self.kinds = kinds = parameter_kinds(scene, lr, width, height, settings.fixed_alpha, keep_alpha)
+        translucent = settings.alpha == "auto" and translucency_wanted(target.image.numpy(), target.opaque)
+        keep_alpha = [*keep_alpha, *colors_kept_opaque(scene, settings.alpha, translucent)]
+        self.kinds = kinds = parameter_kinds(scene, lr, width, height, keep_alpha)
         if not kinds:
             raise VecfitError("nothing to optimise: the scene has no parameters with a learning rate above 0")
         self.adam = Adam(kinds, settings.iterations, settings.lr_decay, settings.lr_warmup)

@@ -73,11 +73,10 @@ def _effect_scales(scene: Scene, width: int, height: int, out: dict) -> None:
                     effect = getattr(effect, "clip", None) or getattr(effect, "mask", None)
 
 
-def parameter_kinds(scene: Scene, lr: dict, width: int, height: int, fixed_alpha: bool = False,
-                    keep_alpha=()) -> list[ParameterKind]:
+def parameter_kinds(scene: Scene, lr: dict, width: int, height: int, keep_alpha=()) -> list[ParameterKind]:
     """The kinds with a positive rate, each with its per-element scale of the rate: lengths
     in each tensor's own units, zero for what stays fixed (the last row of a transform,
-    alphas kept)."""
+    the alphas of the colour tensors in ``keep_alpha``)."""
     scales = learning_rate_scales(scene, width, height)
     kinds = []
     for name, tensors in scene.parameters().items():
@@ -93,9 +92,7 @@ def parameter_kinds(scene: Scene, lr: dict, width: int, height: int, fixed_alpha
         kind = ParameterKind(name, tensors, per_tensor, rate)
         if name == "transforms":  # the last row of an affine matrix stays 0 0 1
             kind.scale.view(-1, 3, 3)[:, 2, :] = 0.0
-        if name == "colors":  # colours are RGBA rows: keep the A of all, or of some
-            if fixed_alpha:
-                kind.scale.view(-1, 4)[:, 3] = 0.0
+        if name == "colors":  # colours are RGBA rows: keep the A of some
             kept = {id(t) for t in keep_alpha}
             offset = 0
             for t in tensors:

@@ -12,6 +12,7 @@ from vecfit.renderer import device as devices
 from vecfit.renderer.options import MODES
 
 LOSSES = ("l2", "l1", "ssim", "pyramid")  # vecfit.fitting.losses implements them
+ALPHA_MODES = ("auto", "free", "fixed")  # which colours' opacity may change (opacity.py)
 
 PARAMETER_KINDS = ("points", "colors", "stroke_widths", "opacities", "radii", "gradient_points",
                    "gradient_radii", "stop_offsets", "transforms")
@@ -32,7 +33,7 @@ class Settings:
     device: str
     lr_decay: float
     lr_warmup: int
-    fixed_alpha: bool
+    alpha: str  # ALPHA_MODES: auto (only where the target or the colour is translucent) | free | fixed
     coarse: float  # fraction of the iterations run at half the size (coarse to fine)
     outline: float  # weight of the cost on outlines growing (outline.py), per px of growth per px
     boundary_budget: float  # Monte Carlo boundary samples per image pixel at most (0: no bound)
@@ -61,6 +62,8 @@ class Settings:
             raise VecfitError("iterations must be 0 or more")
         if self.loss not in LOSSES:
             raise VecfitError(f"loss must be one of {', '.join(LOSSES)}, not {self.loss!r}")
+        if self.alpha not in ALPHA_MODES:
+            raise VecfitError(f"alpha must be one of {', '.join(ALPHA_MODES)}, not {self.alpha!r}")
         if self.mode not in MODES:
             raise VecfitError(f"mode must be one of {', '.join(MODES)}, not {self.mode!r}")
         if self.samples < 1:

@@ -112,6 +112,7 @@ def validate(settings: dict) -> None:
     if settings["optimize"]["background"].strip().lower() != "auto":
         fitting_background(settings["optimize"]["background"])
     Settings.from_config(settings["optimize"])
+    output_precision(settings)
     seed = settings["optimize"]["seed"]
     if "trace" in settings:
         from vecfit.initial.tracer import TraceSettings
@@ -128,6 +129,20 @@ def validate(settings: dict) -> None:
     if "retarget" in settings:
         from vecfit.editing.settings import RetargetSettings
         settings_of(RetargetSettings, settings["retarget"]).check()
+
+
+def output_precision(settings: dict) -> int | None:
+    """[output] precision: the decimals of written coordinates, None for what the canvas
+    needs (-1)."""
+    from vecfit.svg.precision import MAX_DECIMALS
+
+    value = settings["output"]["precision"]
+    if value == -1:
+        return None
+    if not 0 <= value <= MAX_DECIMALS:
+        raise VecfitError(f"output.precision must be 0 to {MAX_DECIMALS} decimals (or -1: what the canvas "
+                          f"needs), not {value}")
+    return value
 
 
 def settings_of(cls, table: dict, **fixed):

@@ -25,7 +25,7 @@ from vecfit.scene import Scene
 from vecfit.svg.numbers import hex_color
 from vecfit.svg.write import svg_bytes
 
-from .config import settings_of
+from .config import output_precision, settings_of
 from .fit import _render_full, background_for, load_scene_to_fit, load_target
 from .protocol import Inputs, Outputs, listener
 
@@ -152,7 +152,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
 
     # The SVG keeps its elements: no background rect is added (an uncovered canvas stays
     # transparent, which over the background looks as optimised).
-    outputs.keep_svg(svg_bytes(scene, document))
+    outputs.keep_svg(svg_bytes(scene, document, precision=output_precision(config), pixels=(w, h)))
     if outputs.comparison is not None:
         save_panels(outputs.comparison, panels_image(
             [original_rgb, target_rgb, final_rgb, error_map(final_rgb, target_rgb)]))

@@ -26,6 +26,7 @@ from vecfit.svg.document import SvgDocument
 from vecfit.svg.read import read_svg, scene_of
 from vecfit.svg.write import svg_bytes
 
+from .config import output_precision
 from .protocol import Outputs, listener
 
 OPAQUE = 0.999  # a target whose every alpha is at least this is treated as opaque
@@ -125,12 +126,15 @@ def _not_optimised(scene: Scene, opt: dict) -> Result:
 
 
 def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, config: dict, outputs: Outputs,
-                  progress=None, inputs: dict | None = None, hooks=(), keep_alpha=()) -> dict:
+                  progress=None, inputs: dict | None = None, hooks=(), keep_alpha=(),
+                  generated: bool = False) -> dict:
     """Optimise ``scene`` (read from ``document``) against ``target`` with the
     ``[optimize]`` settings of ``config``; writes the SVG, the comparison picture and the
     report (last, so a report means a finished run). Returns the report. ``inputs`` are
     extra report entries (a callable value is called when the report is made); ``hooks``
-    and ``keep_alpha`` go to the optimisation loop."""
+    and ``keep_alpha`` go to the optimisation loop. ``generated``: the Scene is vecfit's own
+    (a trace, random strokes), so under ``optimize.alpha = "auto"`` its colours start
+    opaque unless the target has translucent areas (vecfit/fitting/opacity.py)."""
     started = time.perf_counter()
     progress = listener(progress)
     # The report marks a finished run: an old one must not sit beside new outputs if this
@@ -154,7 +158,10 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     if is_tensor(scene.view):
         import torch
         from vecfit.fitting.loop import Settings, Target, optimize
+        from vecfit.fitting.opacity import make_opaque, translucency_wanted
         settings = Settings.from_config(opt)
+        if generated and settings.alpha == "auto" and not translucency_wanted(small, background is not None):
+            make_opaque(scene)
         progress.start(settings.iterations)
         result = optimize(scene, Target(torch.from_numpy(small), background), settings, progress=progress,
                           hooks=hooks, keep_alpha=keep_alpha)
@@ -174,7 +181,8 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     # uncovered, the background is written in as a first rect.
     covered = float(final_image[..., 3].min()) >= OPAQUE
     svg_background = background if background is not None and not covered else None
-    outputs.keep_svg(svg_bytes(scene, document, background=svg_background))
+    outputs.keep_svg(svg_bytes(scene, document, background=svg_background,
+                               precision=output_precision(config), pixels=(w, h)))
     if outputs.comparison is not None:
         save_comparison(outputs.comparison, target_rgb, initial_rgb, final_rgb)
     seconds = time.perf_counter() - started

@@ -33,7 +33,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
         gif = saver.finish()
         return {"folder": str(frames), "count": len(saver.files), "gif": str(gif) if gif else None}
 
-    return fit_and_write(scene, document, target, config, outputs, progress, hooks=hooks,
+    return fit_and_write(scene, document, target, config, outputs, progress, hooks=hooks, generated=True,
                          inputs={"command": "paint", "target": str(target_path), "orientation": orientation,
                                  "paint": lambda: {"kind": settings.kind, "paths": settings.paths,
                                                    "reseeded": reseeder.reseeded,

@@ -32,7 +32,7 @@ from vecfit.renderer.raster import render
 from vecfit.svg.numbers import hex_color
 from vecfit.svg.write import svg_bytes
 
-from .config import settings_of
+from .config import output_precision, settings_of
 from .fit import background_for, load_scene_to_fit
 from .protocol import Inputs, Outputs, listener
 
@@ -169,7 +169,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     fit = compare(final_rgb, goal_rgb)
     if not all(math.isfinite(fit[k]) or (k == "psnr" and fit["mse"] == 0) for k in fit):
         raise VecfitError(f"the retargeted image has non-finite values ({fit}); nothing written")
-    outputs.keep_svg(svg_bytes(scene, document, canvas=(out_w, out_h)))
+    outputs.keep_svg(svg_bytes(scene, document, canvas=(out_w, out_h), precision=output_precision(config)))
     original_rgb = to_rgb(original, background)
     scaled_rgb = cv2.resize(original_rgb.astype(np.float32), (cur_w, cur_h), interpolation=cv2.INTER_AREA)
     if outputs.comparison is not None:

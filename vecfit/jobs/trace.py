@@ -36,7 +36,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     # worth ~2 dB on photos).
     backdrop = [s.fill.color for s in scene.shapes[:1]
                 if isinstance(s.geometry, Rect) and isinstance(s.fill, Solid)]
-    return fit_and_write(scene, traced.document, target, config, outputs, progress, keep_alpha=backdrop,
+    return fit_and_write(scene, traced.document, target, config, outputs, progress, keep_alpha=backdrop, generated=True,
                          inputs={"command": "trace", "target": str(target_path), "orientation": orientation,
                                  "trace": {"paths": traced.paths, "segments": traced.segments,
                                            "colors": traced.colors, "seconds": traced.seconds}})

@@ -282,7 +282,8 @@ def to_arrays(subpaths: list[Subpath]):
 _LETTERS = {1: "L", 2: "Q", 3: "C"}
 
 
-def format_path_data(points, degrees, subpaths, decimals: int = 4, compact: bool = False) -> str:
+def format_path_data(points, degrees, subpaths, decimals: int = 4, compact: bool = False,
+                     axis_lines: bool = False) -> str:
     """Absolute M/L/Q/C/Z path data of subpaths stored as a Scene's ``Path`` stores them:
     ``points`` [P, 2] (finite numbers), per subpath its start, then each segment's
     control points and end, a closed subpath's last end (its start) not stored again;
@@ -290,11 +291,13 @@ def format_path_data(points, degrees, subpaths, decimals: int = 4, compact: bool
 
     A closed subpath's last segment is written as ``Z`` when it is a line, else in full
     and followed by ``Z``. Numbers have at most ``decimals`` decimals; ``compact`` leaves
-    out the spaces before command letters.
+    out the spaces before command letters; ``axis_lines`` writes a line whose written end
+    keeps its start's y (x) as ``H x`` (``V y``), as a designer's file does.
     """
     # every point formatted once, as "x y" (a trace writes 50,000 numbers)
     numbers = fmt_many(points, decimals)
-    text = [f"{x} {y}" for x, y in zip(numbers[0::2], numbers[1::2])]
+    xs, ys = numbers[0::2], numbers[1::2]
+    text = [f"{x} {y}" for x, y in zip(xs, ys)]
     degrees = np.asarray(degrees).tolist()
     out, p = [], 0
     for first, count, closed in subpaths:
@@ -306,6 +309,15 @@ def format_path_data(points, degrees, subpaths, decimals: int = 4, compact: bool
             last = closed and k == first + count - 1
             if last and d == 1:
                 break
+            if axis_lines and d == 1:
+                if ys[p] == ys[p - 1]:
+                    out.append("H" + xs[p])
+                elif xs[p] == xs[p - 1]:
+                    out.append("V" + ys[p])
+                else:
+                    out.append("L" + text[p])
+                p += 1
+                continue
             ends = text[p:p + (d - 1 if last else d)] + ([text[start]] if last else [])
             out.append(_LETTERS[d] + " ".join(ends))
             p += d - 1 if last else d

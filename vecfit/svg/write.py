@@ -32,6 +32,7 @@ from .document import SvgDocument
 from .dom import local_name
 from .numbers import finite, fmt, hex_color, matrix
 from .pathdata import format_path_data
+from .precision import MAX_DECIMALS, root_decimals, shape_decimals
 from .skips import VecfitWarning
 from .style import INHERITED
 from .units import parse_length, parse_viewbox, translate
@@ -42,11 +43,20 @@ __all__ = ["svg_bytes", "write_bytes", "write_svg"]
 # dropped instead of written).
 INITIAL = {"opacity": "1", "fill-opacity": "1", "stroke-opacity": "1", "stop-opacity": "1",
            "fill": "black", "stroke": "none", "stroke-width": "1"}
+OPACITY_DECIMALS = 3
 
 
-def path_data(path: Path) -> str:
-    """A Scene path's ``d``: absolute M/L/Q/C/Z (see ``pathdata.format_path_data``)."""
-    return format_path_data(finite(path.points), path.degrees, path.subpaths)
+def path_data(path: Path, decimals: int = 4) -> str:
+    """A Scene path's ``d``: absolute M/L/H/V/Q/C/Z (see ``pathdata.format_path_data``)."""
+    return format_path_data(finite(path.points), path.degrees, path.subpaths, decimals, axis_lines=True)
+
+
+def opacity_text(value) -> str | None:
+    """An opacity as written: 3 decimals at most (a thousandth is below what 8-bit colour
+    shows), None where it rounds to 1 (opaque: nothing to write)."""
+    v = min(max(float(finite(value)), 0.0), 1.0)
+    text = fmt(v, OPACITY_DECIMALS)
+    return None if text == "1" else text
 
 
 # ---------------------------------------------------------------------- comparison
@@ -159,7 +169,8 @@ class _Styles:
 # -------------------------------------------------------------------------- writer
 
 def write_svg(scene: Scene, document, out_path, *, full: bool = False, background=None,
-              canvas: tuple[float, float] | None = None) -> None:
+              canvas: tuple[float, float] | None = None, precision: int | None = None,
+              pixels: tuple[int, int] | None = None) -> None:
     """Write ``scene``'s values into a copy of ``document`` (the SvgDocument the scene was
     read from, or the path of its file) and save it atomically at ``out_path``.
 
@@ -169,10 +180,14 @@ def write_svg(scene: Scene, document, out_path, *, full: bool = False, backgroun
     canvas: a new (width, height) in pixels for the root element (`vecfit retarget`); its
     viewBox is resized with it, so a user unit keeps its size in pixels.
 
+    precision: decimals of the coordinates written; None: what a ``pixels`` (width,
+    height) canvas needs (vecfit/svg/precision.py; default the Scene's own size).
+
     Raises VecfitError for non-finite values (nothing is written then) or a scene that
     does not match the document.
     """
-    write_bytes(out_path, svg_bytes(scene, document, full=full, background=background, canvas=canvas))
+    write_bytes(out_path, svg_bytes(scene, document, full=full, background=background, canvas=canvas,
+                                    precision=precision, pixels=pixels))
 
 
 def write_bytes(out_path, payload: bytes) -> None:
@@ -188,7 +203,8 @@ def write_bytes(out_path, payload: bytes) -> None:
 
 
 def svg_bytes(scene: Scene, document, *, full: bool = False, background=None,
-              canvas: tuple[float, float] | None = None) -> bytes:
+              canvas: tuple[float, float] | None = None, precision: int | None = None,
+              pixels: tuple[int, int] | None = None) -> bytes:
     """What ``write_svg`` writes, as UTF-8 bytes."""
     from .read import read_svg, scene_of  # the reader records the Scene as read
 
@@ -208,14 +224,18 @@ def svg_bytes(scene: Scene, document, *, full: bool = False, background=None,
         raise VecfitError(f"{document.name}: the scene was not read from this file "
                           f"(its shapes and groups do not match)")
 
+    if precision is not None and not 0 <= int(precision) <= MAX_DECIMALS:
+        raise VecfitError(f"precision must be 0 to {MAX_DECIMALS} decimals, not {precision}")
+    decimals = shape_decimals(scene, pixels, precision)
+    decimals += [root_decimals(scene, pixels, precision)] * (len(shapes) - len(decimals))
     doc = document.copy()
     writer = _Writer(doc, document.viewport, full)
 
     done: set = set()
-    for shape, orig in zip(shapes, shapes_before):
+    for shape, orig, places in zip(shapes, shapes_before, decimals):
         if shape.source in done:
             continue  # <use> instances of an element already written
-        if writer.shape(shape, orig):
+        if writer.shape(shape, orig, places):
             done.add(shape.source)
     if writer.averaged:
         names = ", ".join(str(a) for a in writer.averaged[:5]) + (", ..." if len(writer.averaged) > 5 else "")
@@ -288,9 +308,9 @@ def _add_background(root, color) -> None:
         rect.attrib.update(x="0", y="0", width="100%", height="100%")
     rect.set("id", "vecfit-background")
     rect.set("fill", hex_color(color))
-    alpha = float(color[3]) if len(color) > 3 else 1.0
-    if alpha < 1:
-        rect.set("fill-opacity", fmt(alpha))
+    alpha = opacity_text(color[3]) if len(color) > 3 else None
+    if alpha is not None:
+        rect.set("fill-opacity", alpha)
     rect.tail = root.text
     root.insert(0, rect)
 
@@ -313,11 +333,12 @@ class _Writer:
 
     # ------------------------------------------------------------------ shapes
 
-    def shape(self, shape, orig) -> bool:
-        """Write what changed; True when anything was written."""
+    def shape(self, shape, orig, decimals: int = 4) -> bool:
+        """Write what changed, coordinates with ``decimals`` decimals; True when anything
+        was written."""
         full, e, wrote = self.full, self._element(shape.source), False
         if full or not _same_geometry(shape.geometry, orig.geometry):
-            self._geometry(e, shape.geometry)
+            self._geometry(e, shape.geometry, decimals)
             wrote = True
         for prop, paint, opacity, paint0, opacity0 in (
                 ("fill", shape.fill, shape.fill_opacity, orig.fill, orig.fill_opacity),
@@ -331,7 +352,7 @@ class _Writer:
             width = shape.geometry.widths.detach().double().mean()
             self.averaged.append(shape.source)
         if shape.stroke is not None and (full or not _same(width, orig.stroke_width)):
-            self.doc.set_property(e, "stroke-width", fmt(finite(width), 4))
+            self.doc.set_property(e, "stroke-width", fmt(finite(width), decimals))
             wrote = True
         if full or not _same(shape.opacity, orig.opacity):
             self._opacity(e, "opacity", shape.opacity)
@@ -354,8 +375,7 @@ class _Writer:
         return wrote
 
     def _opacity(self, e, prop, value):
-        v = float(finite(value))
-        self.doc.set_property(e, prop, None if v >= 1 else fmt(min(max(v, 0.0), 1.0), 6))
+        self.doc.set_property(e, prop, opacity_text(value))
 
     def _paint(self, e, prop, paint, opacity):
         op = float(finite(opacity))
@@ -370,45 +390,44 @@ class _Writer:
             if paint.source is None:
                 raise VecfitError("a gradient paint without a source element cannot be written")
             self.doc.set_property(e, prop, f"url(#{paint.source})")
-        self.doc.set_property(e, f"{prop}-opacity",
-                              None if op >= 1 else fmt(min(max(op, 0.0), 1.0), 6))
+        self.doc.set_property(e, f"{prop}-opacity", opacity_text(op))
 
     def _transform(self, e, m):
         if np.array_equal(m, np.eye(3)) and e.get("transform") is None:
             return
         e.set("transform", matrix(m))
 
-    def _geometry(self, e, g):
+    def _geometry(self, e, g, decimals: int):
         tag = local_name(e.tag)
         if isinstance(g, Rect):
             p0, p1, r = finite(g.p_min), finite(g.p_max), finite(g.corner_radii)
             for name, v in (("x", p0[0]), ("y", p0[1]), ("width", p1[0] - p0[0]),
                             ("height", p1[1] - p0[1])):
-                e.set(name, fmt(v))
+                e.set(name, fmt(v, decimals))
             for name, v in (("rx", r[0]), ("ry", r[1])):
                 if v != 0 or e.get(name) is not None:
-                    e.set(name, fmt(v))
+                    e.set(name, fmt(v, decimals))
         elif isinstance(g, Circle):
             c = finite(g.center)
-            e.set("cx", fmt(c[0]))
-            e.set("cy", fmt(c[1]))
-            e.set("r", fmt(finite(g.radius)))
+            e.set("cx", fmt(c[0], decimals))
+            e.set("cy", fmt(c[1], decimals))
+            e.set("r", fmt(finite(g.radius), decimals))
         elif isinstance(g, Ellipse):
             c, r = finite(g.center), finite(g.radii)
             for name, v in (("cx", c[0]), ("cy", c[1]), ("rx", r[0]), ("ry", r[1])):
-                e.set(name, fmt(v))
+                e.set(name, fmt(v, decimals))
         else:
-            self._path(e, tag, g)
+            self._path(e, tag, g, decimals)
 
-    def _path(self, e, tag, g: Path):
+    def _path(self, e, tag, g: Path, decimals: int):
         pts = finite(g.points)
         degrees = [int(d) for d in g.degrees]
         lines = all(d == 1 for d in degrees) and len(g.subpaths) == 1
         closed = bool(g.subpaths[0][2]) if g.subpaths else False
-        pairs = lambda: " ".join(f"{fmt(x)},{fmt(y)}" for x, y in pts)  # noqa: E731
+        pairs = lambda: " ".join(f"{fmt(x, decimals)},{fmt(y, decimals)}" for x, y in pts)  # noqa: E731
         if tag == "line" and lines and not closed and len(degrees) == 1:
             for name, v in zip(("x1", "y1", "x2", "y2"), pts.reshape(-1)):
-                e.set(name, fmt(v))
+                e.set(name, fmt(v, decimals))
             return
         if tag == "polyline" and lines and not closed and len(pts) >= 2:
             e.set("points", pairs())
@@ -420,7 +439,7 @@ class _Writer:
             e.tag = e.tag[: len(e.tag) - len(tag)] + "path"
             for name in ("x1", "y1", "x2", "y2", "points"):
                 e.attrib.pop(name, None)
-        e.set("d", path_data(g))
+        e.set("d", path_data(g, decimals))
 
     # ------------------------------------------------------------------ groups
 
@@ -488,8 +507,6 @@ class _Writer:
                 raise VecfitError(f"gradient #{paint.source}: {len(offsets)} stops in the scene, "
                                   f"{len(stops)} in the file")
             for s, o, c in zip(stops, offsets, colors):
-                s.set("offset", fmt(min(max(o, 0.0), 1.0), 6))
+                s.set("offset", fmt(min(max(o, 0.0), 1.0), 4))
                 self.doc.set_property(s, "stop-color", hex_color(c))
-                a = float(c[3])
-                self.doc.set_property(s, "stop-opacity",
-                                      None if a >= 1 else fmt(min(max(a, 0.0), 1.0), 6))
+                self.doc.set_property(s, "stop-opacity", opacity_text(c[3]))

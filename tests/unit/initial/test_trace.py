@@ -62,7 +62,7 @@ def psnr(a, b) -> float:
 
 
 def count_shapes(svg: str) -> int:
-    return len(re.findall(r"<(path|rect)\b", svg))
+    return len(re.findall(r"<(path|rect|circle|ellipse)\b", svg))
 
 
 def small_photo(name: str, size) -> np.ndarray:
@@ -135,7 +135,8 @@ def test_path_budget_is_respected():
     assert full.paths > 60  # a busy picture: the budget below has work to do
     for budget in (1, 20):
         result = trace_image(image, TraceSettings.defaults(paths=budget))
-        assert result.paths == count_shapes(result.svg) <= budget
+        # the background rect of an opaque image is not counted against the budget
+        assert result.paths == count_shapes(result.svg) <= budget + 1
     assert re.search(r"<rect\b", trace_image(image, TraceSettings.defaults(paths=1)).svg)
 
 
@@ -144,7 +145,7 @@ def test_transparent_background_stays_transparent(tmp_path):
     rect = coverage(lambda x, y: (x > 40.5) & (x < 56.5) & (y > 8.25) & (y < 38.25), 64, 48)
     image = paint([(disc, (0.83, 0.33, 0.0)), (rect, (0.12, 0.38, 0.55))], 64, 48)
     result = trace_image(image)
-    assert "<rect" not in result.svg  # no background shape
+    assert 'x="-' not in result.svg  # no background shape (the backdrop rect reaches past the canvas)
     out = render(result, 64, 48, tmp_path, background=None)
     alpha = out[..., 3]
     # the fit may stray up to the tolerance (1 px) past the edge, not further
@@ -292,8 +293,10 @@ def test_deterministic_for_a_seed():
 
 def test_result_counts_match_the_svg():
     result = trace_image(flat_shapes(), TraceSettings.defaults(paths=3))
-    assert result.paths == count_shapes(result.svg) <= 3
-    assert result.segments == result.svg.count("C") + 4 * result.svg.count("<rect")
+    assert result.paths == count_shapes(result.svg) <= 3 + 1  # and the background rect
+    drawn = sum(len(re.findall(r"[CLHV]", d)) for d in re.findall(r' d="([^"]*)"', result.svg))
+    primitives = len(re.findall(r"<(rect|circle|ellipse)\b", result.svg))
+    assert result.segments == drawn + 4 * primitives
     assert result.colors == len(set(re.findall(r'fill="(#[0-9a-f]{6})"', result.svg)))
     assert result.seconds > 0
     assert re.search(r'<svg xmlns="http://www.w3.org/2000/svg" width="96" height="80" '
@@ -353,7 +356,7 @@ def test_tracing_imports_no_torch():
             "from vecfit.initial.tracer import trace_image\n"
             "img = np.zeros((40, 60, 4), np.float32); img[..., 3] = 1; img[10:30, 15:45, 0] = 1\n"
             "svg = trace_image(img).svg\n"
-            "print('<path' in svg, 'torch' in sys.modules)")
+            "print(svg.count('<rect') == 2, 'torch' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.stdout.split() == ["True", "False"], out.stdout + out.stderr
 

@@ -151,7 +151,7 @@ def test_path_data_closes_with_z(tmp_path):
                  '<path d="M1 1 L5 1 L5 5 L1 1 Z M6 6 q1 1 2 0 c 0 1 1 1 1 0 z M2 8 h3"/></svg>')
     g = quiet_load(p).shapes[0].geometry
     d = path_data(g)
-    assert d == "M1 1 L5 1 L5 5 L1 1 Z M6 6 Q7 7 8 6 C8 7 9 7 9 6 Z M2 8 L5 8"
+    assert d == "M1 1 H5 V5 L1 1 Z M6 6 Q7 7 8 6 C8 7 9 7 9 6 Z M2 8 H5"  # axis-aligned lines as H and V
 
 
 # ----------------------------------------------------------------- round trips
@@ -284,7 +284,8 @@ def test_tiger_changes_written(tmp_path):
     b = quiet_load(out)
     _close(b.shapes[stroked].stroke_width, 2.5, 1e-6, "stroke-width")
     _close(b.shapes[stroked].stroke.color, [1, 0, 0, 1], 1e-6, "stroke colour")
-    _close(b.shapes[10].geometry.points, scene.shapes[10].geometry.points, 1e-4, "points")
+    # written to a hundredth of a pixel (vecfit/svg/precision.py)
+    _close(b.shapes[10].geometry.points, scene.shapes[10].geometry.points, 0.0051, "points")
     _close(b.shapes[filled].fill.color[3] * b.shapes[filled].fill_opacity, 0.5, 1e-6, "alpha")
     for g in b.groups:
         _close(g.opacity, 0.9, 1e-6, "group opacity")
@@ -354,7 +355,7 @@ def test_polyline_keeps_or_becomes_path(tmp_path):
     quiet_write(scene, src, out)
     pl = _element(out, "pl")
     assert pl.tag.endswith("path") and pl.get("points") is None and pl.get("class") == "k"
-    assert pl.get("d") == "M0 0 Q5 10 10 0 L20 0"
+    assert pl.get("d") == "M0 0 Q5 10 10 0 H20"
     _close(quiet_load(out).shapes[0].geometry.points, g.points, 1e-6, "path")
 
 

@@ -19,7 +19,8 @@ class TraceSettings:
     """k of the colour quantisation: the colour classes regions start from (regions are
     then painted with their own mean colour, so the picture has more colours than k)."""
     paths: int
-    """Path budget: at most this many shapes (a background rect counts as one)."""
+    """Path budget: at most this many shapes, besides the background (over an opaque image,
+    the largest region is one full-canvas rect, as the page under a designer's drawing)."""
     min_area: float
     """Speckle removal: regions smaller than this many pixels are merged into neighbours."""
     tolerance: float
@@ -42,6 +43,12 @@ class TraceSettings:
     """Paint each region with its colour class's average colour, so the picture has at
     most `colors` colours (a poster look), instead of the region's own mean colour
     (closer to the image)."""
+    lines: float
+    """A cubic whose control points lie within this many pixels of its chord is written as
+    a line, and lines that continue each other as one (0: every segment a cubic)."""
+    primitives: bool
+    """A shape whose outline is an axis-aligned rectangle, circle or ellipse (within
+    ``lines`` pixels, or the fit's tolerance for curves) is written as that element."""
     seed: int
     """Seed of the k-means sampling and initialisation: equal seeds give equal output."""
 
@@ -91,7 +98,7 @@ def check_settings(s: TraceSettings) -> None:
         bad("tolerance", "must be positive")
     if not 0 < s.corner_angle <= 180:
         bad("corner_angle", "must be in (0, 180] degrees")
-    for name in ("blur", "overlap", "smoothing"):
+    for name in ("blur", "overlap", "smoothing", "lines"):
         if getattr(s, name) < 0:
             bad(name, "must not be negative")
     if s.seed < 0:

@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from vecfit.svg.document import NewDocument, SvgDocument
+from vecfit.svg.numbers import fmt_many
 from vecfit.svg.pathdata import format_path_data
 
 DECIMALS = 2  # a trace is placed to a hundredth of a pixel, its refinement finer
@@ -23,6 +24,25 @@ def path_data(subpaths) -> str:
     if not spans:
         return ""
     return format_path_data(np.concatenate(points), degrees, spans, decimals=DECIMALS, compact=True)
+
+
+def outline_path_data(outlines) -> str:
+    """'M x y C ... L ... Z' for closed outlines (primitives.Outline: lines and cubics, each
+    closed by a Z)."""
+    if not outlines:
+        return ""
+    points = np.concatenate([o.points for o in outlines])
+    degrees, spans = [], []
+    for o in outlines:
+        spans.append((len(degrees), len(o.degrees), True))
+        degrees += o.degrees
+    return format_path_data(points, degrees, spans, decimals=DECIMALS, compact=True, axis_lines=True)
+
+
+def add_primitive(document: NewDocument, ident: str, tag: str, geometry: dict, fill: str) -> None:
+    """A rect, circle or ellipse (primitives.Primitive's geometry, in pixels)."""
+    numbers = dict(zip(geometry, fmt_many(list(geometry.values()), DECIMALS)))
+    document.add(tag, {"id": ident, **numbers, "fill": fill})
 
 
 def new_document(width: int, height: int) -> NewDocument:

@@ -23,7 +23,13 @@ from .quantize import OPAQUE, prefilter, quantize_colors
 from .regions import build_regions, palette_colors
 from .settings import TraceResult, TraceSettings, check_settings
 from .subpixel import refine_outlines
-from .svgtext import add_path, add_rect, new_document, path_data
+from .primitives import as_primitive, straightened
+
+# An outline within this many pixels of an ellipse is one: the traced edges, placed between
+# pixels from the anti-aliasing, stray 0.1-0.2 px from a true circle, and a rounded
+# rectangle's sides 0.5 px or more from its nearest ellipse (an emoji's eye, 20 x 37 px).
+ELLIPSE_TOLERANCE = 0.35
+from .svgtext import add_path, add_primitive, add_rect, new_document, outline_path_data, path_data
 
 
 def check_image(image) -> np.ndarray:
@@ -75,7 +81,9 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     report("quantise", 0.0)
     classes = quantize_colors(prefilter(rgb, s.blur), opaque, int(s.colors), int(s.seed))
     report("regions", 0.15)
-    regions = build_regions(classes, rgb, int(s.paths), s.min_area, s.merge_thin)
+    # over an opaque image the largest region becomes the background rect, which the budget
+    # does not count (a designer's page is the background of the drawing)
+    regions = build_regions(classes, rgb, int(s.paths) + int(bool(opaque.all())), s.min_area, s.merge_thin)
     report("order", 0.35)
     boxes = bounding_boxes(regions.labels, regions.count)  # each region's (rows, cols) slices
     order = drawing_order(regions.labels, regions.count, boxes)
@@ -124,8 +132,20 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
         fill = hex_color(paint[i])
         fills.add(fill)
         cut = any(holes[sl])
-        add_path(document, f"p{len(document.root)}", path_data(subpaths), fill, evenodd=cut)
-        segments += sum(len(sp) for sp in subpaths)
+        ident = f"p{len(document.root)}"
+        if s.lines <= 0:
+            add_path(document, ident, path_data(subpaths), fill, evenodd=cut)
+            segments += sum(len(sp) for sp in subpaths)
+            continue
+        simplified = [straightened(sp, s.lines) for sp in subpaths]
+        shape = as_primitive(outlines[sl.start], simplified[0], s.lines, ELLIPSE_TOLERANCE) \
+            if s.primitives and len(simplified) == 1 and sl.stop - sl.start == 1 else None
+        if shape is not None:
+            add_primitive(document, ident, shape.tag, shape.attributes, fill)
+            segments += 4
+        else:
+            add_path(document, ident, outline_path_data(simplified), fill, evenodd=cut)
+            segments += sum(len(o.degrees) - 1 for o in simplified)
     report("fit", 1.0)
     return TraceResult(document=document, paths=len(document.root), colors=len(fills),
                        segments=segments, seconds=time.perf_counter() - start)

@@ -1,0 +1,105 @@
+"""Straight runs, rectangles, circles and ellipses in a trace (vecfit/initial/tracer/primitives.py)."""
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from vecfit.initial.tracer import TraceSettings, trace_image
+from vecfit.initial.tracer.bezier import fit_closed
+from vecfit.initial.tracer.primitives import as_primitive, straightened
+
+from test_trace import coverage, paint, psnr, render
+
+
+def line_cubic(a, b, bend=0.0):
+    """A cubic from a to b with its control points at the thirds, pushed ``bend`` px off."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    d = b - a
+    n = np.array([-d[1], d[0]]) / np.hypot(*d)
+    return np.stack([a, a + d / 3 + bend * n, a + 2 * d / 3 + bend * n, b])
+
+
+def loop_of(corners, bends=None, split=1):
+    """Closed cubics through ``corners``, each side cut into ``split`` cubics."""
+    segs = []
+    for k, a in enumerate(corners):
+        b = corners[(k + 1) % len(corners)]
+        for j in range(split):
+            p = np.asarray(a, float) + (np.asarray(b, float) - a) * j / split
+            q = np.asarray(a, float) + (np.asarray(b, float) - a) * (j + 1) / split
+            segs.append(line_cubic(p, q, 0.0 if bends is None else bends[k]))
+    return np.array(segs)
+
+
+def test_straight_cubics_become_lines_and_runs_merge():
+    square = loop_of([(10, 10), (40, 10), (40, 30), (10, 30)], split=3)  # 12 cubics
+    out = straightened(square, 0.25)
+    assert out.degrees == [1, 1, 1, 1, 1]  # four sides and the closing Z
+    assert len(out.points) == 5 and np.allclose(out.points[0], out.points[-1])
+    assert {tuple(p) for p in out.points[:4]} == {(10, 10), (40, 10), (40, 30), (10, 30)}
+
+
+def test_runs_merge_across_the_outline_start():
+    # the outline starts in the middle of the bottom side
+    corners = [(25, 30), (10, 30), (10, 10), (40, 10), (40, 30)]
+    out = straightened(loop_of(corners), 0.25)
+    assert out.degrees == [1, 1, 1, 1, 1]
+    assert {tuple(p) for p in out.points[:4]} == {(10, 10), (40, 10), (40, 30), (10, 30)}
+
+
+def test_curved_and_doubling_back_cubics_stay_cubics():
+    bent = loop_of([(10, 10), (40, 10), (40, 30), (10, 30)], bends=[0.0, 2.0, 0.0, 0.2])
+    out = straightened(bent, 0.25)
+    assert out.degrees == [1, 3, 1, 1, 1]  # the 0.2-px bend is within the tolerance
+    back = np.array([[[0, 0], [30, 0], [-10, 0], [20, 0]], [[20, 0], [20, 10], [0, 10], [0, 0]]], float)
+    assert straightened(back, 0.25).degrees[0] == 3  # control points beyond the chord's ends
+
+
+def test_rectangle_circle_and_ellipse_recognised():
+    rect = loop_of([(10, 10), (40, 10), (40, 30), (10, 30)], split=2)
+    shape = as_primitive(rect, straightened(rect, 0.25), 0.25, 0.25)
+    assert shape.tag == "rect" and shape.attributes == pytest.approx(
+        {"x": 10, "y": 10, "width": 30, "height": 20})
+    tilted = loop_of([(10, 10), (40, 12), (38, 32), (8, 30)])
+    assert as_primitive(tilted, straightened(tilted, 0.25), 0.25, 0.25) is None
+
+    t = np.linspace(0, 2 * np.pi, 800, endpoint=False)
+    circle = np.stack([50 + 20 * np.cos(t), 40 + 20 * np.sin(t)], 1)
+    smooth = fit_closed(circle, 0.1, 135.0)
+    shape = as_primitive(circle, straightened(smooth, 0.25), 0.25, 0.25)
+    assert shape.tag == "circle"
+    assert [shape.attributes[k] for k in ("cx", "cy", "r")] == pytest.approx([50, 40, 20], abs=0.02)
+    ellipse = np.stack([50 + 30 * np.cos(t), 40 + 12 * np.sin(t)], 1)
+    shape = as_primitive(ellipse, straightened(fit_closed(ellipse, 0.1, 135.0), 0.25), 0.25, 0.25)
+    assert shape.tag == "ellipse"
+    assert [shape.attributes[k] for k in ("cx", "cy", "rx", "ry")] == pytest.approx([50, 40, 30, 12], abs=0.02)
+    noisy = circle + np.random.default_rng(1).normal(0, 0.1, circle.shape)
+    assert as_primitive(noisy, straightened(smooth, 0.25), 0.25, 0.35).tag == "circle"
+
+
+def test_a_stadium_is_not_an_ellipse():
+    """A rounded rectangle's straight sides leave an ellipse by more than the tolerance."""
+    t = np.linspace(0, 2 * np.pi, 800, endpoint=False)
+    x, y = np.cos(t), np.sin(t)
+    pts = np.stack([50 + 10 * x, 40 + 18 * np.clip(y * 1.6, -1, 1)], 1)
+    segs = fit_closed(pts, 0.1, 135.0)
+    assert as_primitive(pts, straightened(segs, 0.25), 0.25, 0.35) is None
+
+
+def test_striped_flag_traces_to_rects(tmp_path):
+    """Three stripes and a disc: one background rect, two stripe rects and a circle, with
+    no curve in the file, drawn as closely as the paths were."""
+    w, h = 90, 60
+    stripe1 = coverage(lambda x, y: (y > 20) & (y < 40) & (x > -1), w, h)
+    stripe2 = coverage(lambda x, y: (y > 40) & (x > -1), w, h)
+    disc = coverage(lambda x, y: (x - 45.3) ** 2 + (y - 30.2) ** 2 < 8.4 ** 2, w, h)
+    image = paint([(stripe1, (0.9, 0.9, 0.9)), (stripe2, (0.1, 0.5, 0.2)), (disc, (0.8, 0.1, 0.1))],
+                  w, h, background=(0.1, 0.2, 0.6))
+    shapes = trace_image(image, TraceSettings.defaults(paths=8))
+    plain = trace_image(image, TraceSettings.defaults(paths=8, lines=0.0))
+    assert len(re.findall(r"<rect\b", shapes.svg)) == 3 and "<circle" in shapes.svg
+    assert " d=" not in shapes.svg and len(shapes.svg) < 0.8 * len(plain.svg)
+    out, before = render(shapes, w, h, tmp_path), render(plain, w, h, tmp_path)
+    assert psnr(image[..., :3], out[..., :3]) >= psnr(image[..., :3], before[..., :3]) - 0.3

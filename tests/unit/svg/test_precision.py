@@ -1,0 +1,70 @@
+"""Decimals written (vecfit/svg/precision.py) and opacities to three decimals."""
+from __future__ import annotations
+
+import re
+
+import pytest
+import torch
+
+import vecfit
+from vecfit.errors import VecfitError
+from vecfit.svg.precision import decimals_for
+from vecfit.svg.write import opacity_text, svg_bytes
+
+from helpers import quiet_load
+
+
+@pytest.mark.parametrize("pixels_per_unit,side,decimals", [
+    (1.0, 512, 2), (1.0, 1024, 2), (1.0, 4096, 2), (1.0, 20000, 1),  # 0.01 px up to 1,024 px, then its share
+    (512 / 24, 512, 4),  # a 24-unit icon drawn at 512 px
+    (0.1, 512, 1), (1e-9, 512, 0), (1e9, 512, 6), (0.0, 512, 6)])
+def test_decimals_for(pixels_per_unit, side, decimals):
+    assert decimals_for(pixels_per_unit, side) == decimals
+
+
+@pytest.mark.parametrize("value,text", [(1.0, None), (0.9996, None), (0.9994, "0.999"), (0.5, "0.5"),
+                                        (0.12345, "0.123"), (0.0, "0"), (-0.2, "0"), (1.7, None)])
+def test_opacity_written_with_three_decimals(value, text):
+    assert opacity_text(value) == text
+
+
+def _moved(tmp_path, width, view, **kw) -> str:
+    src = tmp_path / "in.svg"
+    src.write_text(f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{width}" viewBox="{view}">'
+                   '<path id="p" d="M1 1 C 2 1 3 2 3 3 L 1 3 Z" fill="#102030"/></svg>')
+    scene = quiet_load(src)
+    with torch.no_grad():
+        scene.shapes[0].geometry.points += 0.123456789
+        scene.shapes[0].fill.color[3] = 0.87654
+    return svg_bytes(scene, src, **kw).decode()
+
+
+def _decimals(d: str) -> int:
+    return max(len(n.split(".")[1]) if "." in n else 0 for n in re.findall(r"-?\d+(?:\.\d+)?", d))
+
+
+def test_written_decimals_follow_the_canvas(tmp_path):
+    d = re.search(r' d="([^"]*)"', _moved(tmp_path, 512, "0 0 512 512")).group(1)
+    assert _decimals(d) == 2
+    icon = _moved(tmp_path, 512, "0 0 24 24")  # a user unit is 21 px
+    assert _decimals(re.search(r' d="([^"]*)"', icon).group(1)) == 4
+    assert 'fill-opacity="0.877"' in icon
+    small = _moved(tmp_path, 24, "0 0 24 24", pixels=(512, 512))  # optimised at 512 px
+    assert _decimals(re.search(r' d="([^"]*)"', small).group(1)) == 4
+    fixed = _moved(tmp_path, 512, "0 0 512 512", precision=5)
+    assert _decimals(re.search(r' d="([^"]*)"', fixed).group(1)) == 5
+    with pytest.raises(VecfitError, match="precision"):
+        _moved(tmp_path, 512, "0 0 512 512", precision=9)
+
+
+def test_precision_option_reaches_the_file(tmp_path):
+    from PIL import Image
+    import numpy as np
+    Image.fromarray(np.full((32, 32, 3), 200, np.uint8)).save(tmp_path / "t.png")
+    (tmp_path / "i.svg").write_text('<svg xmlns="http://www.w3.org/2000/svg" width="32" height="32">'
+                                    '<path id="p" d="M3 3 C 9 3 20 9 20 20 L 3 20 Z" fill="#102030"/></svg>')
+    settings = {"optimize": {"iterations": 3}, "output": {"precision": 0}}
+    svg, _ = vecfit.refine(tmp_path / "t.png", tmp_path / "i.svg", settings=settings)
+    assert _decimals(re.search(r' d="([^"]*)"', svg).group(1)) == 0
+    with pytest.raises(VecfitError, match="output.precision"):
+        vecfit.refine(tmp_path / "t.png", tmp_path / "i.svg", settings={"output": {"precision": 7}})
