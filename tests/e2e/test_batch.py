@@ -160,8 +160,12 @@ def test_resume_skips_finished_images_and_redoes_changed_ones(folder, tmp_path):
     assert statuses(out) == {"a.png": SKIPPED, "b.png": SKIPPED, "c.png": FAILED, "d.png": UNPAIRED}
     assert mtimes(out, *files) == before  # not redone
     again = read_csv(out)
-    for k in ("mse_before", "mse_after", "psnr_after", "ssim_after", "seconds", "svg"):
+    for k in ("mse_before", "mse_after", "psnr_after", "ssim_after", "file_segments", "seconds", "svg"):
         assert again["a.png"][k] == first["a.png"][k]  # from the finished run's report
+    svg_text = (out / "a.svg").read_text()
+    assert int(first["a.png"]["file_paths"]) >= 1 and first["a.png"]["file_crossed_outlines"] == "0"
+    assert int(first["a.png"]["file_gzip_bytes"]) > 0 and ("opacity" in svg_text) == (
+        first["a.png"]["file_translucent_paints"] != "0")
     assert "skipped (finished)" in r.output
     no_leftovers(out)
 

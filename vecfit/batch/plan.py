@@ -36,8 +36,11 @@ NOT_RUN = "not run"
 STATUSES = (DONE, SKIPPED, FAILED, UNPAIRED, INTERRUPTED, NOT_RUN)
 
 METRICS = ("mse", "psnr", "ssim")
+# What a designer finds in the written SVG (the report's "file" counts, vecfit/svg/stats.py).
+FILE_COUNTS = ("paths", "segments", "gzip_bytes", "colours", "translucent_paints", "crossed_outlines")
 ROW_FIELDS = ("name", "file", "status", "reason", "init_svg",
               *[f"{m}_{when}" for m in METRICS for when in ("before", "after")],
+              *[f"file_{c}" for c in FILE_COUNTS],
               "seconds", "svg", "report", "comparison")
 
 
@@ -108,6 +111,9 @@ def metrics_into(row: dict, report: dict) -> dict:
             if m == "psnr" and v is None and values.get("mse") == 0:
                 v = math.inf
             row[f"{m}_{when}"] = v
+    counts = report.get("file") or {}
+    for c in FILE_COUNTS:
+        row[f"file_{c}"] = counts.get(c)
     return row
 
 

@@ -16,7 +16,7 @@ from vecfit.io.images import atomic_write, atomic_write_text
 from vecfit.io.orientation import upright_rgba
 from vecfit.io.report import GAP, save_report
 
-from .plan import DONE, INTERRUPTED, NOT_RUN, ROW_FIELDS, SKIPPED, STATUSES
+from .plan import DONE, FILE_COUNTS, INTERRUPTED, NOT_RUN, ROW_FIELDS, SKIPPED, STATUSES
 
 THUMB = 160  # longest side of a thumbnail, pixels
 THUMBS = "thumbs"
@@ -160,7 +160,8 @@ def write_html(path: Path, meta: dict, rows: list[dict]) -> None:
         "<p>Summaries: " + _link("summary.csv", "summary.csv") + ", "
         + _link("summary.json", "summary.json") + ".</p>",
         "<table><thead><tr><th>target</th><th>result</th><th>image</th><th>status</th><th>reason</th>"
-        "<th>MSE before → after</th><th>PSNR (dB)</th><th>SSIM</th><th>seconds</th><th>files</th>"
+        "<th>MSE before → after</th><th>PSNR (dB)</th><th>SSIM</th>"
+        "<th>paths / segments / gzip bytes / colours / translucent / crossed</th><th>seconds</th><th>files</th>"
         "</tr></thead><tbody>",
     ]
     for row in rows:
@@ -181,10 +182,16 @@ def write_html(path: Path, meta: dict, rows: list[dict]) -> None:
             f'<td class="num">{_pair(row, "mse", 5)}</td>'
             f'<td class="num">{_pair(row, "psnr", 2)}</td>'
             f'<td class="num">{_pair(row, "ssim", 4)}</td>'
+            f'<td class="num">{e(_file_counts(row))}</td>'
             f'<td class="num">{_num(row.get("seconds"), 2)}</td>'
             f'<td>{" ".join(links)}</td></tr>')
     parts += ["</tbody></table>", "</body></html>", ""]
     atomic_write_text(path, "\n".join(parts))
+
+
+def _file_counts(row: dict) -> str:
+    values = [row.get(f"file_{c}") for c in FILE_COUNTS]
+    return "" if all(v is None for v in values) else " / ".join("–" if v is None else str(v) for v in values)
 
 
 def write_all(out_dir: Path, in_dir: Path, meta: dict, rows: list[dict]) -> dict:

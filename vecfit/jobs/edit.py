@@ -22,7 +22,11 @@ from vecfit.io.images import downscaled, downscaled_weight
 from vecfit.io.report import error_map, panels_image, save_panels, save_report
 from vecfit.renderer import device as devices
 from vecfit.scene import Scene
+from vecfit.scene.crossings import crossed_subpaths
+from vecfit.scene.untangle import untangle
 from vecfit.svg.numbers import hex_color
+from vecfit.svg.precision import shape_decimals
+from vecfit.svg.stats import design_stats
 from vecfit.svg.write import svg_bytes
 
 from .config import output_precision, settings_of
@@ -139,6 +143,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     before = {id(t): t.detach().clone() for k in kinds for t in scene.parameters()[k]}
 
     goal = Target(torch.from_numpy(small), background, torch.from_numpy(weight))
+    drawn_crossed = crossed_subpaths(scene)  # the user's crossings stay; the fit's are cut
     progress.start(settings.iterations)
     result = optimize(scene, goal, settings, progress=progress, penalty=penalty)
     final_image = original_image if result.iterations == 0 else _render_full(scene, w, h, opt).numpy()
@@ -149,10 +154,14 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     if not all(math.isfinite(final[k]) or (k == "psnr" and final["mse"] == 0) for k in final):
         raise VecfitError(f"the optimised image has non-finite values ({final}); nothing written")
     changed = changed_elements(scene, before, w, h)
+    # after the picture and the changes are measured: cutting a crossed outline into
+    # simple loops draws the same (less slivers under a square pixel)
+    untangle(scene, keep=drawn_crossed, decimals=shape_decimals(scene, (w, h), output_precision(config)))
 
     # The SVG keeps its elements: no background rect is added (an uncovered canvas stays
     # transparent, which over the background looks as optimised).
-    outputs.keep_svg(svg_bytes(scene, document, precision=output_precision(config), pixels=(w, h)))
+    written = svg_bytes(scene, document, precision=output_precision(config), pixels=(w, h))
+    outputs.keep_svg(written)
     if outputs.comparison is not None:
         save_panels(outputs.comparison, panels_image(
             [original_rgb, target_rgb, final_rgb, error_map(final_rgb, target_rgb)]))
@@ -188,6 +197,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
         "seconds": {"total": seconds, "optimize": result.seconds,
                     "per_iteration": result.seconds / max(result.iterations, 1)},
         "shapes": len(scene.shapes),
+        "file": design_stats(written),  # what a designer finds in the SVG written
         "parameters": {**result.parameters, "total": sum(result.parameters.values())},
         "loss": settings.loss,
         "loss_curve": result.losses,

@@ -21,9 +21,13 @@ from vecfit.renderer import device as devices
 from vecfit.renderer.forward import render_numpy
 from vecfit.scene import Scene
 from vecfit.scene.arrays import is_tensor, to_numpy
+from vecfit.scene.crossings import crossed_subpaths
+from vecfit.scene.untangle import untangle
 from vecfit.svg.numbers import hex_color
 from vecfit.svg.document import SvgDocument
 from vecfit.svg.read import read_svg, scene_of
+from vecfit.svg.precision import shape_decimals
+from vecfit.svg.stats import design_stats
 from vecfit.svg.write import svg_bytes
 
 from .config import output_precision
@@ -162,12 +166,17 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         settings = Settings.from_config(opt)
         if generated and settings.alpha == "auto" and not translucency_wanted(small, background is not None):
             make_opaque(scene)
+        # crossings the user drew stay; those the fit makes are cut into simple loops
+        drawn_crossed = set() if generated else crossed_subpaths(scene)
         progress.start(settings.iterations)
         result = optimize(scene, Target(torch.from_numpy(small), background), settings, progress=progress,
                           hooks=hooks, keep_alpha=keep_alpha)
+        untangled = untangle(scene, keep=drawn_crossed,
+                             decimals=shape_decimals(scene, (w, h), output_precision(config)))
     else:
         progress.start(0)
         result = _not_optimised(scene, opt)
+        untangled = 0
     if result.iterations == 0:  # nothing moved: the same picture and figures
         final_image, final_rgb, final = initial_image, initial_rgb, dict(initial)
     else:
@@ -181,8 +190,9 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     # uncovered, the background is written in as a first rect.
     covered = float(final_image[..., 3].min()) >= OPAQUE
     svg_background = background if background is not None and not covered else None
-    outputs.keep_svg(svg_bytes(scene, document, background=svg_background,
-                               precision=output_precision(config), pixels=(w, h)))
+    written = svg_bytes(scene, document, background=svg_background, precision=output_precision(config),
+                        pixels=(w, h))
+    outputs.keep_svg(written)
     if outputs.comparison is not None:
         save_comparison(outputs.comparison, target_rgb, initial_rgb, final_rgb)
     seconds = time.perf_counter() - started
@@ -209,6 +219,8 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
                     "per_iteration": result.seconds / max(result.iterations, 1),
                     "iterations": [round(t, 4) for t in result.iteration_seconds]},
         "shapes": len(scene.shapes),
+        "untangled_outlines": untangled,  # outlines the fit made cross themselves, cut into simple loops
+        "file": design_stats(written),  # what a designer finds in the SVG written
         "parameters": {**result.parameters, "total": sum(result.parameters.values())},
         "loss": opt["loss"],
         "loss_curve": result.losses,

@@ -29,7 +29,11 @@ from vecfit.fitting.metrics import compare, seen, to_rgb
 from vecfit.io.report import save_panels, save_report, side_by_side
 from vecfit.renderer import device as devices
 from vecfit.renderer.raster import render
+from vecfit.scene.crossings import crossed_subpaths
+from vecfit.scene.untangle import untangle
 from vecfit.svg.numbers import hex_color
+from vecfit.svg.precision import shape_decimals
+from vecfit.svg.stats import design_stats
 from vecfit.svg.write import svg_bytes
 
 from .config import output_precision, settings_of
@@ -129,6 +133,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     progress.start(len(plan) * retarget.iterations_per_step + retarget.final_iterations)
 
     loop = Settings(**{**settings.__dict__, "iterations": retarget.iterations_per_step})
+    drawn_crossed = crossed_subpaths(scene)  # the user's crossings stay; the fit's are cut
     cur_w, cur_h = ww, wh
     image = original
     used = {0: 0, 1: 0}
@@ -164,12 +169,14 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     done = not interrupted
     out_w, out_h = (new_w, new_h) if done else (cur_w / s_x, cur_h / s_y)
     scene.width, scene.height = out_w, out_h
+    untangle(scene, keep=drawn_crossed, decimals=shape_decimals(scene, None, output_precision(config)))
     final = draw(cur_w, cur_h, opt["eval_samples"])
     final_rgb, goal_rgb = to_rgb(final, background), to_rgb(image, background)
     fit = compare(final_rgb, goal_rgb)
     if not all(math.isfinite(fit[k]) or (k == "psnr" and fit["mse"] == 0) for k in fit):
         raise VecfitError(f"the retargeted image has non-finite values ({fit}); nothing written")
-    outputs.keep_svg(svg_bytes(scene, document, canvas=(out_w, out_h), precision=output_precision(config)))
+    written = svg_bytes(scene, document, canvas=(out_w, out_h), precision=output_precision(config))
+    outputs.keep_svg(written)
     original_rgb = to_rgb(original, background)
     scaled_rgb = cv2.resize(original_rgb.astype(np.float32), (cur_w, cur_h), interpolation=cv2.INTER_AREA)
     if outputs.comparison is not None:
@@ -192,6 +199,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
         "initial": plain,
         "optimized": fit,
         "shapes": len(scene.shapes),
+        "file": design_stats(written),  # what a designer finds in the SVG written
         "iterations": iterations,
         "interrupted": interrupted,
         "skipped_steps": skipped,

@@ -104,14 +104,21 @@ def crossed_outlines(scene, tolerance: float = 0.01) -> int:
     """How many closed subpaths of the Scene's filled paths cross themselves (circles,
     ellipses and rects never do). ``tolerance`` is in canvas pixels at the Scene's size:
     each shape's is divided by its matrix's scale."""
+    return len(crossed_subpaths(scene, tolerance))
+
+
+def crossed_subpaths(scene, tolerance: float = 0.01) -> set[tuple[int, int]]:
+    """(shape index, subpath index) of each closed subpath of the Scene's filled paths
+    that crosses itself; ``tolerance`` as in crossed_outlines. One batch for the Scene."""
     shapes = [(i, s) for i, s in enumerate(scene.shapes) if s.fill is not None and isinstance(s.geometry, Path)]
     if not shapes:
-        return 0
+        return set()
     matrices = to_numpy(shape_matrices(scene, scene.width, scene.height)).astype(np.float64)
     scales = [_scale(matrices[i]) for i, _ in shapes]
     tolerances = [tolerance / s if s > 0 else tolerance for s in scales]
-    _, found = _closed_subpath_crossings([s.geometry for _, s in shapes], tolerances)
-    return sum(1 for f in found if f)
+    owners = [i for i, s in shapes for closed in (c for _, _, c in s.geometry.subpaths) if closed]
+    indices, found = _closed_subpath_crossings([s.geometry for _, s in shapes], tolerances)
+    return {(owner, k) for owner, k, f in zip(owners, indices, found) if f}
 
 
 # ------------------------------------------------------------------------ inputs
