@@ -24,6 +24,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from vecfit.io.tone import is_flat_art
 from vecfit.scene import Scene
 from vecfit.scene.arrays import to_numpy
 
@@ -38,12 +39,6 @@ RIM = 2
 # A target needs this share of its pixels (and at least MIN_PIXELS) in translucent areas
 # to count as translucent: a few stray pixels of a scan's alpha do not.
 MIN_SHARE, MIN_PIXELS = 0.001, 16
-# A pixel is flat when its 3 x 3 neighbourhood varies by at most FLAT_STEP in every
-# channel; a target with less than FLAT_SHARE of its pixels flat is continuous-tone.
-# Rendered icons, logos, flags and emoji: 0.84-0.97 flat; skimage's photos 0.04-0.53
-# (rocket's sky), kitty and peppers under 0.01.
-FLAT_STEP, FLAT_SHARE = 3 / 255, 0.7
-
 
 def translucent_pixels(alpha: np.ndarray) -> np.ndarray:
     """[H, W] bool: the translucent pixels of a straight alpha channel that are not on an
@@ -64,21 +59,13 @@ def has_translucent_areas(alpha: np.ndarray) -> bool:
     return count >= max(MIN_PIXELS, MIN_SHARE * np.asarray(alpha).size)
 
 
-def flat_share(rgb: np.ndarray) -> float:
-    """The share of an image's pixels in flat areas (see FLAT_STEP)."""
-    a = np.ascontiguousarray(rgb, np.float32)
-    kernel = np.ones((3, 3), np.uint8)
-    spread = cv2.dilate(a, kernel) - cv2.erode(a, kernel)
-    return float((spread.reshape(*a.shape[:2], -1).max(2) <= FLAT_STEP).mean())
-
-
 def translucency_wanted(image: np.ndarray, opaque: bool) -> bool:
     """Whether ``auto`` lets every colour's alpha change for this target ([H, W, 4]
     straight RGBA; ``opaque``: fitted over a background, so its alpha is not compared):
     it has translucent areas, or it is continuous-tone."""
     if not opaque and has_translucent_areas(image[..., 3]):
         return True
-    return flat_share(image[..., :3]) < FLAT_SHARE
+    return not is_flat_art(image[..., :3])
 
 
 def colors_kept_opaque(scene: Scene, mode: str, target_translucent: bool) -> list:

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 import vecfit
-from vecfit.fitting.opacity import flat_share, has_translucent_areas, translucency_wanted
+from vecfit.fitting.opacity import has_translucent_areas, translucency_wanted
+from vecfit.io.tone import flat_share
 
 
 def disc(w=48, h=40, cx=24.3, cy=19.6, r=11.2, ss=8):

@@ -49,6 +49,10 @@ class TraceSettings:
     primitives: bool
     """A shape whose outline is an axis-aligned rectangle, circle or ellipse (within
     ``lines`` pixels, or the fit's tolerance for curves) is written as that element."""
+    compound: bool
+    """On flat art (icons, logos, emoji: most pixels in flat areas), keep every region and
+    draw the regions of one colour as one path of several pieces, the budget then counting
+    colours (groups.py); photographs keep a path per region."""
     seed: int
     """Seed of the k-means sampling and initialisation: equal seeds give equal output."""
 

@@ -14,9 +14,11 @@ import time
 import numpy as np
 
 from vecfit.errors import VecfitError
+from vecfit.io.tone import is_flat_art
 from vecfit.svg.numbers import hex_color
 
 from .bezier import fit_outlines
+from .groups import grouped
 from .labels import bounding_boxes
 from .outlines import drawing_order, grown_masks, shape_outlines
 from .quantize import OPAQUE, prefilter, quantize_colors
@@ -24,6 +26,12 @@ from .regions import build_regions, palette_colors
 from .settings import TraceResult, TraceSettings, check_settings
 from .subpixel import refine_outlines
 from .primitives import as_primitive, straightened
+
+# Compound paths keep every region (specks and slivers merge away regardless): the
+# budget counts colours. (Capping the regions at 2-8 a path changed no file's segments by
+# more than 10% and cost up to 4.6 dB; joining neighbours closer than 3-10 CIELAB units,
+# the bands of a quantised gradient, cost 6-10 dB median on 7 designer files.)
+ALL_REGIONS = 1 << 30
 
 # An outline within this many pixels of an ellipse is one: the traced edges, placed between
 # pixels from the anti-aliasing, stray 0.1-0.2 px from a true circle, and a rounded
@@ -82,11 +90,21 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     classes = quantize_colors(prefilter(rgb, s.blur), opaque, int(s.colors), int(s.seed))
     report("regions", 0.15)
     # over an opaque image the largest region becomes the background rect, which the budget
-    # does not count (a designer's page is the background of the drawing)
-    regions = build_regions(classes, rgb, int(s.paths) + int(bool(opaque.all())), s.min_area, s.merge_thin)
+    # does not count (a designer's page is the background of the drawing); flat art keeps
+    # every region and the budget counts colours (compound paths: groups.py)
+    compound = s.compound and is_flat_art(rgb)
+    budget = ALL_REGIONS if compound else int(s.paths) + int(bool(opaque.all()))
+    regions = build_regions(classes, rgb, budget, s.min_area, s.merge_thin)
     report("order", 0.35)
     boxes = bounding_boxes(regions.labels, regions.count)  # each region's (rows, cols) slices
     order = drawing_order(regions.labels, regions.count, boxes)
+    if compound and regions.count:
+        backdrop = int(order[0]) if opaque.all() else None
+        regions = grouped(regions, rgb, int(s.paths), backdrop)
+        boxes = bounding_boxes(regions.labels, regions.count)
+        order = drawing_order(regions.labels, regions.count, boxes)
+        if backdrop is not None:  # the backdrop's group (the last) is drawn first, as the rect
+            order = np.concatenate([[regions.count - 1], order[order != regions.count - 1]])
     rank = np.empty(regions.count, np.int64)
     rank[order] = np.arange(regions.count)
     # over an opaque image, everything else is drawn over the largest region: a

@@ -1,0 +1,112 @@
+"""Compound paths: the regions of one colour drawn by one path.
+
+A designer draws the letters of a word, the spots of a leopard or the stars of a flag as
+one path of several subpaths, so a flat-art file has few paths and many pieces. A tracer
+that spends one path per connected region cannot draw such a picture at the designer's
+path count: the budget merges away whole letters. Here every region is kept (specks
+and anti-aliased slivers still merge away) and the path budget bounds the number of
+colours instead: regions are grouped by colour, by Ward's criterion (the pair of groups
+whose merge adds the least squared error to the flat-colour picture merges first, as the
+region merger does for neighbours, here for any two), until at most ``budget`` groups
+are left, and each group becomes one region of several pieces painted with its mean
+colour. The rest of the tracer draws it like any region: stacking order only decides
+which shape reaches under which, and the pieces of a group fill the same pixels as before.
+
+The background region of an opaque image (the tracer's full-canvas rect) keeps a group
+of its own: pieces of its colour elsewhere (an eye's highlight) must be drawn above what
+surrounds them, not under everything.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .regions import Regions, interior, region_stats
+
+
+def ward_groups(area: np.ndarray, color: np.ndarray, budget: int) -> np.ndarray:
+    """Group index (0 ..) of each of the items (areas, mean colours [n, 3]) merged by
+    Ward's criterion down to ``budget`` groups: the groups that merging the cheapest pair
+    each time leaves. The whole hierarchy is built by nearest-neighbour chains (O(n²));
+    its merges, replayed cheapest first, stop at the budget (Ward's merge costs never
+    fall up the hierarchy, so a merge's parts are always merged before it)."""
+    n = len(area)
+    if n <= budget:
+        return np.arange(n)
+    merges = _ward_hierarchy(area.astype(np.float64), color.astype(np.float64))
+    merges.sort(key=lambda m: m[0])
+    parent = np.arange(n)
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for _, a, b in merges[:n - budget]:
+        parent[root(b)] = root(a)
+    _, compact = np.unique([root(i) for i in range(n)], return_inverse=True)
+    return compact
+
+
+def _ward_hierarchy(size: np.ndarray, centre: np.ndarray) -> list[tuple[float, int, int]]:
+    """Every merge (cost, kept item, merged item) of Ward's hierarchy over the items,
+    each merged group named by one of its items."""
+    size, centre = size.copy(), centre.copy()
+    alive = np.ones(len(size), bool)
+    merges, chain = [], []
+
+    def costs(a: int) -> np.ndarray:
+        d = ((centre - centre[a]) ** 2).sum(1)
+        c = size[a] * size / np.maximum(size[a] + size, 1e-12) * d
+        c[~alive] = np.inf
+        c[a] = np.inf
+        return c
+
+    for _ in range(len(size) - 1):
+        while True:
+            if not chain:
+                chain.append(int(np.flatnonzero(alive)[0]))
+            a = chain[-1]
+            c = costs(a)
+            b = int(np.argmin(c))
+            if len(chain) > 1 and c[chain[-2]] <= c[b]:
+                b = chain[-2]
+                break
+            chain.append(b)
+        chain.pop()
+        chain.pop()
+        total = size[a] + size[b]
+        merges.append((float(c[b]), a, b))
+        centre[a] = (size[a] * centre[a] + size[b] * centre[b]) / total
+        size[a] = total
+        alive[b] = False
+    return merges
+
+
+def _relabelled(regions: Regions, rgb: np.ndarray, label: np.ndarray, count: int) -> Regions:
+    """The regions joined by ``label`` (new index of each), each painted with its pixels'
+    mean colour (its interior's where it has enough, as the region builder does)."""
+    labels = np.where(regions.labels >= 0, label[np.maximum(regions.labels, 0)], -1).astype(np.int32)
+    area, color = region_stats(labels, count, rgb)
+    inner = np.where(interior(labels), labels, -1)
+    inner_area, inner_color = region_stats(inner, count, rgb)
+    enough = inner_area >= np.maximum(0.25 * area, 4)
+    color[enough] = inner_color[enough]
+    return Regions(labels, count, area, color)
+
+
+def grouped(regions: Regions, rgb: np.ndarray, budget: int, background: int | None) -> Regions:
+    """The regions relabelled as at most ``budget`` colour groups (besides the background
+    region, which keeps its own), each painted with its pixels' mean colour (its
+    interior's, as the region builder does)."""
+    n = regions.count
+    if n == 0:
+        return regions
+    others = np.array([i for i in range(n) if i != background], np.int64)
+    group = np.empty(n, np.int64)
+    group[others] = ward_groups(regions.area[others], regions.color[others], max(int(budget), 1))
+    count = int(group[others].max()) + 1 if len(others) else 0
+    if background is not None:
+        group[background] = count
+        count += 1
+    return _relabelled(regions, rgb, group, count)
