@@ -23,7 +23,9 @@ _NAMES = {name: tuple(c / 255.0 for c in ImageColor.getrgb(name)) + (1.0,)
 _NAMES["transparent"] = (0.0, 0.0, 0.0, 0.0)
 
 _HEX = re.compile(r"#([0-9a-fA-F]{3,8})$")
-_FUNC = re.compile(r"(rgba?|hsla?)\(\s*(.*?)\s*\)$", re.IGNORECASE)
+# The function's name; its arguments are what lies between "(" and the closing ")",
+# stripped (as a pattern, "\s*(.*?)\s*\)$" tried every split of a run of spaces: cubic).
+_FUNC = re.compile(r"(rgba?|hsla?)\(", re.IGNORECASE)
 _ARG = re.compile(rf"({NUMBER})(%|deg)?$", re.IGNORECASE)
 
 
@@ -41,8 +43,10 @@ def parse_color(text) -> RGBA | None:
     if m:
         return _hex(m.group(1))
     m = _FUNC.match(text)
-    if m:
-        return _function(m.group(1).lower(), m.group(2))
+    if m and text.endswith(")"):
+        body = text[m.end():-1].strip()
+        if "\n" not in body:  # (as the pattern before: a line break only beside the parentheses)
+            return _function(m.group(1).lower(), body)
     return _NAMES.get(text.lower())
 
 

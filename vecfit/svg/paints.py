@@ -18,7 +18,9 @@ from .color import RGBA, parse_color
 from .dom import href_id, local_name
 from .units import clamp, clamp_array, parse_fraction, parse_length, parse_transform
 
-_URL = re.compile(r"url\(\s*(['\"]?)\s*#([^'\")\s]+)\s*\1\s*\)\s*(.*)$", re.IGNORECASE)
+# (possessive, as units.NUMBER: "\s*" beside "\s*" with an empty quote between tried every
+# split of a run of spaces)
+_URL = re.compile(r"url\(\s*+(['\"]?+)\s*+#([^'\")\s]++)\s*+\1\s*+\)\s*+(.*)$", re.IGNORECASE)
 GRADIENTS = ("linearGradient", "radialGradient")
 _COMMON = ("gradientUnits", "gradientTransform", "spreadMethod")
 BLACK = (0.0, 0.0, 0.0, 1.0)

@@ -29,6 +29,7 @@ from .paints import BLACK, Paints, parse_opacity, parse_paint, solid
 from .color import parse_color
 from .document import SvgDocument
 from .dom import href_id, is_svg, local_name
+from .loops import looping_references
 from .shapes import Limiter, ShapeReader
 from .skips import Skips, VecfitWarning
 from .units import (parse_length, parse_number, parse_transform, parse_viewbox, translate,
@@ -129,7 +130,7 @@ class Reader:
         self._effects: dict[tuple[str, int], object] = {}
         self._reading: tuple[int, ...] = ()
         self._in_clip = False
-        self._loops = _looping_references(self.root, self.ids, document.computed)
+        self._loops = looping_references(self.root, self.ids, document.computed)
 
     # --------------------------------------------------------------- document
 
@@ -464,7 +465,11 @@ class Reader:
         draws solid: None) and stroke-dashoffset, in user units. A pattern that would take
         the scene past limits.MAX_DASHES dashes is noted and drawn solid."""
         items = re.split(r"\s*,\s*|\s+", (style.get("stroke-dasharray") or "none").strip())
-        values = [parse_length(t, self._diagonal()) for t in items]
+        diagonal, values = self._diagonal(), []
+        for item in items:
+            values.append(parse_length(item, diagonal))
+            if values[-1] is None:
+                break  # the list is invalid: the rest need not be read
         if items == ["none"] or any(v is None for v in values) or (pattern := dash_pattern(values)) is None:
             return None, 0.0
         offset = parse_length(style.get("stroke-dashoffset"), self._diagonal())
@@ -492,38 +497,6 @@ class Reader:
 NO_EFFECTS = (None, None, None, "normal", False)
 # A filter reference that leads nowhere: SVG (and resvg) then draws the element as nothing.
 _NO_FILTER = Filter(steps=[])
-
-
-def _looping_references(root, ids, computed) -> set[tuple[int, str]]:
-    """(element, property) of the references that make clip paths or masks loop, found
-    as resvg finds them (so that which one of a loop is cut is resvg's choice): for each
-    <clipPath> or <mask> in document order, the first element in it (itself included)
-    whose reference leads back to it, directly or through one other."""
-    cut: set[tuple[int, str]] = set()
-
-    def target(element, prop):
-        if (id(element), prop) in cut:
-            return None
-        ref = func_iri((computed(element).get(prop) or "").strip())
-        return ids.get(ref) if ref else None
-
-    for tag, prop in (("clipPath", "clip-path"), ("mask", "mask")):
-        holders = [e for e in root.iter() if isinstance(e.tag, str) and local_name(e.tag) == tag]
-        found = True
-        while found:
-            found = False
-            for node in holders:
-                for child in node.iter():
-                    link = target(child, prop)
-                    culprit = child if link is node else next(
-                        (e for e in (link.iter() if link is not None else ()) if target(e, prop) is node), None)
-                    if culprit is not None:
-                        cut.add((id(culprit), prop))
-                        found = True
-                        break
-                if found:
-                    break
-    return cut
 
 
 def _choice(text, allowed, default):

@@ -8,7 +8,10 @@ is parsed where it is used, with that property's rule for invalid values.
 from __future__ import annotations
 
 import re
+from collections import Counter
 from dataclasses import dataclass
+from itertools import accumulate, repeat
+from operator import itemgetter
 
 from .dom import local_name
 
@@ -25,15 +28,28 @@ NOT_INHERITED = frozenset({
 })
 PROPERTIES = INHERITED | NOT_INHERITED
 
-_COMMENT = re.compile(r"/\*.*?\*/", re.DOTALL)
 _SIMPLE_SELECTOR = re.compile(r"(\*|[A-Za-z_][\w-]*)?((?:[.#][A-Za-z_\-][\w-]*)*)$")
 _PART = re.compile(r"[.#][\w-]+")
+
+
+def without_comments(text: str) -> str:
+    """``text`` without its ``/* comments */``. (Found with str.find: the pattern
+    "/\\*.*?\\*/" scanned to the end from every unclosed "/*", quadratic.)"""
+    parts, i = [], 0
+    while (start := text.find("/*", i)) >= 0:
+        end = text.find("*/", start + 2)
+        if end < 0:
+            break  # unclosed, and so is every "/*" after it
+        parts.append(text[i:start])
+        i = end + 2
+    parts.append(text[i:])
+    return "".join(parts)
 
 
 def parse_declarations(text: str) -> list[tuple[str, str, bool]]:
     """``a: b; c: d !important`` -> [(name, value, important)], names lowercased."""
     out = []
-    for item in _COMMENT.sub("", text or "").split(";"):
+    for item in without_comments(text or "").split(";"):
         name, sep, value = item.partition(":")
         if not sep:
             continue
@@ -72,23 +88,28 @@ class StyleSheet:
     def __init__(self):
         self.rules: list[_Rule] = []
         self.unsupported: list[str] = []
+        self._index: dict[tuple, list[tuple[int, _Rule]]] | None = None  # made on the first lookup
 
     def add(self, css: str) -> None:
-        css = _COMMENT.sub("", css)
+        css = without_comments(css)
         for prelude, body in _blocks(css):
             if prelude.startswith("@"):
                 self.unsupported.append(prelude.split()[0])  # @media, @font-face, ...
                 continue
-            decls = parse_declarations(body)
-            for selector in prelude.split(","):
-                self._add_selector(selector.strip(), decls)
-        # Sorted so that applying matching rules in order gives later ones precedence.
-        self.rules.sort(key=lambda r: (r.specificity, r.order))
+            # (only properties the reader looks at: every element gets each matching rule's)
+            decls = [d for d in parse_declarations(body) if d[0] in PROPERTIES]
+            # each selector once, at its last place (an earlier repeat is wholly overridden)
+            selectors = list(dict.fromkeys(s.strip() for s in reversed(prelude.split(","))))
+            for selector in reversed(selectors):
+                self._add_selector(selector, decls)
+        self._index = None
 
     def _add_selector(self, selector: str, decls) -> None:
         m = _SIMPLE_SELECTOR.match(selector)
         if not selector or not m:
             self.unsupported.append(selector)
+            return
+        if not decls:
             return
         tag = None if m.group(1) in (None, "*") else m.group(1)
         parts = _PART.findall(m.group(2))
@@ -101,31 +122,68 @@ class StyleSheet:
                                         (int(important), len(ids), len(classes), int(tag is not None)),
                                         len(self.rules), chosen))
 
+    def _make_index(self) -> None:
+        """Sorts the rules (applied in order, later ones take precedence), drops each
+        declaration that a later rule of the same selector overrides (that rule matches
+        wherever this one does), and files every rule under one key that each element it
+        matches has: its first id, else its least used class, else its tag, else "any".
+        (Each element had checked every rule: 5,000 rules and 2,000 elements took seconds.)"""
+        self.rules.sort(key=lambda r: (r.specificity, r.order))
+        later: dict[tuple, set[str]] = {}  # selector -> properties set by its later rules
+        for rule in reversed(self.rules):
+            names = later.setdefault((rule.tag, rule.ids, rule.classes, rule.specificity[0]), set())
+            kept = []
+            for name, value in reversed(rule.declarations):
+                if name not in names:
+                    names.add(name)
+                    kept.append((name, value))
+            rule.declarations = kept[::-1]
+        uses = Counter(c for rule in self.rules for c in rule.classes)
+        self._index = {}
+        for position, rule in enumerate(self.rules):
+            if not rule.declarations:
+                continue
+            key = (("id", rule.ids[0]) if rule.ids
+                   else ("class", min(rule.classes, key=uses.__getitem__)) if rule.classes
+                   else ("tag", rule.tag) if rule.tag is not None else ("any",))
+            self._index.setdefault(key, []).append((position, rule))
+
     def declarations_for(self, element, tag: str):
         """(normal, important) declarations of the rules matching ``element``, lowest
         precedence first."""
-        if not self.rules:
+        if self._index is None:
+            self._make_index()
+        if not self._index:
             return [], []
         classes = set((element.get("class") or "").split())
         element_id = element.get("id")
+        keys = [("any",), ("tag", tag), ("id", element_id)] + [("class", c) for c in classes]
+        candidates = sorted((entry for key in keys for entry in self._index.get(key, ())), key=itemgetter(0))
         normal, important = [], []
-        for rule in self.rules:
+        for _, rule in candidates:
             if rule.matches(tag, element_id, classes):
                 (important if rule.specificity[0] else normal).extend(rule.declarations)
         return normal, important
 
 
+_BRACE_STEP = {"{": 1, "}": -1}
+
+
 def _blocks(css: str):
-    """(prelude, body) of each top-level ``prelude { body }``, nested braces skipped."""
+    """(prelude, body) of each top-level ``prelude { body }``, nested braces skipped (an
+    unclosed block runs to the end, less its last character)."""
+    # depth[k]: braces opened less braces closed up to css[k], counted in C rather than
+    # by a Python loop over the characters
+    depth = list(accumulate(map(_BRACE_STEP.get, css, repeat(0))))
     i, n = 0, len(css)
     while i < n:
         open_ = css.find("{", i)
         if open_ < 0:
             return
-        depth, j = 1, open_ + 1
-        while j < n and depth:
-            depth += {"{": 1, "}": -1}.get(css[j], 0)
-            j += 1
+        try:
+            j = depth.index(depth[open_] - 1, open_ + 1) + 1  # past the brace that closes it
+        except ValueError:
+            j = n
         yield css[i:open_].strip(), css[open_ + 1:j - 1]
         i = j
 

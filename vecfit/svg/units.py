@@ -14,9 +14,14 @@ import svgelements
 # Larger magnitudes overflow float32 or make the renderer's arithmetic lose all precision.
 LIMIT = 1e7
 
-NUMBER = r"[-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?"
+# Quantifiers are possessive (``++``, ``*+``, ``?+``: what they take is never given back),
+# so that a match fails in one pass: backtracking into a number (is "123" also "1", "23"?)
+# or into whitespace beside whitespace made matching quadratic, cubic or exponential in
+# the value's length (issue 41). A number's parts cannot start one another, so taking the
+# longest accepts the same texts.
+NUMBER = r"[-+]?+(?:\d++(?:\.\d*+)?+|\.\d++)(?:[eE][-+]?+\d++)?+"
 _NUMBER_RE = re.compile(NUMBER)
-_LENGTH_RE = re.compile(rf"\s*({NUMBER})\s*(px|pt|pc|mm|cm|in|em|ex|%)?\s*$", re.IGNORECASE)
+_LENGTH_RE = re.compile(rf"\s*+({NUMBER})\s*+(px|pt|pc|mm|cm|in|em|ex|%)?+\s*+$", re.IGNORECASE)
 _LIST_SPLIT = re.compile(r"[\s,]+")
 
 # Absolute units in px at CSS's 96 dpi; em and ex assume the default 16 px font.
@@ -103,9 +108,11 @@ def parse_transform(text) -> np.ndarray | None:
 _TRANSFORM_ARITY = {"matrix": (6,), "translate": (1, 2), "scale": (1, 2), "rotate": (1, 3), "skewX": (1,),
                     "skewY": (1,)}
 _WSP = r"[ \t\r\n\f]"
-_COMMA_WSP = rf"(?:{_WSP}+,?{_WSP}*|,{_WSP}*)"
-_TRANSFORM_ITEM = re.compile(rf"{_WSP}*([A-Za-z]+){_WSP}*\({_WSP}*((?:{NUMBER}(?:{_COMMA_WSP}(?={NUMBER}|[-+.\d]))?)*)"
-                             rf"{_WSP}*\)(?:{_WSP}*,?{_WSP}*)")
+_COMMA_WSP = rf"(?:{_WSP}++,?+{_WSP}*+|,{_WSP}*+)"
+# (possessive, as NUMBER: with numbers that may follow each other unseparated, "(" and 24
+# digits without ")" had 2^23 ways to fail)
+_TRANSFORM_ITEM = re.compile(rf"{_WSP}*+([A-Za-z]++){_WSP}*+\({_WSP}*+((?:{NUMBER}(?:{_COMMA_WSP}(?=[-+.\d]))?+)*+)"
+                             rf"{_WSP}*+\)(?:{_WSP}*+,?+{_WSP}*+)")
 
 
 def _valid_transform_list(text: str) -> bool:
