@@ -98,10 +98,13 @@ class StyleSheet:
                 continue
             # (only properties the reader looks at: every element gets each matching rule's)
             decls = [d for d in parse_declarations(body) if d[0] in PROPERTIES]
-            # each selector once, at its last place (an earlier repeat is wholly overridden)
-            selectors = list(dict.fromkeys(s.strip() for s in reversed(prelude.split(","))))
-            for selector in reversed(selectors):
-                self._add_selector(selector, decls)
+            # A selector repeated in one prelude makes its rule once, at its last place (an
+            # earlier repeat is wholly overridden), and is reported where it first stands.
+            selectors = [s.strip() for s in prelude.split(",")]
+            last = {s: i for i, s in enumerate(selectors)}
+            first = {s: i for i, s in reversed(list(enumerate(selectors)))}
+            for i in sorted({*first.values(), *last.values()}):
+                self._add_selector(selectors[i], decls if last[selectors[i]] == i else [])
         self._index = None
 
     def _add_selector(self, selector: str, decls) -> None:
