@@ -2,6 +2,7 @@
 (the paper's Table 2 experiment), scored at full size both by vecfit's own render and by
 resvg rendering the written SVG. Also where an iteration's time goes, at the start (first
 10% of the iterations) and the end (last 10%) of each run, and PSNR against wall time.
+Times are also given in R, the machine unit measured at the start (benchmarks/machine.py).
 
 Usage: python benchmarks/refine.py [--iterations N] [--threads T] [--images kitty,peppers]
        [--set optimize.mode=analytic ...]
@@ -16,6 +17,7 @@ import warnings
 from pathlib import Path
 
 from common import SHARED, parse_sets, resvg_rgb
+from machine import in_r, machine_unit
 
 from vecfit.io.colors import parse_background
 from vecfit.jobs.config import resolve
@@ -42,6 +44,8 @@ def main() -> None:
         overrides["optimize"]["iterations"] = args.iterations
     config = resolve("refine", overrides=overrides)
     opt = config["optimize"]
+    unit = machine_unit()
+    print(f"machine unit R = {unit:.4f} s (benchmarks/machine.py)")
     print(f"refine defaults: {opt['iterations']} iterations, {opt['mode']} {opt['samples']}x{opt['samples']}, "
           f"loss {opt['loss']}, max size {opt['max_size']}, lr {opt['lr']}, {args.threads} threads")
     rows = []
@@ -60,14 +64,15 @@ def main() -> None:
             rows.append((name, report, before, after, watch.laps))
 
     print()
-    print("| image | size | shapes | parameters | iterations | time | s/iter | PSNR before -> after (vecfit) "
+    print("| image | size | shapes | parameters | iterations | time | per iteration | PSNR before -> after (vecfit) "
           "| PSNR before -> after (resvg) | gain (resvg) | MSE before -> after (resvg) | MSE ratio | SSIM (resvg) |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name, rep, before, after, _ in rows:
         w, h = rep["size"]
         ow, oh = rep["optimized_size"]
         print(f"| {name} | {w}x{h} (opt. {ow}x{oh}) | {rep['shapes']} | {rep['parameters']['total']} "
-              f"| {rep['iterations']} | {rep['seconds']['total']:.1f} s | {rep['seconds']['per_iteration']:.3f} "
+              f"| {rep['iterations']} | {in_r(rep['seconds']['total'], unit)} "
+              f"| {in_r(rep['seconds']['per_iteration'], unit)} "
               f"| {rep['initial']['psnr']:.2f} -> {rep['optimized']['psnr']:.2f} "
               f"| {before['psnr']:.2f} -> {after['psnr']:.2f} | {after['psnr'] - before['psnr']:+.2f} dB "
               f"| {before['mse']:.5f} -> {after['mse']:.5f} | {before['mse'] / after['mse']:.2f}x "

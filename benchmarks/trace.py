@@ -22,6 +22,7 @@ and where each run's iterations spend their time at its start and its end.
 count (the k of the k-means) and scores the trace as resvg renders it: a colour count
 where a photo's PSNR falls well below its neighbours' shows a tracer bug that a
 particular clustering exposes (one painted the coffee in a cup white at 88 colours).
+Times are also given in R, the machine unit measured at the start (benchmarks/machine.py).
 """
 from __future__ import annotations
 
@@ -134,9 +135,12 @@ def main():
         first, last, step = (int(v) for v in args.colors_scan.split(":"))
         colors_scan(args.images.split(","), list(range(first, last + 1, step)))
         return
+    from machine import machine_unit  # (benchmarks/ is on sys.path: the script's own folder)
+    unit = machine_unit()
+    print(f"machine unit R = {unit:.4f} s (benchmarks/machine.py)")
     if args.refine:
         refine_table([int(b) for b in args.refine.split(",")], args.images.split(","),
-                     args.iterations, args.threads, args.set)
+                     args.iterations, args.threads, args.set, unit)
         return
     budgets = [int(b) for b in args.budgets.split(",")]
     images = args.images.split(",")
@@ -148,7 +152,7 @@ def main():
           f"tolerance={defaults.tolerance} corner_angle={defaults.corner_angle} "
           f"blur={defaults.blur} overlap={defaults.overlap} smoothing={defaults.smoothing}")
     head = (f"{'image':22s} {'budget':>6s} {'paths':>6s} {'segments':>8s} {'seg/path':>8s} "
-            f"{'trace s':>8s} {'CPU s':>8s} {'PSNR dB':>8s}   " + " ".join(f"{k:>8s}" for k in STAGES))
+            f"{'trace s':>8s} {'trace R':>8s} {'CPU s':>8s} {'PSNR dB':>8s}   " + " ".join(f"{k:>8s}" for k in STAGES))
     print(head)
     print("-" * len(head))
     inputs = [(f"{name} {im.shape[1]}x{im.shape[0]}", im, budgets) for name, im in
@@ -163,12 +167,14 @@ def main():
             seconds.setdefault((group, b), []).append(r["seconds"])
             cpu.setdefault((group, b), []).append(r["cpu"])
             print(f"{label:22s} {b:6d} {r['paths']:6d} {r['segments']:8d} "
-                  f"{r['segments'] / r['paths']:8.1f} {r['seconds']:8.3f} {r['cpu']:8.3f} {r['psnr']:8.2f}   "
+                  f"{r['segments'] / r['paths']:8.1f} {r['seconds']:8.3f} {r['seconds'] / unit:8.2f} {r['cpu']:8.3f} "
+                  f"{r['psnr']:8.2f}   "
                   + " ".join(f"{r['stages'][k]:8.3f}" for k in STAGES), flush=True)
     print("-" * len(head))
     for (group, b), values in psnr.items():
         print(f"{'mean ' + group:22s} {b:6d} {'':6s} {'':8s} {'':8s} {np.median(seconds[(group, b)]):8.3f} "
-              f"{np.median(cpu[(group, b)]):8.3f} {np.mean(values):8.2f}   (times: median)")
+              f"{np.median(seconds[(group, b)]) / unit:8.2f} {np.median(cpu[(group, b)]):8.3f} {np.mean(values):8.2f}"
+              "   (times: median)")
 
     if args.overlap_check:
         b = defaults.paths
@@ -208,8 +214,9 @@ def colors_scan(images, counts):
         print(f"{name:12s} worst {value:.2f} dB at {k} colours; {at_default:.2f} dB at the default {default}")
 
 
-def refine_table(budgets, images, iterations, threads, sets=()):
-    """Trace + refine with the defaults: PSNR before / after and wall time per image."""
+def refine_table(budgets, images, iterations, threads, sets=(), unit=None):
+    """Trace + refine with the defaults: PSNR before / after and wall time per image (and
+    the total in R, the machine unit ``unit`` in seconds)."""
     from PIL import Image
 
     from vecfit.io.colors import parse_background
@@ -218,12 +225,14 @@ def refine_table(budgets, images, iterations, threads, sets=()):
     from vecfit.jobs.protocol import Inputs, Outputs
     from vecfit.jobs.trace import run as trace
     from common import parse_sets, resvg_rgb  # (benchmarks/ is on sys.path: the script's own folder)
+    from machine import in_r, machine_unit
     from refine import print_breakdown
 
     from vecfit.renderer.stopwatch import Stopwatch
 
+    unit = unit or machine_unit()
     print("| image | budget | paths | PSNR trace | PSNR refined (vecfit) | PSNR refined (resvg) "
-          "| trace s | refine s | s/iter | total s |")
+          "| trace s | refine s | s/iter | total |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     means = {b: [] for b in budgets}
     breakdowns = []
@@ -251,7 +260,7 @@ def refine_table(budgets, images, iterations, threads, sets=()):
                 print(f"| {name} {image.shape[1]}x{image.shape[0]} | {b} | {rep['trace']['paths']} "
                       f"| {rep['initial']['psnr']:.2f} | {rep['optimized']['psnr']:.2f} | {resvg_psnr:.2f} "
                       f"| {rep['trace']['seconds']:.1f} | {opt:.1f} | {rep['seconds']['per_iteration']:.3f} "
-                      f"| {rep['seconds']['total']:.1f} |", flush=True)
+                      f"| {in_r(rep['seconds']['total'], unit)} |", flush=True)
     for b in budgets:
         print(f"mean PSNR (resvg) at {b} paths: {np.mean(means[b]):.2f} dB")
     for label, laps, coarse in breakdowns:
