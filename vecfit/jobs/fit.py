@@ -176,7 +176,10 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     else:
         progress.start(0)
         result = _not_optimised(scene, opt)
-        untangled = 0
+        # a trace written as it is: outlines that touch themselves at a pixel corner can
+        # come out of the fit crossing (a sliver's two sides)
+        untangled = untangle(scene, decimals=shape_decimals(scene, (w, h), output_precision(config))) \
+            if generated else 0
     if result.iterations == 0:  # nothing moved: the same picture and figures
         final_image, final_rgb, final = initial_image, initial_rgb, dict(initial)
     else:

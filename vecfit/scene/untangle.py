@@ -15,7 +15,7 @@ import dataclasses
 
 import numpy as np
 
-from .arrays import floats, to_numpy
+from .arrays import floats_torch, is_tensor, to_numpy
 from .crossings import crossed_subpaths, subpath_crossings
 from .model import Path, Scene
 from .placement import shape_matrices
@@ -119,7 +119,7 @@ def untangle(scene: Scene, keep=frozenset(), tolerance: float = 0.01, min_area: 
         scale = scales[shape_index] if scales[shape_index] > 0 else 1.0
         places = None if decimals is None else decimals[shape_index]
         shape.geometry = _untangled(judged.shapes[shape_index].geometry, subpaths, tolerance / scale,
-                                    min_area / scale ** 2, places)
+                                    min_area / scale ** 2, places, is_tensor(shape.geometry.points))
     return len(crossed)
 
 
@@ -135,8 +135,10 @@ def _rounded(scene: Scene, decimals: list[int]) -> Scene:
     return dataclasses.replace(scene, shapes=shapes)
 
 
-def _untangled(path: Path, cut: set[int], tolerance: float, min_area: float, decimals: int | None) -> Path:
-    """The path with the subpaths ``cut`` replaced by their simple loops."""
+def _untangled(path: Path, cut: set[int], tolerance: float, min_area: float, decimals: int | None,
+               tensor: bool) -> Path:
+    """The path with the subpaths ``cut`` replaced by their simple loops (its points a
+    tensor or, for a Scene of NumPy arrays, an array)."""
     pts = np.asarray(to_numpy(path.points), np.float64)
     points, degrees, subpaths = [], [], []
     for index, ((first, count, closed), (p0, n)) in enumerate(zip(path.subpaths, path.subpath_point_ranges())):
@@ -156,7 +158,8 @@ def _untangled(path: Path, cut: set[int], tolerance: float, min_area: float, dec
             degrees += loop_degrees
     if not points:  # every loop was a sliver: keep a point, so the path stays a path
         points, degrees, subpaths = [pts[:1], pts[:1]], [1], [(0, 1, False)]
-    return Path(points=floats(np.concatenate(points).astype(np.float32)), degrees=np.array(degrees, np.int64),
+    flat = np.concatenate(points).astype(np.float32)
+    return Path(points=floats_torch(flat) if tensor else flat, degrees=np.array(degrees, np.int64),
                 subpaths=subpaths)
 
 

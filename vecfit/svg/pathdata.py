@@ -1,5 +1,6 @@
 """SVG path data (the ``d`` attribute): read into subpaths of line, quadratic and cubic
-segments, and written from them (``format_path_data``, vecfit's one path-data writer).
+segments, and written from them (``format_relative_path_data``, as the SVG writer and the
+tracer write it; ``format_path_data``, absolute, for pydiffvg and the painter).
 
 Written here rather than taken from svgelements because the Scene needs choices that
 svgelements does not make for us: arcs as cubics of at most 90 degrees, ``Z`` as an
@@ -282,8 +283,7 @@ def to_arrays(subpaths: list[Subpath]):
 _LETTERS = {1: "L", 2: "Q", 3: "C"}
 
 
-def format_path_data(points, degrees, subpaths, decimals: int = 4, compact: bool = False,
-                     axis_lines: bool = False) -> str:
+def format_path_data(points, degrees, subpaths, decimals: int = 4, compact: bool = False) -> str:
     """Absolute M/L/Q/C/Z path data of subpaths stored as a Scene's ``Path`` stores them:
     ``points`` [P, 2] (finite numbers), per subpath its start, then each segment's
     control points and end, a closed subpath's last end (its start) not stored again;
@@ -291,13 +291,12 @@ def format_path_data(points, degrees, subpaths, decimals: int = 4, compact: bool
 
     A closed subpath's last segment is written as ``Z`` when it is a line, else in full
     and followed by ``Z``. Numbers have at most ``decimals`` decimals; ``compact`` leaves
-    out the spaces before command letters; ``axis_lines`` writes a line whose written end
-    keeps its start's y (x) as ``H x`` (``V y``), as a designer's file does.
+    out the spaces before command letters. (pydiffvg's save_svg and the painter's random
+    strokes; the SVG writer and the tracer write format_relative_path_data.)
     """
     # every point formatted once, as "x y" (a trace writes 50,000 numbers)
     numbers = fmt_many(points, decimals)
-    xs, ys = numbers[0::2], numbers[1::2]
-    text = [f"{x} {y}" for x, y in zip(xs, ys)]
+    text = [f"{x} {y}" for x, y in zip(numbers[0::2], numbers[1::2])]
     degrees = np.asarray(degrees).tolist()
     out, p = [], 0
     for first, count, closed in subpaths:
@@ -309,18 +308,64 @@ def format_path_data(points, degrees, subpaths, decimals: int = 4, compact: bool
             last = closed and k == first + count - 1
             if last and d == 1:
                 break
-            if axis_lines and d == 1:
-                if ys[p] == ys[p - 1]:
-                    out.append("H" + xs[p])
-                elif xs[p] == xs[p - 1]:
-                    out.append("V" + ys[p])
-                else:
-                    out.append("L" + text[p])
-                p += 1
-                continue
             ends = text[p:p + (d - 1 if last else d)] + ([text[start]] if last else [])
             out.append(_LETTERS[d] + " ".join(ends))
             p += d - 1 if last else d
         if closed:
             out.append("Z")
     return ("" if compact else " ").join(out)
+
+
+def format_relative_path_data(points, degrees, subpaths, decimals: int = 2) -> str:
+    """Relative m/l/h/v/q/c/z path data, as designers' tools write it (Scene layout and Z
+    rule as ``format_path_data``): each subpath starts with an absolute ``M``, each segment
+    is written as offsets from its start, axis-aligned lines as ``h``/``v``, and a number
+    is not preceded by a space where its minus sign separates it. Offsets are short
+    (5.11 where the point is at 340.38): a refined photograph's path data is a quarter
+    smaller. The points are rounded to ``decimals`` first and every offset is the
+    difference of two rounded points, so the path lands exactly where the absolute one
+    would, with no drift along it."""
+    a = np.asarray(points, np.float64)
+    if not np.isfinite(a).all():
+        fmt_many(a, decimals)  # raises, naming the value
+    unit = 10 ** int(decimals)
+    q = np.rint(a * unit).astype(np.int64).tolist()
+    fractions = [""] + [f".{f:0{decimals}d}".rstrip("0") for f in range(1, unit)] if decimals > 0 else [""]
+
+    def number(v: int) -> str:
+        whole, frac = divmod(abs(v), unit)
+        text = f"{whole}{fractions[frac]}"
+        return "-" + text if v < 0 and text != "0" else text
+
+    def joined(values) -> str:
+        out = ""
+        for v in values:
+            t = number(v)
+            out += t if not out or t[0] == "-" else " " + t
+        return out
+
+    degrees = np.asarray(degrees).tolist()
+    out, p = [], 0
+    for first, count, closed in subpaths:
+        start = p
+        out.append("M" + joined(q[p]))
+        current = q[p]
+        p += 1
+        for k in range(first, first + count):
+            d = int(degrees[k])
+            last = closed and k == first + count - 1
+            if last and d == 1:
+                break
+            ends = q[p:p + (d - 1 if last else d)] + ([q[start]] if last else [])
+            p += d - 1 if last else d
+            offsets = [(x - current[0], y - current[1]) for x, y in ends]
+            current = ends[-1]
+            if d == 1 and offsets[0][1] == 0:
+                out.append("h" + joined([offsets[0][0]]))
+            elif d == 1 and offsets[0][0] == 0:
+                out.append("v" + joined([offsets[0][1]]))
+            else:
+                out.append(_LETTERS[d].lower() + joined([v for pair in offsets for v in pair]))
+        if closed:
+            out.append("z")
+    return "".join(out)

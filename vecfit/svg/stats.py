@@ -19,6 +19,7 @@ bytes and the colours.
 from __future__ import annotations
 
 import gzip
+import math
 import os
 import re
 import warnings
@@ -143,7 +144,7 @@ def path_data_segments(d: str) -> tuple[int, int]:
         if token.isalpha() and token in "MmZzLlHhVvCcSsQqTtAa":
             command, i = token, i + 1
             if command in "Zz":
-                if started and (x, y) != (start_x, start_y):
+                if started and not _same_point((x, y), (start_x, start_y)):
                     lines += 1
                 x, y = start_x, start_y
                 continue
@@ -170,10 +171,15 @@ def path_data_segments(d: str) -> tuple[int, int]:
                 y = oy + values[0]
         else:
             end = (ox + values[-2], oy + values[-1])
-            if kind != "a" or end != (x, y):
+            if kind != "a" or not _same_point(end, (x, y)):
                 curves += 1
             x, y = end
     return lines, curves
+
+
+def _same_point(a, b) -> bool:
+    """The same point, but for the rounding of relative offsets summed along a path."""
+    return all(math.isclose(p, q, rel_tol=1e-9, abs_tol=1e-9) for p, q in zip(a, b))
 
 
 def _arguments(tokens, i, kind):

@@ -31,7 +31,7 @@ from .paints import GRADIENTS
 from .document import SvgDocument
 from .dom import local_name
 from .numbers import finite, fmt, hex_color, matrix
-from .pathdata import format_path_data
+from .pathdata import format_relative_path_data
 from .precision import MAX_DECIMALS, root_decimals, shape_decimals
 from .skips import VecfitWarning
 from .style import INHERITED
@@ -47,8 +47,9 @@ OPACITY_DECIMALS = 3
 
 
 def path_data(path: Path, decimals: int = 4) -> str:
-    """A Scene path's ``d``: absolute M/L/H/V/Q/C/Z (see ``pathdata.format_path_data``)."""
-    return format_path_data(finite(path.points), path.degrees, path.subpaths, decimals, axis_lines=True)
+    """A Scene path's ``d``: relative m/l/h/v/q/c/z after an absolute M per subpath (see
+    ``pathdata.format_relative_path_data``)."""
+    return format_relative_path_data(finite(path.points), path.degrees, path.subpaths, decimals)
 
 
 def opacity_text(value) -> str | None:

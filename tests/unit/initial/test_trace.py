@@ -294,7 +294,7 @@ def test_deterministic_for_a_seed():
 def test_result_counts_match_the_svg():
     result = trace_image(flat_shapes(), TraceSettings.defaults(paths=3))
     assert result.paths == count_shapes(result.svg) <= 3 + 1  # and the background rect
-    drawn = sum(len(re.findall(r"[CLHV]", d)) for d in re.findall(r' d="([^"]*)"', result.svg))
+    drawn = sum(len(re.findall(r"[cqlhv]", d)) for d in re.findall(r' d="([^"]*)"', result.svg))
     primitives = len(re.findall(r"<(rect|circle|ellipse)\b", result.svg))
     assert result.segments == drawn + 4 * primitives
     assert result.colors == len(set(re.findall(r'fill="(#[0-9a-f]{6})"', result.svg)))

@@ -1,5 +1,6 @@
 """The tracer's path data (svgtext.path_data): closed subpaths of cubics, each closed by a
-Z after its last cubic, two decimals, written by vecfit's path-data writer."""
+Z after its last cubic, two decimals, relative after each subpath's M (the SVG writer's
+format_relative_path_data)."""
 from __future__ import annotations
 
 import numpy as np
@@ -12,7 +13,7 @@ from vecfit.svg.pathdata import parse_path_data, to_arrays
 
 def test_a_square_of_cubics():
     square = np.array([[[0, 0], [1, 0], [2, 0], [3, 0]], [[3, 0], [3, 1], [3, 2], [0, 0]]], float)
-    assert path_data([square]) == "M0 0C1 0 2 0 3 0C3 1 3 2 0 0Z"
+    assert path_data([square]) == "M0 0c1 0 2 0 3 0c0 1 0 2-3 0z"
 
 
 def test_empty_subpaths_are_left_out():
@@ -26,7 +27,7 @@ def test_many_subpaths_read_back_to_hundredths():
     for segs in subpaths:
         segs[1:, 0] = segs[:-1, 3]  # each cubic starts where the one before ends
     text = path_data(subpaths)
-    assert "-0 " not in text and text.count("Z") == 40
+    assert "-0 " not in text and "-0-" not in text and text.count("z") == 40
     points, degrees, table = to_arrays(parse_path_data(text))
     written = np.concatenate([np.concatenate([s[:1, 0], s[:, 1:].reshape(-1, 2)]) for s in subpaths])
     assert np.abs(points - np.round(written, 2)).max() < 1e-9

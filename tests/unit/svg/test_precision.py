@@ -68,3 +68,32 @@ def test_precision_option_reaches_the_file(tmp_path):
     assert _decimals(re.search(r' d="([^"]*)"', svg).group(1)) == 0
     with pytest.raises(VecfitError, match="output.precision"):
         vecfit.refine(tmp_path / "t.png", tmp_path / "i.svg", settings={"output": {"precision": 7}})
+
+
+@pytest.mark.parametrize("seed", range(5))
+@pytest.mark.parametrize("decimals", [0, 2, 4])
+def test_relative_path_data_lands_where_the_absolute_does(seed, decimals):
+    """Offsets are differences of rounded points: read back, every point equals the
+    point rounded, with no drift along a long path."""
+    import numpy as np
+    from vecfit.svg.pathdata import format_path_data, format_relative_path_data, parse_path_data, to_arrays
+
+    rng = np.random.default_rng(seed)
+    degrees = rng.choice([1, 2, 3], 300).tolist()
+    subpaths = [(0, 120, True), (120, 100, False), (220, 80, True)]
+    n = sum(sum(degrees[f:f + c]) + (0 if closed else 1) for f, c, closed in subpaths)
+    points = np.cumsum(rng.normal(0, 7.3, (n, 2)), 0) + 300
+    points[1::9, 1] = points[0::9, 1][:len(points[1::9])]  # some axis-aligned lines (h)
+    relative = to_arrays(parse_path_data(format_relative_path_data(points, degrees, subpaths, decimals)))
+    absolute = to_arrays(parse_path_data(format_path_data(points, degrees, subpaths, decimals)))
+    assert np.array_equal(relative[1], absolute[1]) and relative[2] == absolute[2]
+    assert np.abs(relative[0] - absolute[0]).max() < 1e-9  # the absolute text is the points rounded
+
+
+def test_relative_path_data_text():
+    import numpy as np
+    from vecfit.svg.pathdata import format_relative_path_data
+
+    pts = np.array([[10.004, 10], [50, 10], [50.25, 40.126], [30, 41], [20.5, 35], [12, -3]])
+    assert format_relative_path_data(pts, [1, 1, 3, 1], [(0, 4, True)], 2) == \
+        "M10 10h40l0.25 30.13c-20.25 0.87-29.75-5.13-38.25-43.13z"

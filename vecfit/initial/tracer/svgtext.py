@@ -5,7 +5,7 @@ import numpy as np
 
 from vecfit.svg.document import NewDocument, SvgDocument
 from vecfit.svg.numbers import fmt_many
-from vecfit.svg.pathdata import format_path_data
+from vecfit.svg.pathdata import format_relative_path_data
 
 DECIMALS = 2  # a trace is placed to a hundredth of a pixel, its refinement finer
 
@@ -23,7 +23,7 @@ def path_data(subpaths) -> str:
         degrees += [3] * len(segs) + [1]
     if not spans:
         return ""
-    return format_path_data(np.concatenate(points), degrees, spans, decimals=DECIMALS, compact=True)
+    return format_relative_path_data(np.concatenate(points), degrees, spans, decimals=DECIMALS)
 
 
 def outline_path_data(outlines) -> str:
@@ -36,7 +36,7 @@ def outline_path_data(outlines) -> str:
     for o in outlines:
         spans.append((len(degrees), len(o.degrees), True))
         degrees += o.degrees
-    return format_path_data(points, degrees, spans, decimals=DECIMALS, compact=True, axis_lines=True)
+    return format_relative_path_data(points, degrees, spans, decimals=DECIMALS)
 
 
 def add_primitive(document: NewDocument, ident: str, tag: str, geometry: dict, fill: str) -> None:
