@@ -66,9 +66,9 @@ class TraceSettings:
 @dataclass
 class TraceResult:
     document: "SvgDocument"  # the traced SVG (vecfit.svg.document)
-    paths: int        # number of shapes written
-    colors: int       # number of distinct fill colours
-    segments: int     # total segments (cubics; the background rect counts its 4 sides)
+    paths: int        # number of shapes written, besides the background rect
+    colors: int       # number of distinct fill colours (the background's included)
+    segments: int     # their segments (lines and curves; a rect, circle or ellipse counts 4)
     seconds: float
 
     @property

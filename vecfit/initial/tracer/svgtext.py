@@ -39,10 +39,10 @@ def outline_path_data(outlines) -> str:
     return format_relative_path_data(points, degrees, spans, decimals=DECIMALS)
 
 
-def add_primitive(document: NewDocument, ident: str, tag: str, geometry: dict, fill: str) -> None:
+def add_primitive(document: NewDocument, tag: str, geometry: dict, fill: str) -> None:
     """A rect, circle or ellipse (primitives.Primitive's geometry, in pixels)."""
     numbers = dict(zip(geometry, fmt_many(list(geometry.values()), DECIMALS)))
-    document.add(tag, {"id": ident, **numbers, "fill": fill})
+    document.add(tag, {**numbers, "fill": fill})
 
 
 def new_document(width: int, height: int) -> NewDocument:
@@ -54,14 +54,21 @@ def new_document(width: int, height: int) -> NewDocument:
 BACKGROUND_MARGIN = 4
 
 
-def add_rect(document: NewDocument, ident: str, width: int, height: int, fill: str) -> None:
+# The backdrop is named as the SVG writer names the background it adds (svg/write.py): a
+# background, not a shape of the drawing (vecfit/svg/stats.py counts it apart).
+BACKGROUND_ID = "vecfit-background"
+
+
+def add_rect(document: NewDocument, width: int, height: int, fill: str) -> None:
     m = BACKGROUND_MARGIN
-    document.add("rect", {"id": ident, "x": f"-{m}", "y": f"-{m}", "width": f"{width + 2 * m}",
+    document.add("rect", {"id": BACKGROUND_ID, "x": f"-{m}", "y": f"-{m}", "width": f"{width + 2 * m}",
                           "height": f"{height + 2 * m}", "fill": fill})
 
 
-def add_path(document: NewDocument, ident: str, d: str, fill: str, evenodd: bool = False) -> None:
-    attributes = {"id": ident, "d": d, "fill": fill}
+def add_path(document: NewDocument, d: str, fill: str, evenodd: bool = False) -> None:
+    """A traced shape (no id: like an unnamed path in a designer's file, and 8 bytes less
+    a shape)."""
+    attributes = {"d": d, "fill": fill}
     if evenodd:
         attributes["fill-rule"] = "evenodd"
     document.add("path", attributes)

@@ -141,8 +141,7 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     document, segments, fills = new_document(w, h), 0, set()
     if background is not None:
         fills.add(hex_color(paint[background]))
-        add_rect(document, "p0", w, h, hex_color(paint[background]))
-        segments += 4
+        add_rect(document, w, h, hex_color(paint[background]))
     for i, sl in shapes:
         subpaths = [sp for sp in fitted[sl] if len(sp)]
         if not subpaths:
@@ -150,20 +149,19 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
         fill = hex_color(paint[i])
         fills.add(fill)
         cut = any(holes[sl])
-        ident = f"p{len(document.root)}"
         if s.lines <= 0:
-            add_path(document, ident, path_data(subpaths), fill, evenodd=cut)
+            add_path(document, path_data(subpaths), fill, evenodd=cut)
             segments += sum(len(sp) for sp in subpaths)
             continue
         simplified = [straightened(sp, s.lines) for sp in subpaths]
         shape = as_primitive(outlines[sl.start], simplified[0], s.lines, ELLIPSE_TOLERANCE) \
             if s.primitives and len(simplified) == 1 and sl.stop - sl.start == 1 else None
         if shape is not None:
-            add_primitive(document, ident, shape.tag, shape.attributes, fill)
+            add_primitive(document, shape.tag, shape.attributes, fill)
             segments += 4
         else:
-            add_path(document, ident, outline_path_data(simplified), fill, evenodd=cut)
+            add_path(document, outline_path_data(simplified), fill, evenodd=cut)
             segments += sum(len(o.degrees) - 1 for o in simplified)
     report("fit", 1.0)
-    return TraceResult(document=document, paths=len(document.root), colors=len(fills),
+    return TraceResult(document=document, paths=len(document.root) - (background is not None), colors=len(fills),
                        segments=segments, seconds=time.perf_counter() - start)
