@@ -60,8 +60,9 @@ def _paint_equal(p, q, opacity_p, opacity_q, tol, ctol, what):
     assert type(p) is type(q), f"{what}: {type(p).__name__} vs {type(q).__name__}"
     if isinstance(p, Solid):
         _close(p.color[:3], q.color[:3], ctol, what + " colour")
-        # alpha may move between the colour and the *-opacity property
-        _close(p.color[3] * opacity_p, q.color[3] * opacity_q, tol, what + " alpha")
+        # alpha may move between the colour and the *-opacity property, which is written
+        # with 3 decimals (a #rrggbbaa colour becomes #rrggbb and fill-opacity)
+        _close(p.color[3] * opacity_p, q.color[3] * opacity_q, max(tol, 5e-4 + 1e-6), what + " alpha")
         return
     _close(opacity_p, opacity_q, tol, what + " opacity")
     assert p.units == q.units
