@@ -16,11 +16,12 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import statistics
 import threading
 import time
 from importlib.metadata import version
 from pathlib import Path
+
+from common import median_time
 
 os.environ["RAYON_NUM_THREADS"] = "1"  # (before resvg_py is imported)
 
@@ -35,13 +36,7 @@ def _render() -> None:
 
 def machine_unit(repeats: int = 20) -> float:
     """R in seconds: the median wall time of ``repeats`` renders, after one not timed."""
-    _render()
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        _render()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
+    return median_time(_render, repeats=repeats, warmup=1)
 
 
 def _significant(value: float, digits: int) -> str:

@@ -10,6 +10,7 @@ gradient, step, the checks for non-finite values, the best-so-far snapshot, hook
 from __future__ import annotations
 
 import contextlib
+import functools
 import gc
 import math
 import time
@@ -61,6 +62,12 @@ class Target:
     @property
     def opaque(self) -> bool:
         return self.background is not None
+
+    @functools.cached_property
+    def wants_translucency(self) -> bool:
+        """Whether optimize.alpha = "auto" lets every colour's alpha change here
+        (opacity.translucency_wanted: translucent areas, or a photograph)."""
+        return translucency_wanted(self.image.numpy(), self.opaque)
 
     def compared(self, rgba: torch.Tensor) -> torch.Tensor:
         """The channels the loss sees: RGB over the opaque background (a render is already
@@ -171,7 +178,7 @@ class _Fit:
             lr["points"] = dense_point_rate(float(lr["points"]), self.density, settings.dense_outline,
                                             settings.dense_points)
         self.point_rate = lr.get("points")
-        translucent = settings.alpha == "auto" and translucency_wanted(target.image.numpy(), target.opaque)
+        translucent = settings.alpha == "auto" and target.wants_translucency
         keep_alpha = [*keep_alpha, *colors_kept_opaque(scene, settings.alpha, translucent)]
         self.kinds = kinds = parameter_kinds(scene, lr, width, height, keep_alpha)
         if not kinds:

@@ -28,7 +28,6 @@ from vecfit.io.tone import is_flat_art
 from vecfit.scene import Scene
 from vecfit.scene.arrays import to_numpy
 
-from .settings import ALPHA_MODES  # noqa: F401  (the modes, checked with the other settings)
 
 # A pixel is clear at or below CLEAR, opaque at or above SOLID; between them it is
 # translucent. An anti-aliased edge between an opaque shape and a clear background is
@@ -70,7 +69,7 @@ def translucency_wanted(image: np.ndarray, opaque: bool) -> bool:
 
 def colors_kept_opaque(scene: Scene, mode: str, target_translucent: bool) -> list:
     """The colour tensors (Scene.parameters()['colors']) whose alpha must not change, by
-    ``mode`` (ALPHA_MODES) and whether the target wants translucency
+    ``mode`` (settings.ALPHA_MODES) and whether the target wants translucency
     (translucency_wanted)."""
     colors = scene.parameters().get("colors", [])
     if mode == "free" or (mode == "auto" and target_translucent):

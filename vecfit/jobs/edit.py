@@ -23,14 +23,12 @@ from vecfit.io.report import error_map, panels_image, save_panels, save_report
 from vecfit.renderer import device as devices
 from vecfit.scene import Scene
 from vecfit.scene.crossings import crossed_subpaths
-from vecfit.scene.untangle import untangle
 from vecfit.svg.numbers import hex_color
-from vecfit.svg.precision import shape_decimals
 from vecfit.svg.stats import design_stats
 from vecfit.svg.write import svg_bytes
 
 from .config import output_precision, settings_of
-from .fit import _render_full, background_for, load_scene_to_fit, load_target
+from .fit import _render_full, background_for, cut_crossed_outlines, load_scene_to_fit, load_target
 from .protocol import Inputs, Outputs, listener
 
 MOVED_PX = 0.1        # an element counts as changed when a length moved this many pixels
@@ -156,7 +154,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     changed = changed_elements(scene, before, w, h)
     # after the picture and the changes are measured: cutting a crossed outline into
     # simple loops draws the same (less slivers under a square pixel)
-    untangle(scene, keep=drawn_crossed, decimals=shape_decimals(scene, (w, h), output_precision(config)))
+    cut_crossed_outlines(scene, drawn_crossed, config, (w, h))
 
     # The SVG keeps its elements: no background rect is added (an uncovered canvas stays
     # transparent, which over the background looks as optimised).

@@ -129,6 +129,13 @@ def _not_optimised(scene: Scene, opt: dict) -> Result:
     return Result(parameters=counts)
 
 
+def cut_crossed_outlines(scene: Scene, keep: set, config: dict, pixels=None) -> int:
+    """Outlines that cross themselves, but for those in ``keep`` (drawn so), cut into
+    simple loops (vecfit/scene/untangle.py), judged at the decimals the SVG will be written
+    with on a ``pixels`` canvas; returns how many were cut."""
+    return untangle(scene, keep=keep, decimals=shape_decimals(scene, pixels, output_precision(config)))
+
+
 def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, config: dict, outputs: Outputs,
                   progress=None, inputs: dict | None = None, hooks=(), keep_alpha=(),
                   generated: bool = False) -> dict:
@@ -159,27 +166,23 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     initial_image = _render_full(scene, sw, sh, opt)
     initial_rgb = to_rgb(to_numpy(initial_image), background)
     initial = compare(initial_rgb, target_rgb)
+    # crossings the user drew stay; those the fit makes (and those a trace's fit gives a
+    # sliver's two sides) are cut into simple loops
+    drawn_crossed = set() if generated else crossed_subpaths(scene)
     if is_tensor(scene.view):
         import torch
         from vecfit.fitting.loop import Settings, Target, optimize
-        from vecfit.fitting.opacity import make_opaque, translucency_wanted
+        from vecfit.fitting.opacity import make_opaque
         settings = Settings.from_config(opt)
-        if generated and settings.alpha == "auto" and not translucency_wanted(small, background is not None):
+        goal = Target(torch.from_numpy(small), background)
+        if generated and settings.alpha == "auto" and not goal.wants_translucency:
             make_opaque(scene)
-        # crossings the user drew stay; those the fit makes are cut into simple loops
-        drawn_crossed = set() if generated else crossed_subpaths(scene)
         progress.start(settings.iterations)
-        result = optimize(scene, Target(torch.from_numpy(small), background), settings, progress=progress,
-                          hooks=hooks, keep_alpha=keep_alpha)
-        untangled = untangle(scene, keep=drawn_crossed,
-                             decimals=shape_decimals(scene, (w, h), output_precision(config)))
+        result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
     else:
         progress.start(0)
         result = _not_optimised(scene, opt)
-        # a trace written as it is: outlines that touch themselves at a pixel corner can
-        # come out of the fit crossing (a sliver's two sides)
-        untangled = untangle(scene, decimals=shape_decimals(scene, (w, h), output_precision(config))) \
-            if generated else 0
+    untangled = cut_crossed_outlines(scene, drawn_crossed, config, (w, h))
     if result.iterations == 0:  # nothing moved: the same picture and figures
         final_image, final_rgb, final = initial_image, initial_rgb, dict(initial)
     else:

@@ -30,14 +30,12 @@ from vecfit.io.report import save_panels, save_report, side_by_side
 from vecfit.renderer import device as devices
 from vecfit.renderer.raster import render
 from vecfit.scene.crossings import crossed_subpaths
-from vecfit.scene.untangle import untangle
 from vecfit.svg.numbers import hex_color
-from vecfit.svg.precision import shape_decimals
 from vecfit.svg.stats import design_stats
 from vecfit.svg.write import svg_bytes
 
 from .config import output_precision, settings_of
-from .fit import background_for, load_scene_to_fit
+from .fit import background_for, cut_crossed_outlines, load_scene_to_fit
 from .protocol import Inputs, Outputs, listener
 
 MIN_SIDE = 11
@@ -169,7 +167,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     done = not interrupted
     out_w, out_h = (new_w, new_h) if done else (cur_w / s_x, cur_h / s_y)
     scene.width, scene.height = out_w, out_h
-    untangle(scene, keep=drawn_crossed, decimals=shape_decimals(scene, None, output_precision(config)))
+    cut_crossed_outlines(scene, drawn_crossed, config)
     final = draw(cur_w, cur_h, opt["eval_samples"])
     final_rgb, goal_rgb = to_rgb(final, background), to_rgb(image, background)
     fit = compare(final_rgb, goal_rgb)

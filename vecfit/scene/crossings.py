@@ -58,7 +58,7 @@ import numpy as np
 
 from .arrays import to_numpy
 from .model import Path
-from .placement import shape_matrices
+from .placement import pixel_scales
 
 MAX_PIECES = 1024          # per segment: a wild control polygon is flattened less finely
 _EPS = 2.0 ** -53
@@ -113,20 +113,15 @@ def crossed_subpaths(scene, tolerance: float = 0.01) -> set[tuple[int, int]]:
     shapes = [(i, s) for i, s in enumerate(scene.shapes) if s.fill is not None and isinstance(s.geometry, Path)]
     if not shapes:
         return set()
-    matrices = to_numpy(shape_matrices(scene, scene.width, scene.height)).astype(np.float64)
-    scales = [_scale(matrices[i]) for i, _ in shapes]
+    every = pixel_scales(scene)
+    scales = [every[i] for i, _ in shapes]
     tolerances = [tolerance / s if s > 0 else tolerance for s in scales]
-    owners = [i for i, s in shapes for closed in (c for _, _, c in s.geometry.subpaths) if closed]
+    owners = [i for i, s in shapes for _, _, closed in s.geometry.subpaths if closed]
     indices, found = _closed_subpath_crossings([s.geometry for _, s in shapes], tolerances)
     return {(owner, k) for owner, k, f in zip(owners, indices, found) if f}
 
 
 # ------------------------------------------------------------------------ inputs
-
-def _scale(matrix: np.ndarray) -> float:
-    """How much a 3x3 affine map scales lengths (the square root of its area factor)."""
-    return float(np.sqrt(abs(np.linalg.det(matrix[:2, :2]))))
-
 
 def _closed_subpath_crossings(paths, tolerances):
     """(subpath indices, crossings) over the closed subpaths of ``paths``, each path with its

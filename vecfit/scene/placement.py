@@ -44,3 +44,18 @@ def shape_matrices(scene: Scene, width: int, height: int):
     """[S, 3, 3]: each shape's map from its own space to pixels of a width x height render."""
     canvas = canvas_matrix(scene, width, height)
     return stacked_shape_matrices(scene, canvas, group_matrices(scene, canvas))
+
+
+def pixel_scales(scene: Scene, width: float | None = None, height: float | None = None):
+    """[S] float64 NumPy: pixels per unit of each shape's own space on a width x height
+    canvas (default: the Scene's own size), the square root of its map's area factor."""
+    import numpy as np
+
+    from .arrays import to_numpy
+
+    if not scene.shapes:
+        return np.zeros(0)
+    w = scene.width if width is None else width
+    h = scene.height if height is None else height
+    m = np.asarray(to_numpy(shape_matrices(scene, w, h)), np.float64)[:, :2, :2]
+    return np.sqrt(np.abs(m[:, 0, 0] * m[:, 1, 1] - m[:, 0, 1] * m[:, 1, 0]))

@@ -18,7 +18,7 @@ import numpy as np
 from .arrays import floats_torch, is_tensor, to_numpy
 from .crossings import crossed_subpaths, subpath_crossings
 from .model import Path, Scene
-from .placement import shape_matrices
+from .placement import pixel_scales
 from .segments import layout_of, segments_of, split_at
 
 MAX_CUTS = 10_000  # per subpath: a pathological outline is left as far as it got
@@ -108,7 +108,7 @@ def untangle(scene: Scene, keep=frozenset(), tolerance: float = 0.01, min_area: 
     crossed = crossed_subpaths(judged, tolerance) - set(keep)
     if not crossed:
         return 0
-    scales = _pixel_scales(scene)
+    scales = pixel_scales(scene)
     by_shape: dict[int, set[int]] = {}
     for shape_index, subpath in crossed:
         by_shape.setdefault(shape_index, set()).add(subpath)
@@ -162,7 +162,3 @@ def _untangled(path: Path, cut: set[int], tolerance: float, min_area: float, dec
     return Path(points=floats_torch(flat) if tensor else flat, degrees=np.array(degrees, np.int64),
                 subpaths=subpaths)
 
-
-def _pixel_scales(scene: Scene) -> np.ndarray:
-    m = np.asarray(to_numpy(shape_matrices(scene, scene.width, scene.height)), np.float64)[:, :2, :2]
-    return np.sqrt(np.abs(m[:, 0, 0] * m[:, 1, 1] - m[:, 0, 1] * m[:, 1, 0]))

@@ -283,6 +283,27 @@ def to_arrays(subpaths: list[Subpath]):
 _LETTERS = {1: "L", 2: "Q", 3: "C"}
 
 
+def _segment_ends(degrees, subpaths):
+    """Walk subpaths stored as a Scene's ``Path`` stores them: for each, (the index of its
+    start point, [(degree, indices of the points each segment writes after its start)],
+    closed). A closed subpath's last end is its start (not stored again), and its last
+    segment, when it is a line, is left to the ``Z``."""
+    degrees = np.asarray(degrees).tolist()
+    p = 0
+    for first, count, closed in subpaths:
+        start, segments = p, []
+        p += 1
+        for k in range(first, first + count):
+            d = int(degrees[k])
+            last = closed and k == first + count - 1
+            if last and d == 1:
+                break
+            stored = d - 1 if last else d
+            segments.append((d, list(range(p, p + stored)) + ([start] if last else [])))
+            p += stored
+        yield start, segments, closed
+
+
 def format_path_data(points, degrees, subpaths, decimals: int = 4, compact: bool = False) -> str:
     """Absolute M/L/Q/C/Z path data of subpaths stored as a Scene's ``Path`` stores them:
     ``points`` [P, 2] (finite numbers), per subpath its start, then each segment's
@@ -297,20 +318,10 @@ def format_path_data(points, degrees, subpaths, decimals: int = 4, compact: bool
     # every point formatted once, as "x y" (a trace writes 50,000 numbers)
     numbers = fmt_many(points, decimals)
     text = [f"{x} {y}" for x, y in zip(numbers[0::2], numbers[1::2])]
-    degrees = np.asarray(degrees).tolist()
-    out, p = [], 0
-    for first, count, closed in subpaths:
-        start = p
-        out.append("M" + text[p])
-        p += 1
-        for k in range(first, first + count):
-            d = int(degrees[k])
-            last = closed and k == first + count - 1
-            if last and d == 1:
-                break
-            ends = text[p:p + (d - 1 if last else d)] + ([text[start]] if last else [])
-            out.append(_LETTERS[d] + " ".join(ends))
-            p += d - 1 if last else d
+    out = []
+    for start, segments, closed in _segment_ends(degrees, subpaths):
+        out.append("M" + text[start])
+        out += [_LETTERS[d] + " ".join(text[i] for i in ends) for d, ends in segments]
         if closed:
             out.append("Z")
     return ("" if compact else " ").join(out)
@@ -344,22 +355,13 @@ def format_relative_path_data(points, degrees, subpaths, decimals: int = 2) -> s
             out += t if not out or t[0] == "-" else " " + t
         return out
 
-    degrees = np.asarray(degrees).tolist()
-    out, p = [], 0
-    for first, count, closed in subpaths:
-        start = p
-        out.append("M" + joined(q[p]))
-        current = q[p]
-        p += 1
-        for k in range(first, first + count):
-            d = int(degrees[k])
-            last = closed and k == first + count - 1
-            if last and d == 1:
-                break
-            ends = q[p:p + (d - 1 if last else d)] + ([q[start]] if last else [])
-            p += d - 1 if last else d
-            offsets = [(x - current[0], y - current[1]) for x, y in ends]
-            current = ends[-1]
+    out = []
+    for start, segments, closed in _segment_ends(degrees, subpaths):
+        out.append("M" + joined(q[start]))
+        cx, cy = q[start]
+        for d, ends in segments:
+            offsets = [(q[i][0] - cx, q[i][1] - cy) for i in ends]
+            cx, cy = q[ends[-1]]
             if d == 1 and offsets[0][1] == 0:
                 out.append("h" + joined([offsets[0][0]]))
             elif d == 1 and offsets[0][0] == 0:

@@ -15,7 +15,7 @@ import numpy as np
 
 from vecfit.scene import Scene
 from vecfit.scene.arrays import to_numpy
-from vecfit.scene.placement import shape_matrices
+from vecfit.scene.placement import pixel_scales
 
 STEP_PIXELS = 0.01     # the written step, in pixels ...
 STEP_CANVAS = 1024     # ... of a canvas up to this long side; beyond, in proportion
@@ -41,10 +41,8 @@ def shape_decimals(scene: Scene, pixels: tuple[int, int] | None = None,
     width, height = pixels if pixels is not None else (scene.width, scene.height)
     if not scene.shapes:
         return []
-    m = np.asarray(to_numpy(shape_matrices(scene, width, height)), np.float64)[:, :2, :2]
-    scale = np.sqrt(np.abs(m[:, 0, 0] * m[:, 1, 1] - m[:, 0, 1] * m[:, 1, 0]))
     side = max(float(width), float(height))
-    return [decimals_for(float(s), side) for s in scale]
+    return [decimals_for(float(s), side) for s in pixel_scales(scene, width, height)]
 
 
 def root_decimals(scene: Scene, pixels: tuple[int, int] | None = None, precision: int | None = None) -> int:

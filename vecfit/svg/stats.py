@@ -27,7 +27,7 @@ from pathlib import Path as FilePath
 
 import numpy as np
 
-from vecfit.scene import Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect, Solid
+from vecfit.scene import Circle, Ellipse, LinearGradient, RadialGradient, Rect, Solid
 from vecfit.scene.arrays import numpy_arrays, to_numpy
 from vecfit.scene.crossings import crossed_outlines
 
@@ -36,8 +36,7 @@ from .dom import local_name
 from .numbers import hex_color
 from .read import scene_of
 from .units import NUMBER
-
-BACKGROUND_ID = "vecfit-background"
+from .write import BACKGROUND_ID
 _TOKEN = re.compile(rf"[MmZzLlHhVvCcSsQqTtAa]|{NUMBER}|[^\s,]")
 _ARGUMENTS = {"m": 2, "l": 2, "h": 1, "v": 1, "c": 6, "s": 4, "q": 4, "t": 2, "a": 7}
 _OPAQUE = 1 - 1e-6  # opacities are float32: 1 is 1 exactly, but be lenient

@@ -44,6 +44,9 @@ __all__ = ["svg_bytes", "write_bytes", "write_svg"]
 INITIAL = {"opacity": "1", "fill-opacity": "1", "stroke-opacity": "1", "stop-opacity": "1",
            "fill": "black", "stroke": "none", "stroke-width": "1"}
 OPACITY_DECIMALS = 3
+# The id of a background rect vecfit writes (here, and as the tracer's backdrop): it is the
+# page, not a shape of the drawing (stats.py counts it apart, as trace's budget does).
+BACKGROUND_ID = "vecfit-background"
 
 
 def path_data(path: Path, decimals: int = 4) -> str:
@@ -297,7 +300,7 @@ def _set_canvas(root, size, before) -> None:
 def _add_background(root, color) -> None:
     """A full-canvas rect, drawn first, named so that it is recognisable (and not added
     twice when a file written so is refined again: the rect is then part of the scene)."""
-    if any(e.get("id") == "vecfit-background" for e in root.iter()):
+    if any(e.get("id") == BACKGROUND_ID for e in root.iter()):
         return
     ns = root.tag[:root.tag.index("}") + 1] if root.tag.startswith("{") else ""
     box = parse_viewbox(root.get("viewBox"))
@@ -307,7 +310,7 @@ def _add_background(root, color) -> None:
         rect.attrib.update(x=fmt(x), y=fmt(y), width=fmt(w), height=fmt(h))
     else:
         rect.attrib.update(x="0", y="0", width="100%", height="100%")
-    rect.set("id", "vecfit-background")
+    rect.set("id", BACKGROUND_ID)
     rect.set("fill", hex_color(color))
     alpha = opacity_text(color[3]) if len(color) > 3 else None
     if alpha is not None:

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .regions import Regions, interior, region_stats
+from .regions import Regions, painted_regions
 
 
 def ward_groups(area: np.ndarray, color: np.ndarray, budget: int) -> np.ndarray:
@@ -83,18 +83,6 @@ def _ward_hierarchy(size: np.ndarray, centre: np.ndarray) -> list[tuple[float, i
     return merges
 
 
-def _relabelled(regions: Regions, rgb: np.ndarray, label: np.ndarray, count: int) -> Regions:
-    """The regions joined by ``label`` (new index of each), each painted with its pixels'
-    mean colour (its interior's where it has enough, as the region builder does)."""
-    labels = np.where(regions.labels >= 0, label[np.maximum(regions.labels, 0)], -1).astype(np.int32)
-    area, color = region_stats(labels, count, rgb)
-    inner = np.where(interior(labels), labels, -1)
-    inner_area, inner_color = region_stats(inner, count, rgb)
-    enough = inner_area >= np.maximum(0.25 * area, 4)
-    color[enough] = inner_color[enough]
-    return Regions(labels, count, area, color)
-
-
 def grouped(regions: Regions, rgb: np.ndarray, budget: int, background: int | None) -> Regions:
     """The regions relabelled as at most ``budget`` colour groups (besides the background
     region, which keeps its own), each painted with its pixels' mean colour (its
@@ -109,4 +97,5 @@ def grouped(regions: Regions, rgb: np.ndarray, budget: int, background: int | No
     if background is not None:
         group[background] = count
         count += 1
-    return _relabelled(regions, rgb, group, count)
+    labels = np.where(regions.labels >= 0, group[np.maximum(regions.labels, 0)], -1).astype(np.int32)
+    return painted_regions(labels, count, rgb)

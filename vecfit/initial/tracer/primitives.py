@@ -40,6 +40,13 @@ class Primitive:
     attributes: dict
 
 
+def cubic_outline(segs: np.ndarray) -> Outline:
+    """A closed outline of cubics [S, 4, 2] as they are, closed by a ``Z`` line of zero
+    length (as the reader closes it)."""
+    points = np.concatenate([np.asarray(segs[:1, 0], float), np.asarray(segs[:, 1:], float).reshape(-1, 2)])
+    return Outline(points, [3] * len(segs) + [1])
+
+
 def _line_like(segs: np.ndarray, tolerance: float) -> np.ndarray:
     """[S] bool: cubics [S, 4, 2] whose control points lie within ``tolerance`` of the chord
     and project inside it (so the curve neither bulges nor doubles back)."""

@@ -205,15 +205,23 @@ def build_regions(classes: np.ndarray, rgb: np.ndarray, budget: int, min_area: f
     lut = merge_regions(area, color, thin, edges, min_area, budget)
     labels = np.where(comp >= 0, lut[np.maximum(comp, 0)], -1).astype(np.int32)
     n = int(lut.max()) + 1 if len(lut) and lut.max() >= 0 else 0
-    area, color = region_stats(labels, n, rgb)
     if fill_from_interior:
-        # The rim of a region holds the anti-aliased blend with its neighbours, which the
-        # shape's own edge will recreate; its interior gives the cleaner fill colour.
-        inner = np.where(interior(labels), labels, -1)
-        inner_area, inner_color = region_stats(inner, n, rgb)
-        enough = inner_area >= np.maximum(0.25 * area, 4)
-        color[enough] = inner_color[enough]
+        return painted_regions(labels, n, rgb)
+    area, color = region_stats(labels, n, rgb)
     return Regions(labels, n, area, color)
+
+
+def painted_regions(labels: np.ndarray, count: int, rgb: np.ndarray) -> Regions:
+    """The regions of a label map, each painted with its interior's mean colour where it
+    has enough interior: the rim of a region holds the anti-aliased blend with its
+    neighbours, which the shape's own edge will recreate; its interior gives the cleaner
+    fill colour."""
+    area, color = region_stats(labels, count, rgb)
+    inner = np.where(interior(labels), labels, -1)
+    inner_area, inner_color = region_stats(inner, count, rgb)
+    enough = inner_area >= np.maximum(0.25 * area, 4)
+    color[enough] = inner_color[enough]
+    return Regions(labels, count, area, color)
 
 
 def palette_colors(regions: Regions, classes: np.ndarray, rgb: np.ndarray) -> np.ndarray:

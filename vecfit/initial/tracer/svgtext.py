@@ -6,24 +6,17 @@ import numpy as np
 from vecfit.svg.document import NewDocument, SvgDocument
 from vecfit.svg.numbers import fmt_many
 from vecfit.svg.pathdata import format_relative_path_data
+from vecfit.svg.write import BACKGROUND_ID
+
+from .primitives import cubic_outline
 
 DECIMALS = 2  # a trace is placed to a hundredth of a pixel, its refinement finer
 
 
 def path_data(subpaths) -> str:
-    """'M x y C ... Z' for each closed subpath of cubic segments [S, 4, 2] (each closed by
+    """'M x y c ... z' for each closed subpath of cubic segments [S, 4, 2] (each closed by
     a Z after its last cubic, as the reader closes it: a line of zero length)."""
-    points, degrees, spans = [], [], []
-    for segs in subpaths:
-        if len(segs) == 0:
-            continue
-        spans.append((len(degrees), len(segs) + 1, True))
-        points.append(np.asarray(segs[:1, 0]))
-        points.append(np.asarray(segs[:, 1:]).reshape(-1, 2))
-        degrees += [3] * len(segs) + [1]
-    if not spans:
-        return ""
-    return format_relative_path_data(np.concatenate(points), degrees, spans, decimals=DECIMALS)
+    return outline_path_data([cubic_outline(segs) for segs in subpaths if len(segs)])
 
 
 def outline_path_data(outlines) -> str:
@@ -52,11 +45,6 @@ def new_document(width: int, height: int) -> NewDocument:
 # The background rect reaches this far past the canvas: its edges then touch no pixel,
 # get no gradient, and refinement cannot pull them in and uncover the canvas's rim.
 BACKGROUND_MARGIN = 4
-
-
-# The backdrop is named as the SVG writer names the background it adds (svg/write.py): a
-# background, not a shape of the drawing (vecfit/svg/stats.py counts it apart).
-BACKGROUND_ID = "vecfit-background"
 
 
 def add_rect(document: NewDocument, width: int, height: int, fill: str) -> None:
