@@ -385,12 +385,7 @@ BackwardPlan plan_backward(const PreparedScene& prepared, const RenderOptions& o
     bc.height = o.height;
     bc.R = R;
     bc.filter = o.filter;
-    if (o.filter == FILTER_TENT || o.filter == FILTER_HANN) bc.filter_integral = R * R;
-    else if (o.filter == FILTER_PARABOLIC) bc.filter_integral = (4 * R / 3) * (4 * R / 3);
-    else if (o.filter == FILTER_GAUSSIAN) {
-        double sigma = R / 2, one = sigma * std::sqrt(2 * M_PI) * std::erf(R / (sigma * std::sqrt(2.0)));
-        bc.filter_integral = one * one;
-    } else bc.filter_integral = 4 * R * R;
+    bc.filter_integral = filter_integral(o.filter, R);
     bc.no_layers = sc.layer_parent.size() <= 1;
     bc.gpix = plan.gpix.data();
     // Hits at a point: at most the entries of its tile, and one forced draw. Tape: per

@@ -116,11 +116,20 @@ VF_HD void composite_backward(const SceneView& sc, const Buffer<Hit>& hits, cons
 // the transmittance of what lies in front of the draw and B the composite behind it, so
 // delta = T (c_d - a_d B). One front-to-back pass that stops as soon as T is 0 (the
 // draw is hidden) or B is opaque.
-VF_HD void jump_without_layers(const SceneView& sc, const TileView& bins, Vec2 p, int forced, double delta[4]) {
+// `inside` is the sample's point a hair inside the draw. A draw behind that covers it but
+// not p has an edge of its own through the sample, on the same side: a shape drawn over
+// another along part of its outline (mcseem2 is full of them). When every point moves, that
+// edge moves with this one, so it counts as covering p in both composites: the copies of
+// one edge then add up to its jump once, as a sum that telescopes in paint order (the
+// later copy's jump is over the earlier one's colour, not over what lay behind both).
+VF_HD void jump_without_layers(const SceneView& sc, const TileView& bins, Vec2 p, Vec2 inside, int forced,
+                               double delta[4]) {
     for (int i = 0; i < 4; ++i) delta[i] = 0;
     int tile = tile_of(bins, p);
     Box region = bins.region(tile);
     if (p.x < region.x0 || p.x > region.x1 || p.y < region.y0 || p.y > region.y1) return;
+    const bool inside_in_region = inside.x >= region.x0 && inside.x <= region.x1 && inside.y >= region.y0 &&
+                                  inside.y <= region.y1;
     const TileEntry* es = bins.begin(tile);
     double T = 1, B[4] = {0, 0, 0, 0}, c[4];
     for (int k = bins.count(tile) - 1; k >= 0; --k) {
@@ -132,7 +141,9 @@ VF_HD void jump_without_layers(const SceneView& sc, const TileView& bins, Vec2 p
             T *= 1 - c[3];
             if (T <= 0) return;
         } else {  // behind
-            if (!covers(sc, bins, es[k], region, p)) continue;
+            if (inside_in_region ? !covers_or_edge_to(sc, bins, es[k], region, p, inside)
+                                 : !covers(sc, bins, es[k], region, p))
+                continue;
             paint_color(sc, sc.paints[sc.draws[draw].paint], p, c);
             double k2 = 1 - B[3];
             for (int i = 0; i < 4; ++i) B[i] += k2 * c[i];

@@ -55,29 +55,20 @@ VF_HD bool draw_covers_at(const SceneView& sc, const TileView& bins, int draw, V
     return e && covers(sc, bins, *e, region, p);
 }
 
-// Whether draw `draw` covers each of two points a hair apart (either side of one of its
-// boundaries): draw_covers_at for both, with the entry looked up once and the crossings of
-// both points counted in one pass over its segments when they share a tile (fills).
-VF_HD void draw_covers_pair(const SceneView& sc, const TileView& bins, int draw, Vec2 a, Vec2 b, bool& in_a,
-                            bool& in_b) {
-    int tile = tile_of(bins, a);
-    const PreparedDraw& d = sc.draws[draw];
-    if (tile != tile_of(bins, b) || d.kind != DRAW_FILL || d.is_ellipse) {
-        in_a = draw_covers_at(sc, bins, draw, a);
-        in_b = draw_covers_at(sc, bins, draw, b);
+// Whether the entry's draw covers each of two points of the tile region: covers() for
+// both, the crossings of both counted in one pass over a fill's segments.
+VF_HD void covers_pair(const SceneView& sc, const TileView& bins, const TileEntry& e, const Box& region, Vec2 a,
+                       Vec2 b, bool& in_a, bool& in_b) {
+    const PreparedDraw& d = sc.draws[e.draw];
+    auto in_box = [&](Vec2 p) { return p.x >= d.box.x0 && p.x <= d.box.x1 && p.y >= d.box.y0 && p.y <= d.box.y1; };
+    bool ra = in_box(a), rb = in_box(b);
+    in_a = in_b = false;
+    if (!ra && !rb) return;
+    if (d.kind != DRAW_FILL || d.is_ellipse) {
+        in_a = ra && entry_covers(sc, bins, e, region, a);
+        in_b = rb && entry_covers(sc, bins, e, region, b);
         return;
     }
-    in_a = in_b = false;
-    Box region = bins.region(tile);
-    auto reached = [&](Vec2 p) {
-        return p.x >= region.x0 && p.x <= region.x1 && p.y >= region.y0 && p.y <= region.y1 && p.x >= d.box.x0 &&
-               p.x <= d.box.x1 && p.y >= d.box.y0 && p.y <= d.box.y1;
-    };
-    bool ra = reached(a), rb = reached(b);
-    if (!ra && !rb) return;
-    const TileEntry* found = entry_of(bins, tile, draw);
-    if (!found) return;
-    const TileEntry& e = *found;
     const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
     const LocalItem* items = bins.items.data() + e.first;
     int wa = e.winding, wb = e.winding;
@@ -92,13 +83,73 @@ VF_HD void draw_covers_pair(const SceneView& sc, const TileView& bins, int draw,
     in_b = rb && winding_inside(wb, d.fill_rule);
 }
 
+// Whether the entry's draw covers p, or has an edge of its own between p and `inside` (a
+// point a hair away, both in the tile region) and covers `inside`. A fill's crossings are
+// counted at p alone unless one of its segments' boxes meets the box of the two points:
+// where none does, no segment passes between them and both have the same winding number.
+VF_HD bool covers_or_edge_to(const SceneView& sc, const TileView& bins, const TileEntry& e, const Box& region,
+                             Vec2 p, Vec2 inside) {
+    const PreparedDraw& d = sc.draws[e.draw];
+    auto in_box = [&](Vec2 q) { return q.x >= d.box.x0 && q.x <= d.box.x1 && q.y >= d.box.y0 && q.y <= d.box.y1; };
+    const bool rp = in_box(p), ri = in_box(inside);
+    if (!rp && !ri) return false;
+    if (d.kind != DRAW_FILL || d.is_ellipse)
+        return (rp && entry_covers(sc, bins, e, region, p)) || (ri && entry_covers(sc, bins, e, region, inside));
+    const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
+    const LocalItem* items = bins.items.data() + e.first;
+    const Box pair{vmin(p.x, inside.x), vmin(p.y, inside.y), vmax(p.x, inside.x), vmax(p.y, inside.y)};
+    int w = e.winding;
+    bool near = false;
+    for (int i = 0; i < e.count; ++i) {
+        const LocalItem& li = items[i];
+        if (li.y0 <= pair.y1 && li.y1 >= pair.y0) {
+            const PreparedSegment& s = segs[li.item];
+            if (li.spans(p.y)) w += ray_crossings(s, p, region.x1);
+            near = near || (s.box.x0 <= pair.x1 && s.box.x1 >= pair.x0 && s.box.y0 <= pair.y1 && s.box.y1 >= pair.y0);
+        }
+        w += bins.leg_crossings(li, p.y);
+    }
+    if (rp && winding_inside(w, d.fill_rule)) return true;
+    return near && ri && winding_inside(tile_winding(sc, bins, e, region, inside), d.fill_rule);
+}
+
+// Whether draw `draw` covers each of two points a hair apart (either side of one of its
+// boundaries): draw_covers_at for both, with the entry looked up once and the crossings of
+// both points counted in one pass over its segments when they share a tile (fills).
+VF_HD void draw_covers_pair(const SceneView& sc, const TileView& bins, int draw, Vec2 a, Vec2 b, bool& in_a,
+                            bool& in_b) {
+    int tile = tile_of(bins, a);
+    if (tile != tile_of(bins, b)) {
+        in_a = draw_covers_at(sc, bins, draw, a);
+        in_b = draw_covers_at(sc, bins, draw, b);
+        return;
+    }
+    in_a = in_b = false;
+    Box region = bins.region(tile);
+    auto reached = [&](Vec2 p) { return p.x >= region.x0 && p.x <= region.x1 && p.y >= region.y0 && p.y <= region.y1; };
+    bool ra = reached(a), rb = reached(b);
+    if (!ra && !rb) return;
+    const TileEntry* e = entry_of(bins, tile, draw);
+    if (!e) return;
+    covers_pair(sc, bins, *e, region, a, b, in_a, in_b);
+    in_a = in_a && ra;
+    in_b = in_b && rb;
+}
+
 // Draws covering p, front to back, with their premultiplied colours; `forced` (if >= 0)
-// counts as covering. Returns the count.
-VF_HD int collect_hits(const SceneView& sc, const TileView& bins, Vec2 p, int forced, Buffer<Hit>& hits) {
+// counts as covering. With AT_EDGE, for a boundary sample's composites (see
+// jump_without_layers): `edge_of` is the sampled draw and `inside` the point a hair inside
+// it, and a draw behind it that covers `inside` but not p (its own edge through the sample,
+// on the same side) counts as covering p too. Returns the count.
+template <bool AT_EDGE>
+VF_HD int collect_hits_of(const SceneView& sc, const TileView& bins, Vec2 p, int forced, Buffer<Hit>& hits,
+                          int edge_of, Vec2 inside) {
     hits.clear();
     int tile = tile_of(bins, p);
     Box region = bins.region(tile);
     bool in_region = p.x >= region.x0 && p.x <= region.x1 && p.y >= region.y0 && p.y <= region.y1;
+    const bool inside_in_region = AT_EDGE && inside.x >= region.x0 && inside.x <= region.x1 &&
+                                  inside.y >= region.y0 && inside.y <= region.y1;
     const TileEntry* es = bins.begin(tile);
     int n = in_region ? bins.count(tile) : 0;
     bool forced_done = forced < 0;
@@ -125,10 +176,18 @@ VF_HD int collect_hits(const SceneView& sc, const TileView& bins, Vec2 p, int fo
             forced_done = true;
             continue;
         }
+        if (AT_EDGE && inside_in_region && draw < edge_of) {
+            if (covers_or_edge_to(sc, bins, es[k], region, p, inside)) add(draw);
+            continue;
+        }
         if (covers(sc, bins, es[k], region, p)) add(draw);
     }
     if (!forced_done) add(forced);
     return (int)hits.size();
+}
+
+VF_HD int collect_hits(const SceneView& sc, const TileView& bins, Vec2 p, int forced, Buffer<Hit>& hits) {
+    return collect_hits_of<false>(sc, bins, p, forced, hits, -1, p);
 }
 
 // Analytical prefilter: the draws reaching p, front to back, with fractional coverage.

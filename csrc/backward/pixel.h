@@ -199,14 +199,17 @@ VF_HD void boundary_sample(const SceneView& sc, const TileView& bins, const Boun
     Vec2 outside = nudged(p, EPS_NORMAL, bs.n);  // (after the flip above)
     BoundarySupport support;
     if (!boundary_support(p, outside, R, W, H, support)) return;  // the change is off the canvas
+    // (a draw behind with its own edge through p, on the same side, moves with this one: see
+    // jump_without_layers)
+    Vec2 inside = nudged(p, -EPS_NORMAL, bs.n);
     double delta[4];
     if (bc.no_layers) {
-        jump_without_layers(sc, bins, outside, bs.draw, delta);
+        jump_without_layers(sc, bins, outside, inside, bs.draw, delta);
     } else {
         double c_in[4], c_out[4];
-        collect_hits(sc, bins, outside, bs.draw, hits);
+        collect_hits_of<true>(sc, bins, outside, bs.draw, hits, bs.draw, inside);
         composite_forward(sc, hits, nullptr, c_in);
-        collect_hits(sc, bins, outside, -1, hits);
+        collect_hits_of<true>(sc, bins, outside, -1, hits, bs.draw, inside);
         composite_forward(sc, hits, nullptr, c_out);
         for (int i = 0; i < 4; ++i) delta[i] = c_in[i] - c_out[i];
     }

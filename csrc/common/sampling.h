@@ -93,19 +93,38 @@ VF_HD double filter_weight(int kind, double r, double dx, double dy) {
     }
 }
 
-// The radius derivative's kernel (Monte Carlo mode): a pixel is I(r) = E[W(u) c(p + r u)] /
+// The integral of filter_weight over its support, [-r, r]^2.
+inline double filter_integral(int kind, double r) {
+    switch (kind) {
+        case FILTER_TENT: case FILTER_HANN: return r * r;
+        case FILTER_PARABOLIC: return (4 * r / 3) * (4 * r / 3);
+        case FILTER_GAUSSIAN: {
+            double sigma = r / 2, one = sigma * std::sqrt(2 * M_PI) * std::erf(r / (sigma * std::sqrt(2.0)));
+            return one * one;
+        }
+        default: return 4 * r * r;
+    }
+}
+
+// The radius derivative's kernel (Monte Carlo mode). A pixel is I(r) = E[W(u) c(p + r u)] /
 // E[W(u)] over u uniform in [-1, 1]^2, with W(u) = filter_weight at (r u_x, r u_y), which
-// depends on u alone. Substituting q = p + r u and differentiating under the integral,
-// dI/dr = E[D(u) c(p + r u)] / (r E[W(u)]) with D = -2 W - grad W . u, where the filter
-// vanishes on its support's edge (tent, parabolic, Hann; not the truncated Gaussian,
-// whose edge adds a boundary term, nor the box, whose radius is fixed). Separable
-// W = h(u_x) h(u_y): D = -2 h(x) h(y) - x h'(x) h(y) - h(x) y h'(y).
+// depends on u alone. Substituting q = p + r u and differentiating under the integral (the
+// support grows with r), dI/dr = (E[D(u) c(p + r u)] + 2 E_edge[W c]) / (r E[W]) with
+// D = -2 W - grad W . u, E_edge over u uniform on the support's edge, |u|_inf = 1 (zero
+// where W vanishes there: tent, parabolic, Hann; not the truncated Gaussian). The two
+// expectations of a constant cancel (E[D] = -2 E_edge[W]), so c may be replaced by c - b
+// for any b independent of u. Separable W = h(u_x) h(u_y):
+// D = -2 h(x) h(y) - x h'(x) h(y) - h(x) y h'(y). 0 for the box (its radius is fixed).
 VF_HD double filter_radius_kernel(int kind, double ux, double uy) {
     double hx, hy, xhx, yhy;  // h(x), h(y), x h'(x), y h'(y)
     switch (kind) {
         case FILTER_TENT:
             hx = 1 - std::fabs(ux), hy = 1 - std::fabs(uy);
             xhx = -std::fabs(ux), yhy = -std::fabs(uy);
+            break;
+        case FILTER_GAUSSIAN:  // h(x) = exp(-2 x^2): filter_weight's sigma r / 2
+            hx = std::exp(-2 * ux * ux), hy = std::exp(-2 * uy * uy);
+            xhx = -4 * ux * ux * hx, yhy = -4 * uy * uy * hy;
             break;
         case FILTER_PARABOLIC:
             hx = 1 - ux * ux, hy = 1 - uy * uy;
@@ -119,6 +138,15 @@ VF_HD double filter_radius_kernel(int kind, double ux, double uy) {
     }
     if (hx < 0 || hy < 0) return 0.0;
     return -2 * hx * hy - xhx * hy - hx * yhy;
+}
+
+// Point j of 4 n on the edge of [-1, 1]^2, stratified: n per side, jittered by `jitter` in
+// [0, 1) (the Gaussian's edge term, see filter_radius_kernel).
+VF_HD void support_edge_point(int j, int n, double jitter, double& ux, double& uy) {
+    int side = j / n;
+    double t = -1 + 2 * ((j % n) + jitter) / n;
+    ux = side == 0 ? 1.0 : side == 1 ? -1.0 : t;
+    uy = side == 2 ? 1.0 : side == 3 ? -1.0 : t;
 }
 
 }  // namespace vf

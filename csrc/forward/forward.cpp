@@ -206,38 +206,63 @@ void render_forward(const PreparedScene& prepared, const RenderOptions& o, float
     });
 }
 
-double filter_radius_gradient(const PreparedScene& prepared, const RenderOptions& o, const float* g) {
+double filter_radius_gradient(const PreparedScene& prepared, const RenderOptions& o, const float* pixels,
+                              const float* g) {
     ForwardPlan plan = plan_forward(prepared, o);
     const RenderOptions& s = plan.options;
-    if (s.mode != MODE_MC || (s.filter != FILTER_TENT && s.filter != FILTER_PARABOLIC && s.filter != FILTER_HANN))
-        return 0.0;
+    // The box's radius is fixed, and the others are settled to at least 0.5 px: there the
+    // image does not depend on the radius.
+    if (s.mode != MODE_MC || s.filter == FILTER_BOX || !(o.filter_radius >= 0.5)) return 0.0;
     const SceneView sc = prepared.view();
     const TileView bins = plan.bins.view();
-    const int W = s.width, H = s.height, N = s.samples;
+    const int W = s.width, H = s.height, N = s.samples, per_pixel = N * N;
     const double R = s.filter_radius;
+    // E[W] over the square of u, exact: a sum of the samples' weights would correlate with them
+    const double mean_weight = filter_integral(s.filter, R) / (4 * R * R);
+    const bool edge_term = s.filter == FILTER_GAUSSIAN;  // the only filter not 0 on its edge
+    // Samples of their own, not the image's: g comes from the image, and an estimate from
+    // the same samples correlates with it (on diffvg's optimize_pixel_filter.py, 2 x 2
+    // samples and an L2 loss, that bias alone pushed the radius below 0)
+    const uint64_t seed = mix64(s.seed ^ 0x2f1a7e5d3c9b8a61ull);
     std::vector<double> per_tile(bins.nx * bins.ny, 0.0);  // summed in order: independent of threads
     ThreadPool::instance().parallel_for(bins.nx * bins.ny, s.threads, [&](int tile, int) {
+        if (bins.count(tile) == 0) return;
         int tx = tile % bins.nx, ty = tile / bins.nx;
         double total = 0;
         for (int y = ty * TILE; y < std::min(H, (ty + 1) * TILE); ++y)
             for (int x = tx * TILE; x < std::min(W, (tx + 1) * TILE); ++x) {
                 const float* gp = g + 4 * ((size_t)y * W + x);
-                if (bins.count(tile) == 0 || (gp[0] == 0 && gp[1] == 0 && gp[2] == 0 && gp[3] == 0)) continue;
-                uint64_t pixel = (uint64_t)y * W + x;
-                double acc = 0, wsum = 0;
-                for (int k = 0; k < N * N; ++k) {  // the samples of pixel_forward, in its order
-                    double fx, fy;
-                    sample_position(s.seed, pixel, k, N, fx, fy);
-                    double ux = 2 * fx - 1, uy = 2 * fy - 1;
-                    double w = filter_weight(s.filter, R, R * ux, R * uy);
-                    if (w <= 0) continue;
-                    wsum += w;
+                if (gp[0] == 0 && gp[1] == 0 && gp[2] == 0 && gp[3] == 0) continue;
+                const float* b = pixels + 4 * ((size_t)y * W + x);
+                // g . (c - b) at offset u: b, the pixel as rendered, is independent of these
+                // samples, and a flat region then adds exactly nothing instead of noise
+                auto g_dot_change = [&](double ux, double uy) {
                     double c[4];
                     sample_forward(sc, bins, tile, {x + 0.5 + R * ux, y + 0.5 + R * uy}, s, c);
-                    acc += filter_radius_kernel(s.filter, ux, uy) *
-                           (gp[0] * c[0] + gp[1] * c[1] + gp[2] * c[2] + gp[3] * c[3]);
+                    return gp[0] * (c[0] - b[0]) + gp[1] * (c[1] - b[1]) + gp[2] * (c[2] - b[2]) +
+                           gp[3] * (c[3] - b[3]);
+                };
+                uint64_t pixel = (uint64_t)y * W + x;
+                double acc = 0;
+                for (int k = 0; k < per_pixel; ++k) {
+                    double fx, fy;
+                    sample_position(seed, pixel, k, N, fx, fy);
+                    double ux = 2 * fx - 1, uy = 2 * fy - 1;
+                    double d = filter_radius_kernel(s.filter, ux, uy);
+                    if (d != 0) acc += d * g_dot_change(ux, uy);
                 }
-                if (wsum > 0) total += acc / (R * wsum);
+                acc /= per_pixel;
+                if (edge_term) {  // 2 E_edge[W (c - b)], N samples a side
+                    double edge = 0;
+                    for (int j = 0; j < 4 * N; ++j) {
+                        double jitter, unused, ux, uy;
+                        sample_uniform2(seed, pixel, (uint64_t)(per_pixel + j), jitter, unused);
+                        support_edge_point(j, N, jitter, ux, uy);
+                        edge += filter_weight(s.filter, R, R * ux, R * uy) * g_dot_change(ux, uy);
+                    }
+                    acc += 2 * edge / (4 * N);
+                }
+                total += acc / (R * mean_weight);
             }
         per_tile[tile] = total;
     });

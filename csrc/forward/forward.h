@@ -54,8 +54,10 @@ ForwardPlan plan_forward(const PreparedScene& scene, const RenderOptions& option
 void render_forward(const PreparedScene& scene, const RenderOptions& options, float* out);
 
 // dL/d(filter radius) in Monte Carlo mode (see filter_radius_kernel, common/sampling.h),
-// given g: height x width x 4, dL/d(each pixel's filtered premultiplied colour, background
-// excluded). 0 for the box filter (its radius is fixed) and the Gaussian (not supported).
-double filter_radius_gradient(const PreparedScene& scene, const RenderOptions& options, const float* g);
+// given pixels, the image as rendered, and g, dL/d(it): both height x width x 4, each
+// pixel's filtered premultiplied colour with the background excluded. 0 for the box filter
+// (its radius is fixed) and below 0.5 px (settled to 0.5).
+double filter_radius_gradient(const PreparedScene& scene, const RenderOptions& options, const float* pixels,
+                              const float* g);
 
 }  // namespace vf

@@ -211,15 +211,17 @@ py::dict grads_dict(const SceneGrads& g) {
     return r;
 }
 
-// dL/d(filter radius), Monte Carlo mode: g is dL/d(the filtered premultiplied colour of
-// each pixel, background excluded), height x width x 4. On the CPU.
-double filter_radius_grad(const py::dict& scene, Array<float> g, const RenderOptions& options) {
+// dL/d(filter radius), Monte Carlo mode: pixels is the image as rendered and g is dL/d(it),
+// each height x width x 4, the filtered premultiplied colour of each pixel with the
+// background excluded. On the CPU.
+double filter_radius_grad(const py::dict& scene, Array<float> pixels, Array<float> g, const RenderOptions& options) {
     SceneInput in = scene_input(scene);
     SceneArrays a = in.arrays();
     if (options.mode != MODE_MC) throw std::invalid_argument("the filter radius's gradient is Monte Carlo's");
+    check_image(pixels, options, 1, "pixels");
     check_image(g, options, 1, "g");
     py::gil_scoped_release release;
-    return filter_radius_gradient(*prepare_timed(a), options, g.data());
+    return filter_radius_gradient(*prepare_timed(a), options, pixels.data(), g.data());
 }
 
 py::dict render_grad(const py::dict& scene, Array<float> image, Array<float> d_image, const RenderOptions& options,
@@ -639,8 +641,8 @@ PYBIND11_MODULE(_core, m) {
           py::arg("scene"), py::arg("positions"), py::arg("colours"), py::arg("d_colours"),
           py::arg("filter_radius"), py::arg("threads"));
     m.def("filter_radius_grad", &filter_radius_grad,
-          "dL/d(filter radius) in Monte Carlo mode, given dL/d(premultiplied colour) per pixel",
-          py::arg("scene"), py::arg("g"), py::arg("options"));
+          "dL/d(filter radius) in Monte Carlo mode, given the premultiplied image (background excluded) and "
+          "dL/d(it)", py::arg("scene"), py::arg("pixels"), py::arg("g"), py::arg("options"));
     m.def("footprint", &footprint, "Bytes the core holds for a scene at these options, by part",
           py::arg("scene"), py::arg("options"));
     m.def("layout", &layout,

@@ -11,8 +11,13 @@ argument orders and defaults (see README "Coming from diffvg"). What differs, an
   mode at one sample per pixel. The box filter always covers exactly the pixel (its
   radius is ignored); tent, parabolic and Hann filters use the radius (at least 0.5).
 - The filter radius's gradient (taken only when the radius requires grad): in Monte Carlo
-  mode the core's estimate from the image's own samples (one more pass over them); in
-  the analytical mode a central difference of two more renders.
+  mode the core's estimate of the filtered image's derivative, from samples of its own
+  (one more pass); in the analytical mode a central difference of two more renders.
+  A pixel gathers its N x N samples from the filter's whole support, where diffvg splats
+  each sample onto every pixel centre within the radius: a filter several pixels wide
+  averages N^2 samples here and about (2r)^2 N^2 there, so its image is noisier at few
+  samples (apps/optimize_pixel_filter.py reaches the target's radius on both, but its
+  loss, with new samples each step, stays near 0.6x its start here).
 - ``RenderFunction.render_grad`` (the per-pixel translation gradient) is a central
   difference of the image over a small translation of the scene (five renders).
 - ``background_image`` is composited under the filtered image per pixel (diffvg does it

@@ -89,7 +89,7 @@ def _difference(image, hi, lo, step):
 
 class _FilterRadius(torch.autograd.Function):
     """Passes the image through; its backward adds the filter radius's dL/dr from
-    ``gradient(image, dL/d(image))``: _mc_radius_gradient or _analytic_radius_gradient."""
+    ``gradient(image, dL/d(image))``: mc_radius_gradient or analytic_radius_gradient."""
 
     @staticmethod
     def forward(ctx, radius, image, gradient):
@@ -129,22 +129,24 @@ def _premultiplied_adjoint(image, grad):
     return torch.cat([g_rgb, g_a], dim=-1)
 
 
-def _mc_radius_gradient(scene, width, height, settings):
-    """Monte Carlo mode: the core's estimate with the image's own samples (the radius
-    derivative of the filtered integral, see filter_radius_kernel in csrc/common/sampling.h;
-    one more pass over the samples, on the CPU)."""
+def mc_radius_gradient(scene, width, height, settings):
+    """Monte Carlo mode: the core's estimate of the radius derivative of the filtered
+    integral, from samples of its own (see filter_radius_kernel in csrc/common/sampling.h;
+    one more pass, on the CPU)."""
     def gradient(image, grad):
         arrays = pack_scene(scene, width, height).arrays()
         core_scene = {k: (v.detach().cpu().float().numpy() if isinstance(v, torch.Tensor) else v)
                       for k, v in arrays.items()}
-        g = _premultiplied_adjoint(image.cpu(), grad.cpu()).contiguous().numpy()
+        image = image.cpu()
+        pixels = torch.cat([image[..., :3] * image[..., 3:], image[..., 3:]], dim=-1).contiguous().numpy()
+        g = _premultiplied_adjoint(image, grad.cpu()).contiguous().numpy()
         options = RenderOptions(width, height, samples=settings["samples"], filter=settings["filter"],
                                 filter_radius=settings["filter_radius"], seed=settings["seed"])
-        return _core.filter_radius_grad(core_scene, g, options.core())
+        return _core.filter_radius_grad(core_scene, pixels, g, options.core())
     return gradient
 
 
-def _analytic_radius_gradient(render_at, r):
+def analytic_radius_gradient(render_at, r):
     """Analytical mode (a smooth function of r, whose kernel the core does not
     differentiate): a central difference of two more renders, 0.2% of r each way (a
     larger step would mix colours across an edge where alpha is near 0; see
@@ -251,9 +253,9 @@ class RenderFunction:
         if (isinstance(radius, torch.Tensor) and radius.requires_grad and torch.is_grad_enabled()
                 and ftype != FilterType.box):
             if parsed.use_prefiltering:
-                gradient = _analytic_radius_gradient(render_at, r)
+                gradient = analytic_radius_gradient(render_at, r)
             else:
-                gradient = _mc_radius_gradient(scene, int(width), int(height),
+                gradient = mc_radius_gradient(scene, int(width), int(height),
                                                dict(options, filter_radius=r))
             image = _FilterRadius.apply(radius, image, gradient)
         if background_image is not None:

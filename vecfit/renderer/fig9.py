@@ -25,13 +25,14 @@ def weighting(seed: int, height: int, width: int, border: float = 4.0) -> torch.
     return (w * ry[None, :, None] * rx[None, None, :]).permute(1, 2, 0)
 
 
-def shifted(scene: Scene, dx: torch.Tensor, keep=None, _copies=None) -> Scene:
+def shifted(scene: Scene, dx: torch.Tensor, keep=None, _copies=None, axis: int = 0) -> Scene:
     """A copy of the scene whose every geometry point (in its shape's own space) is moved
-    by (dx, 0), those of its clip paths and masks included. keep(i, shape) -> False drops
-    shape i (for bisecting by shape)."""
+    by dx along `axis` (0: x, 1: y), those of its clip paths and masks included.
+    keep(i, shape) -> False drops shape i (for bisecting by shape)."""
     copies = {} if _copies is None else _copies  # id(clip or mask) -> its moved copy
     out = copy.copy(scene)
-    step = torch.stack([dx, torch.zeros_like(dx)])
+    zero = torch.zeros_like(dx)
+    step = torch.stack([dx, zero] if axis == 0 else [zero, dx])
     shapes = []
     for i, s in enumerate(scene.shapes):
         if keep is not None and not keep(i, s):
@@ -45,25 +46,25 @@ def shifted(scene: Scene, dx: torch.Tensor, keep=None, _copies=None) -> Scene:
         elif isinstance(g, (Circle, Ellipse)):
             g.center = g.center.detach() + step
         s.geometry = g
-        s.clip, s.mask = _shifted_effect(s.clip, dx, copies), _shifted_effect(s.mask, dx, copies)
+        s.clip, s.mask = _shifted_effect(s.clip, dx, copies, axis), _shifted_effect(s.mask, dx, copies, axis)
         shapes.append(s)
     out.shapes = shapes
     out.groups = [copy.copy(g) for g in scene.groups]
     for g in out.groups:
-        g.clip, g.mask = _shifted_effect(g.clip, dx, copies), _shifted_effect(g.mask, dx, copies)
+        g.clip, g.mask = _shifted_effect(g.clip, dx, copies, axis), _shifted_effect(g.mask, dx, copies, axis)
     return out
 
 
-def _shifted_effect(effect, dx, copies):
+def _shifted_effect(effect, dx, copies, axis):
     if effect is None:
         return None
     if id(effect) not in copies:
         moved = copies[id(effect)] = copy.copy(effect)
-        moved.content = shifted(effect.content, dx, None, copies)
+        moved.content = shifted(effect.content, dx, None, copies, axis)
         if isinstance(effect, ClipPath):
-            moved.clip = _shifted_effect(effect.clip, dx, copies)
+            moved.clip = _shifted_effect(effect.clip, dx, copies, axis)
         else:
-            moved.mask = _shifted_effect(effect.mask, dx, copies)
+            moved.mask = _shifted_effect(effect.mask, dx, copies, axis)
     return copies[id(effect)]
 
 
@@ -71,16 +72,17 @@ def weighted(image: torch.Tensor, W: torch.Tensor) -> torch.Tensor:
     return (image.double() * W.double()).sum()  # (a float32 sum's rounding shows in small steps)
 
 
-def fig9(scene: Scene, width: int, height: int, weights, step: float = 0.5, keep=None, **kw):
+def fig9(scene: Scene, width: int, height: int, weights, step: float = 0.5, keep=None, axis: int = 0, **kw):
     """[(autograd, central difference)] of dL/d delta for each weighting W (one render
     and one backward pass per W for autograd, two renders for the differences); kw go to
-    render (mode, samples, seed, ...); keep(i, shape) selects shapes."""
+    render (mode, samples, seed, ...); keep(i, shape) selects shapes; axis 1 moves the
+    points down instead of right."""
     dx = torch.tensor(0.0, requires_grad=True)
-    image = render(shifted(scene, dx, keep), width, height, **kw)
+    image = render(shifted(scene, dx, keep, axis=axis), width, height, **kw)
     ads = [torch.autograd.grad(weighted(image, W), dx, retain_graph=True)[0].item() for W in weights]
     with torch.no_grad():
-        plus = render(shifted(scene, torch.tensor(step), keep), width, height, **kw)
-        minus = render(shifted(scene, torch.tensor(-step), keep), width, height, **kw)
+        plus = render(shifted(scene, torch.tensor(step), keep, axis=axis), width, height, **kw)
+        minus = render(shifted(scene, torch.tensor(-step), keep, axis=axis), width, height, **kw)
     return [(ad, float(weighted(plus, W) - weighted(minus, W)) / (2 * step)) for ad, W in zip(ads, weights)]
 
 
