@@ -273,6 +273,13 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
                         crossings.push_back(c);
                     }
                 }
+                else {  // strokes: the piece's heights, read per sample without the piece itself
+                    const StrokeSegment& s = sc.stroke_items[d.first_item + li.item];
+                    li.y0 = float_below(s.box.y0);
+                    li.y1 = float_above(s.box.y1);
+                    li.x0 = float_below(s.box.x0);
+                    li.x1 = float_above(s.box.x1);
+                }
                 items.push_back(li);
             }
             pending.push_back({tile, e});

@@ -37,10 +37,13 @@ struct LocalItem {
     int32_t item = 0;             // index into the draw's fill or stroke items
     int32_t cross = -1;           // fills: its crossings of the vertical leg (index into the
                                   // bins' crossings), -1 where it has none (most items)
-    // Fills: the segment's heights (its box's, as floats rounded outwards): a ray at a
-    // height outside them crosses nothing, and the segment itself (384 bytes, scattered)
-    // need not be read. Most of a tile's segments are set aside so, per sample.
+    // The segment's heights (its box's, as floats rounded outwards; for a stroke its
+    // piece's, half width included): a ray at a height outside them crosses nothing, and a
+    // stroke's piece lies farther than the height difference, so the segment itself (384
+    // bytes, scattered) need not be read. Most of a tile's segments are set aside so, per
+    // sample.
     float y0 = 0, y1 = -1;
+    float x0 = 0, x1 = -1;        // strokes: the piece's box's sides, as the heights
     VF_HD bool spans(double y) const { return y >= y0 && y <= y1; }
 };
 
@@ -140,6 +143,11 @@ struct LocalItems {
     VF_HD LocalItems(const TileView& bins, const TileEntry& e) : li(bins.items.data() + e.first), n(e.count) {}
     VF_HD int size() const { return n; }
     VF_HD int operator[](int i) const { return li[i].item; }
+    // Whether item i's box (a stroke's) may come within `reach` of p (see LocalItem::y0).
+    VF_HD bool may_reach(int i, Vec2 p, double reach) const {
+        const LocalItem& l = li[i];
+        return p.y >= l.y0 - reach && p.y <= l.y1 + reach && p.x >= l.x0 - reach && p.x <= l.x1 + reach;
+    }
 };
 
 // Whether the entry's draw covers p (a point of the tile region): the Monte Carlo test.
