@@ -80,6 +80,16 @@ def _at(points, s, d):
     return (points[k] + t * (points[k + 1] - points[k]))[None]
 
 
+def _has_area(path, tolerance: float) -> bool:
+    """Whether a closed outline encloses anything: SVG fills nothing for a line (an open
+    path's fill, a closed path that goes there and back), nor should a cutter cut it."""
+    pts = flattened(path, tolerance)
+    if len(pts) < 3:
+        return False
+    centred = pts - pts.mean(axis=0)
+    return float(np.linalg.svd(centred, compute_uv=False)[-1]) > tolerance
+
+
 def scene_dxf(scene: Scene, units: str = "mm", curves: str = "polyline") -> bytes:
     """The Scene as DXF text (bytes)."""
     import ezdxf
@@ -159,7 +169,8 @@ def scene_dxf(scene: Scene, units: str = "mm", curves: str = "polyline") -> byte
                 add(paths, {"layer": layer(stroke), "lineweight": lw})
         # the same outline in the same colour is drawn once
         if fill is not None and not (fill == stroke and pattern is None and all(s.closed for s in paths)):
-            add([type(s)(s.start, s.segments, True) for s in paths], {"layer": layer(fill)})
+            outlines = [type(s)(s.start, s.segments, True) for s in paths]
+            add([s for s in outlines if _has_area(s, tolerance)], {"layer": layer(fill)})
     for g in scene.groups:
         for effect in ("clip", "mask", "filter"):
             if getattr(g, effect) is not None:
