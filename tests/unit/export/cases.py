@@ -48,6 +48,14 @@ CASES = {
                   '<g transform="scale(1.5 0.6) skewX(20)"><circle r="10" fill="#e84"/></g></g>'
                   '<path transform="matrix(0.8 0.2 -0.3 0.9 10 5)" d="M5 5 h20 v20 z" fill="none" '
                   'stroke="#a0a" stroke-width="3" stroke-linejoin="round"/>',
+    "masks": '<defs><mask id="m"><rect x="0" y="0" width="100" height="80" fill="#fff"/>'
+             '<circle cx="35" cy="40" r="15" fill="#000"/><rect x="60" y="10" width="30" height="60" fill="#808080"/>'
+             '</mask><clipPath id="g" clipPathUnits="objectBoundingBox"><circle cx="0.5" cy="0.5" r="0.5"/></clipPath>'
+             '</defs>'
+             '<rect x="5" y="5" width="90" height="70" fill="#2a6" mask="url(#m)"/>'
+             '<g clip-path="url(#g)" opacity="0.8"><rect x="40" y="30" width="20" height="20" fill="#c30"/>'
+             '<rect x="50" y="40" width="20" height="20" fill="#03c"/></g>'
+             '<circle cx="80" cy="20" r="12" fill="#f0f" style="mix-blend-mode:multiply"/>',
 }
 
 
