@@ -80,14 +80,16 @@ def _at(points, s, d):
     return (points[k] + t * (points[k + 1] - points[k]))[None]
 
 
-def _has_area(path, tolerance: float) -> bool:
+def _has_area(path) -> bool:
     """Whether a closed outline encloses anything: SVG fills nothing for a line (an open
-    path's fill, a closed path that goes there and back), nor should a cutter cut it."""
-    pts = flattened(path, tolerance)
+    path's fill, a closed path that goes there and back), nor should a cutter cut it. A
+    Bézier lies on a line exactly when its control points do."""
+    pts = np.vstack([path.start[None]] + [c for _, c in path.segments])
     if len(pts) < 3:
         return False
     centred = pts - pts.mean(axis=0)
-    return float(np.linalg.svd(centred, compute_uv=False)[-1]) > tolerance
+    sv = np.linalg.svd(centred, compute_uv=False)
+    return bool(sv[-1] > 1e-9 * max(sv[0], 1e-300))
 
 
 def scene_dxf(scene: Scene, units: str = "mm", curves: str = "polyline") -> bytes:
@@ -170,7 +172,7 @@ def scene_dxf(scene: Scene, units: str = "mm", curves: str = "polyline") -> byte
         # the same outline in the same colour is drawn once
         if fill is not None and not (fill == stroke and pattern is None and all(s.closed for s in paths)):
             outlines = [type(s)(s.start, s.segments, True) for s in paths]
-            add([s for s in outlines if _has_area(s, tolerance)], {"layer": layer(fill)})
+            add([s for s in outlines if _has_area(s)], {"layer": layer(fill)})
     for g in scene.groups:
         for effect in ("clip", "mask", "filter"):
             if getattr(g, effect) is not None:

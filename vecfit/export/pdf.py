@@ -55,7 +55,7 @@ def path_ops(paths, close_as_line=True) -> str:
         out.append(f"{n(s.start[0])} {n(s.start[1])} m")
         segments = s.segments
         # A closed subpath's last line back to the start is what h draws.
-        if s.closed and segments and segments[-1][0] == 1 and np.allclose(segments[-1][1][-1], s.start):
+        if s.closed and segments and segments[-1][0] == 1 and np.array_equal(segments[-1][1][-1], s.start):
             segments = segments[:-1]
         for d, c in segments:
             if d == 1:
@@ -65,6 +65,21 @@ def path_ops(paths, close_as_line=True) -> str:
         if s.closed:
             out.append("h")
     return "\n".join(out)
+
+
+class _Lazy:
+    """A value computed when first asked for (``_value``)."""
+
+    def __init__(self, make):
+        self.make, self.done, self.value = make, False, None
+
+
+def _value(x):
+    if isinstance(x, _Lazy):
+        if not x.done:
+            x.value, x.done = x.make(), True
+        return x.value
+    return x
 
 
 class _Stream:
@@ -275,9 +290,7 @@ class PdfWriter:
     def draw_group(self, scene: Scene, out: _Stream, group, index: int, run):
         out.q()
         out.cm(f64(group.transform))
-        needs_box = any(e is not None and getattr(e, "units", "") == "objectBoundingBox"
-                        for e in (group.clip, group.mask))
-        box = scene_bbox(scene, index) if needs_box else None
+        box = _Lazy(lambda: scene_bbox(scene, index))  # for bounding-box units only
         self.effects(scene, out, group, run, box)
         out.Q()
 
@@ -294,7 +307,7 @@ class PdfWriter:
             return
         out.q()
         out.cm(f64(shape.transform))
-        box = bbox(paths)
+        box = _Lazy(lambda: bbox(paths))  # for bounding-box units only: sampling costs
         ops = path_ops(paths)
         opacity = num(shape.opacity)
         both = fill is not None and stroke is not None and opacity < 1
@@ -381,7 +394,7 @@ class PdfWriter:
         """Gradient space -> the shape's space: gradientTransform, then the bounding box."""
         m = f64(paint.transform)
         if paint.units == "objectBoundingBox":
-            unit = unit_box(box)
+            unit = unit_box(_value(box))
             if unit is None:
                 return None
             m = unit @ m
@@ -432,7 +445,7 @@ class PdfWriter:
             if nested:  # (rare) a clipped clip of several shapes: drawn on its own layer
                 self.warn("PDF: a clip path on a clip path of several shapes is drawn unclipped by the outer one")
         if clip.units == "objectBoundingBox":
-            unit = unit_box(box)
+            unit = unit_box(_value(box))
             if unit is None:
                 out.add("0 0 m h W n")  # nothing shows
                 return {}
@@ -459,7 +472,7 @@ class PdfWriter:
     def mask(self, out: _Stream, mask, box) -> int:
         """The SMask of an SVG mask: its content drawn in the element's space (or its
         bounding box's), inside the mask region."""
-        unit = unit_box(box)
+        unit = unit_box(_value(box)) if "objectBoundingBox" in (mask.units, mask.content_units) else None
         region = np.asarray(mask.region, np.float64)
 
         def draw(stream):
