@@ -29,7 +29,7 @@ from vecfit.scene.dashes import dash_pattern
 from vecfit.scene.model import Scene, Solid
 from vecfit.scene.placement import shape_matrices
 
-from .outline import f64, flattened, num, subpaths, transformed
+from .outline import encloses, f64, flattened, is_dot, num, subpaths, transformed
 
 MM_PER_PX = 25.4 / 96
 UNITS = {"mm": (4, MM_PER_PX), "in": (1, 1 / 96)}  # $INSUNITS code, drawing units per px
@@ -80,18 +80,6 @@ def _at(points, s, d):
     return (points[k] + t * (points[k + 1] - points[k]))[None]
 
 
-def _has_area(path) -> bool:
-    """Whether a closed outline encloses anything: SVG fills nothing for a line (an open
-    path's fill, a closed path that goes there and back), nor should a cutter cut it. A
-    Bézier lies on a line exactly when its control points do."""
-    pts = np.vstack([path.start[None]] + [c for _, c in path.segments])
-    if len(pts) < 3:
-        return False
-    centred = pts - pts.mean(axis=0)
-    sv = np.linalg.svd(centred, compute_uv=False)
-    return bool(sv[-1] > 1e-9 * max(sv[0], 1e-300))
-
-
 def scene_dxf(scene: Scene, units: str = "mm", curves: str = "polyline") -> bytes:
     """The Scene as DXF text (bytes)."""
     import ezdxf
@@ -123,6 +111,9 @@ def scene_dxf(scene: Scene, units: str = "mm", curves: str = "polyline") -> byte
                 for piece in dashed(local, pattern, dash_offset):
                     pts = piece @ own[:2, :2].T + own[:2, 2]
                     msp.add_lwpolyline(pts[:, :2], dxfattribs=attribs)
+                continue
+            if is_dot(s):  # a pen's dot (a stroke's cap alone)
+                msp.add_point((*s.start, 0), dxfattribs=attribs)
                 continue
             has_curves = any(d == 3 for d, _ in s.segments)
             if curves == "spline" and has_curves:
@@ -165,6 +156,10 @@ def scene_dxf(scene: Scene, units: str = "mm", curves: str = "polyline") -> byte
         if stroke is not None:
             weight = width * own_scale * (100 if units == "mm" else 2540)  # in 1/100 mm
             lw = min(VALID_DXF_LINEWEIGHTS, key=lambda v: abs(v - weight))
+            if shape.linecap == "butt":  # a subpath without length draws nothing
+                keep = [not is_dot(s) for s in local]
+                local = [s for s, k in zip(local, keep) if k]
+                paths = [s for s, k in zip(paths, keep) if k]
             if pattern is not None:
                 add(local, {"layer": layer(stroke), "lineweight": lw}, pattern, shape.dash_offset, own, own_scale)
             else:
@@ -172,7 +167,7 @@ def scene_dxf(scene: Scene, units: str = "mm", curves: str = "polyline") -> byte
         # the same outline in the same colour is drawn once
         if fill is not None and not (fill == stroke and pattern is None and all(s.closed for s in paths)):
             outlines = [type(s)(s.start, s.segments, True) for s in paths]
-            add([s for s in outlines if _has_area(s)], {"layer": layer(fill)})
+            add([s for s in outlines if encloses(s)], {"layer": layer(fill)})
     for g in scene.groups:
         for effect in ("clip", "mask", "filter"):
             if getattr(g, effect) is not None:

@@ -115,6 +115,23 @@ def _bernstein(n: int) -> np.ndarray:
     return np.hstack([u ** 3, 3 * u * u * t, 3 * u * t * t, t ** 3])
 
 
+def encloses(path: Subpath) -> bool:
+    """Whether the subpath, closed, encloses anything: SVG fills nothing for a line (an
+    open line's fill, a path that goes there and back), and PDF viewers draw such a fill as
+    a hairline. A Bézier lies on a line exactly when its control points do."""
+    pts = np.vstack([path.start[None]] + [c for _, c in path.segments])
+    if len(pts) < 3:
+        return False
+    sv = np.linalg.svd(pts - pts.mean(axis=0), compute_uv=False)
+    return bool(sv[-1] > 1e-9 * max(sv[0], 1e-300))
+
+
+def is_dot(path: Subpath) -> bool:
+    """Whether the subpath has no length (every point at its start): a stroke draws it as
+    its cap alone."""
+    return all(np.array_equal(c, np.broadcast_to(path.start, c.shape)) for _, c in path.segments)
+
+
 def bbox(paths: list[Subpath]) -> tuple[np.ndarray, np.ndarray] | None:
     """The tight bounds of the subpaths (curves sampled finely enough for a gradient's or
     clip's bounding-box units), or None when there are none."""

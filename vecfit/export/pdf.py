@@ -25,7 +25,8 @@ import numpy as np
 from vecfit.scene.dashes import dash_pattern
 from vecfit.scene.model import ClipPath, LinearGradient, RadialGradient, Scene, Solid
 
-from .outline import f64, group_chain, num, scene_bbox, shape_to, subpaths, transformed, unit_box, bbox
+from .outline import (Subpath, bbox, encloses, f64, group_chain, is_dot, num, scene_bbox, shape_to, subpaths,
+                      transformed, unit_box)
 
 PT_PER_PX = 0.75
 CAPS = {"butt": 0, "round": 1, "square": 2}
@@ -48,7 +49,7 @@ def matrix(m: np.ndarray) -> str:
     return " ".join(n(v) for v in (m[0, 0], m[1, 0], m[0, 1], m[1, 1], m[0, 2], m[1, 2]))
 
 
-def path_ops(paths, close_as_line=True) -> str:
+def path_ops(paths) -> str:
     """Path construction operators of the subpaths."""
     out = []
     for s in paths:
@@ -65,6 +66,24 @@ def path_ops(paths, close_as_line=True) -> str:
         if s.closed:
             out.append("h")
     return "\n".join(out)
+
+
+def _caps(dots: list, cap: str, width: float) -> list:
+    """The caps a stroke draws on subpaths without length: a disc with round caps, a
+    square along the axes with square caps (as resvg and tiny-skia), nothing with butt."""
+    r = width / 2
+    out = []
+    for d in dots:
+        c = d.start
+        if cap == "round":
+            k = 0.5522847498307936 * r
+            pts = c + np.array([[r, 0], [r, k], [k, r], [0, r], [-k, r], [-r, k], [-r, 0],
+                                [-r, -k], [-k, -r], [0, -r], [k, -r], [r, -k], [r, 0]])
+            out.append(Subpath(pts[0], [(3, pts[i:i + 3]) for i in (1, 4, 7, 10)], True))
+        elif cap == "square":
+            pts = c + np.array([[-r, -r], [r, -r], [r, r], [-r, r]])
+            out.append(Subpath(pts[0], [(1, pts[i:i + 1]) for i in (1, 2, 3)], True))
+    return out
 
 
 class _Lazy:
@@ -308,19 +327,26 @@ class PdfWriter:
         out.q()
         out.cm(f64(shape.transform))
         box = _Lazy(lambda: bbox(paths))  # for bounding-box units only: sampling costs
-        ops = path_ops(paths)
+        # (PDF viewers draw a fill without area as a hairline, and no cap on a subpath
+        # without length: both are said here as SVG draws them)
+        fill_ops = path_ops([s for s in paths if encloses(s)])
+        stroke_ops = path_ops([s for s in paths if not is_dot(s)])
+        dots = "" if dash_pattern(shape.dash_array) else path_ops(
+            _caps([s for s in paths if is_dot(s)], shape.linecap, width))  # (a dot has no dashes)
         opacity = num(shape.opacity)
         both = fill is not None and stroke is not None and opacity < 1
 
         def draw(stream):
             # a shape with fill and stroke under an opacity is one layer at that opacity
             k = 1.0 if both else opacity
-            if fill is not None:
-                self.paint(stream, ops, fill, k * num(shape.fill_opacity), box,
+            if fill is not None and fill_ops:
+                self.paint(stream, fill_ops, fill, k * num(shape.fill_opacity), box,
                            "f*" if shape.fill_rule == "evenodd" else "f", False)
-            if stroke is not None:
-                self.paint(stream, ops, stroke, k * num(shape.stroke_opacity), box, "S", True,
+            if stroke is not None and stroke_ops:
+                self.paint(stream, stroke_ops, stroke, k * num(shape.stroke_opacity), box, "S", True,
                            self.stroke_state(shape, width))
+            if stroke is not None and dots:
+                self.paint(stream, dots, stroke, k * num(shape.stroke_opacity), box, "f", False)
 
         class _Element:  # the shape's effects, with the opacity as a layer only where needed
             pass

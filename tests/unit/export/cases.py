@@ -56,6 +56,10 @@ CASES = {
              '<g clip-path="url(#g)" opacity="0.8"><rect x="40" y="30" width="20" height="20" fill="#c30"/>'
              '<rect x="50" y="40" width="20" height="20" fill="#03c"/></g>'
              '<circle cx="80" cy="20" r="12" fill="#f0f" style="mix-blend-mode:multiply"/>',
+    "dots": '<g stroke="#135" stroke-width="8"><path d="M15 15 Z" stroke-linecap="round"/>'
+            '<path d="M35 15 l0 0" stroke-linecap="square"/>'
+            '<path d="M75 15 h0 M10 40 H90" stroke-linecap="round"/></g>'
+            '<path d="M10 65 L90 60" stroke="#a30" stroke-width="3"/>',  # (its black fill has no area)
 }
 
 

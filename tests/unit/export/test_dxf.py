@@ -39,6 +39,8 @@ def dxf_lines(doc, height_px: float) -> list[np.ndarray]:
             pts = np.array(e.get_points("xy"), np.float64)
             if e.closed:
                 pts = np.vstack([pts, pts[:1]])
+        elif e.dxftype() == "POINT":
+            pts = np.array([[e.dxf.location.x, e.dxf.location.y]], np.float64)
         elif e.dxftype() == "SPLINE":
             pts = np.array([(v.x, v.y) for v in e.construction_tool().flattening(1e-4)], np.float64)
         else:
@@ -68,6 +70,7 @@ def dense(lines: list[np.ndarray], step: float = 0.01) -> np.ndarray:
     """Points every ``step`` px along polylines."""
     out = []
     for pts in lines:
+        out.append(pts)
         for a, b in zip(pts[:-1], pts[1:]):
             k = max(1, int(np.ceil(np.hypot(*(b - a)) / step)))
             out.append(a + (b - a) * np.linspace(0, 1, k + 1)[:, None])
