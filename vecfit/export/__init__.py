@@ -29,6 +29,11 @@ def format_for(path, fmt: str | None = None) -> str:
     return fmt
 
 
+def _is_text(svg) -> bool:
+    """Whether ``svg`` is the SVG itself (bytes, or text starting with "<"), not a path."""
+    return isinstance(svg, bytes) or (isinstance(svg, str) and svg.lstrip().startswith("<"))
+
+
 def scene_of_svg(svg, name: str = "the SVG"):
     """An SVG (bytes, text or a path) read into a Scene of NumPy arrays (no torch), and
     the unit its root's width is given in ("" for none or px)."""
@@ -37,7 +42,7 @@ def scene_of_svg(svg, name: str = "the SVG"):
     from vecfit.svg.read import scene_of
 
     with numpy_arrays():
-        if isinstance(svg, (bytes, str)) and not (isinstance(svg, str) and not svg.lstrip().startswith("<")):
+        if _is_text(svg):
             text = svg.decode("utf-8") if isinstance(svg, bytes) else svg
             document = SvgDocument.parse(text, name)
         else:
@@ -86,7 +91,7 @@ def export(svg, path, fmt: str | None = None, curves: str = "polyline") -> str:
     the path's suffix); returns the format written."""
     fmt = format_for(path, fmt)
     if fmt == "svg":
-        if isinstance(svg, (str, bytes)) and (isinstance(svg, bytes) or svg.lstrip().startswith("<")):
+        if _is_text(svg):
             payload = svg if isinstance(svg, bytes) else svg.encode("utf-8")
         else:
             payload = Path(svg).read_bytes()

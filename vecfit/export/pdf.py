@@ -23,7 +23,7 @@ import zlib
 import numpy as np
 
 from vecfit.scene.dashes import dash_pattern
-from vecfit.scene.model import ClipPath, LinearGradient, RadialGradient, Scene, Solid
+from vecfit.scene.model import ClipPath, LinearGradient, Scene, Solid
 
 from .outline import (Subpath, bbox, encloses, f64, group_chain, is_dot, num, scene_bbox, shape_to, subpaths,
                       transformed, unit_box)
@@ -274,12 +274,11 @@ class PdfWriter:
                 i += 1
         return i
 
-    def effects(self, scene: Scene, out: _Stream, element, draw, box):
+    def effects(self, out: _Stream, draw, box, element, opacity: float):
         """Draws ``draw`` (in ``out``'s current space, the element's own) under the
-        element's clip, mask, opacity and blend mode."""
+        element's (a Shape's or Group's) clip, mask, blend mode and ``opacity``."""
         if element.filter is not None:
             self.warn("PDF: filters are not drawn (the elements are drawn without them)")
-        opacity = num(element.opacity)
         entries = {}
         if opacity < 1:
             entries["ca"] = n(max(opacity, 0))
@@ -300,7 +299,7 @@ class PdfWriter:
                     self.layer(stream, inner_draw, **inner_entries)
                 else:
                     inner_draw(stream)
-        if entries or getattr(element, "isolate", False):
+        if entries or getattr(element, "isolate", False):  # (a Group's isolation)
             self.layer(out, draw, **entries)
         else:
             draw(out)
@@ -310,7 +309,7 @@ class PdfWriter:
         out.q()
         out.cm(f64(group.transform))
         box = _Lazy(lambda: scene_bbox(scene, index))  # for bounding-box units only
-        self.effects(scene, out, group, run, box)
+        self.effects(out, run, box, group, num(group.opacity))
         out.Q()
 
     def draw_shape(self, scene: Scene, out: _Stream, shape):
@@ -348,12 +347,8 @@ class PdfWriter:
             if stroke is not None and dots:
                 self.paint(stream, dots, stroke, k * num(shape.stroke_opacity), box, "f", False)
 
-        class _Element:  # the shape's effects, with the opacity as a layer only where needed
-            pass
-        element = _Element()
-        element.filter, element.mask, element.clip, element.blend = shape.filter, shape.mask, shape.clip, shape.blend
-        element.opacity = opacity if both else 1.0
-        self.effects(scene, out, element, draw, box)
+        # the opacity is a layer's only where fill and stroke overlap
+        self.effects(out, draw, box, shape, opacity if both else 1.0)
         out.Q()
 
     @staticmethod

@@ -117,3 +117,13 @@ def test_a_traced_photo():
     text, report = vecfit.trace(image, settings={"optimize": {"iterations": 0}})
     assert report["shapes"] > 100
     assert roundtrip_psnr(text, 240) >= MIN_PSNR
+
+
+def test_a_scene_of_tensors_converts_as_its_file():
+    """vecfit.export.convert takes a Scene as vecfit.load_svg reads it (tensors): the same
+    PDF as the SVG's."""
+    import tempfile
+    from vecfit.export import convert
+    path = Path(tempfile.mkdtemp()) / "g.svg"
+    path.write_text(svg("gradients"))
+    assert convert(vecfit.load_svg(path), "pdf") == svg_to(svg("gradients"), "pdf")
