@@ -7,7 +7,8 @@
 - Curves: by default polylines (LWPOLYLINE) within ``TOLERANCE_MM`` of the curve: every
   cutter, plotter and CAM program reads them, while SPLINE support is patchy among
   cutter software. ``curves="spline"`` writes each subpath with curves as one exact
-  SPLINE instead (a cubic Bézier chain is a clamped cubic B-spline with triple knots).
+  SPLINE instead (a cubic Bézier chain is a clamped cubic B-spline with triple knots),
+  and a circle or ellipse as a CIRCLE or ELLIPSE.
 - Layers: one per colour, named ``#rrggbb``, coloured with that true colour; a gradient's
   layer is the mean of its stops. Entities are BYLAYER. A stroke's width is kept as the
   nearest DXF lineweight.
@@ -26,7 +27,7 @@ import warnings
 import numpy as np
 
 from vecfit.scene.dashes import dash_pattern
-from vecfit.scene.model import Scene, Solid
+from vecfit.scene.model import Circle, Ellipse, Scene, Solid
 from vecfit.scene.placement import shape_matrices
 
 from .outline import encloses, f64, flattened, is_dot, num, subpaths, transformed
@@ -134,6 +135,24 @@ def scene_dxf(scene: Scene, units: str = "mm", curves: str = "polyline") -> byte
                 if len(pts) >= 2:
                     msp.add_lwpolyline(pts, close=s.closed, dxfattribs=attribs)
 
+    def conic(geometry, own, attribs) -> bool:
+        """With exact curves, a circle or an ellipse as a CIRCLE or ELLIPSE entity (an
+        ellipse under any affine map is one); False for anything else."""
+        if curves != "spline" or not isinstance(geometry, (Circle, Ellipse)):
+            return False
+        c = f64(geometry.center).reshape(2)
+        r = np.repeat(f64(geometry.radius).reshape(1), 2) if isinstance(geometry, Circle) else f64(geometry.radii)
+        axes = own[:2, :2] @ np.diag(r)  # the image of the unit circle: centre + axes @ (cos, sin)
+        u, sv, _ = np.linalg.svd(axes)
+        centre = (*(own[:2, :2] @ c + own[:2, 2]), 0)
+        if sv[1] <= 0:
+            return False
+        if sv[0] - sv[1] <= 1e-9 * sv[0]:
+            msp.add_circle(centre, float(sv[0]), dxfattribs=attribs)
+        else:
+            msp.add_ellipse(centre, (*(u[:, 0] * sv[0]), 0), float(sv[1] / sv[0]), dxfattribs=attribs)
+        return True
+
     matrices = np.asarray(f64(shape_matrices(scene, scene.width, scene.height)), np.float64) \
         if scene.shapes else np.zeros((0, 3, 3))
     for shape, m in zip(scene.shapes, matrices):
@@ -163,11 +182,13 @@ def scene_dxf(scene: Scene, units: str = "mm", curves: str = "polyline") -> byte
             if pattern is not None:
                 add(local, {"layer": layer(stroke), "lineweight": lw}, pattern, shape.dash_offset, own, own_scale)
             else:
-                add(paths, {"layer": layer(stroke), "lineweight": lw})
+                if not conic(shape.geometry, own, {"layer": layer(stroke), "lineweight": lw}):
+                    add(paths, {"layer": layer(stroke), "lineweight": lw})
         # the same outline in the same colour is drawn once
         if fill is not None and not (fill == stroke and pattern is None and all(s.closed for s in paths)):
-            outlines = [type(s)(s.start, s.segments, True) for s in paths]
-            add([s for s in outlines if encloses(s)], {"layer": layer(fill)})
+            if not conic(shape.geometry, own, {"layer": layer(fill)}):
+                outlines = [type(s)(s.start, s.segments, True) for s in paths]
+                add([s for s in outlines if encloses(s)], {"layer": layer(fill)})
     for g in scene.groups:
         for effect in ("clip", "mask", "filter"):
             if getattr(g, effect) is not None:
