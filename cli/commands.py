@@ -103,7 +103,8 @@ def main():
 
 @main.command()
 @click.argument("inputs", nargs=-1, required=True, type=click.Path(dir_okay=False))
-@click.option("-o", "--output", type=click.Path(dir_okay=False), help="Output PNG (one input).")
+@click.option("-o", "--output", type=click.Path(dir_okay=False),
+              help="Output PNG (one input); OUT.pdf or OUT.dxf converts the SVG to that format.")
 @click.option("--out-dir", type=click.Path(file_okay=False), help="Folder for outputs, NAME.svg -> NAME.png.")
 @click.option("--width", type=click.IntRange(min=1), help="Width in pixels (default: the SVG's).")
 @click.option("--height", type=click.IntRange(min=1), help="Height in pixels (default: the SVG's).")
@@ -146,6 +147,15 @@ def render(inputs, output, out_dir, width, height, samples, mode, filter_, filte
     for i, src in enumerate(inputs):
         dst = Path(output) if output else Path(out_dir) / (Path(src).stem + ".png")
         start = time.perf_counter()
+        if dst.suffix.lower() in (".pdf", ".dxf"):  # a vector copy, not a render
+            from vecfit.export import export
+            try:
+                export(Path(src), dst)
+            except VecfitError as e:
+                _echo_err(f"error: {e}")
+                sys.exit(EXIT_FAILED)
+            _echo_err(f"{src} -> {dst} ({time.perf_counter() - start:.2f} s)")
+            continue
         try:
             scene, without_torch = _scene_to_render(src)
             draw = render_numpy if without_torch else vecfit.render
@@ -224,7 +234,10 @@ def optimize_options(f):
     """Options shared by refine, trace and paint; each overrides the config's value."""
     options = [
         click.option("-o", "--output", type=click.Path(dir_okay=False),
-                     help="Output SVG (default: NAME.vecfit.svg next to the target)."),
+                     help="Output SVG, or PDF or DXF by its suffix (default: NAME.vecfit.svg next to the target)."),
+        click.option("--format", "output_format", type=click.Choice(["svg", "pdf", "dxf"]),
+                     help="Write the result as SVG, PDF (print) or DXF (plotters, cutters). "
+                          "[default: -o's suffix, else svg]"),
         click.option("--report", type=click.Path(dir_okay=False),
                      help="JSON report (default: the output's name + .report.json)."),
         click.option("--comparison", type=click.Path(dir_okay=False),
@@ -353,12 +366,45 @@ def _run_job(name, inputs, config, outputs, quiet):
         sys.exit(EXIT_INTERRUPTED)
 
 
+def _outputs(main, output, report, comparison, options, frames=None):
+    """The job's Outputs (vecfit.jobs.protocol), in the format asked (--format, or -o's
+    suffix); a format the name contradicts, or a place that cannot be written, is a usage
+    error said before any work."""
+    from vecfit.errors import VecfitError
+    from vecfit.jobs.protocol import Outputs
+
+    try:
+        outputs = Outputs.beside(main, output, report, comparison, frames, format=options.get("output_format"))
+    except VecfitError as e:
+        _echo_err(f"error: {e}")
+        sys.exit(EXIT_USAGE)
+    for path in (outputs.svg, outputs.report, outputs.comparison):
+        folder = path.parent
+        while not folder.exists() and folder != folder.parent:
+            folder = folder.parent
+        if path.is_dir() or not folder.is_dir() or not _can_write_in(folder):
+            _echo_err(f"error: {path}: cannot write there")
+            sys.exit(EXIT_USAGE)
+    return outputs
+
+
+def _can_write_in(folder) -> bool:
+    """Whether a file can be made in ``folder`` (tried: permissions alone do not say, for
+    root or a read-only file system)."""
+    import tempfile
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            return True
+    except OSError:
+        return False
+
+
 def _summarise(report) -> None:
     a, b = report["initial"], report["optimized"]
     _echo_err(f"PSNR {a['psnr']:.2f} -> {b['psnr']:.2f} dB, MSE {a['mse']:.5f} -> {b['mse']:.5f}, "
               f"SSIM {a['ssim']:.4f} -> {b['ssim']:.4f} "
               f"({report['iterations']} iterations, {report['seconds']['total']:.1f} s)")
-    click.echo(f"svg: {report['output']}")
+    click.echo(f"{report.get('format', 'svg')}: {report['output']}")
     click.echo(f"report: {report['report']}")
     click.echo(f"comparison: {report['comparison']}")
 
@@ -369,11 +415,11 @@ def _summarise(report) -> None:
 @optimize_options
 def refine(target, init_svg, output, report, comparison, config_file, quiet, **options):
     """Optimise INIT_SVG's control points, colours and stroke widths to match TARGET."""
-    from vecfit.jobs.protocol import Inputs, Outputs
+    from vecfit.jobs.protocol import Inputs
 
     config = _resolve_config("refine", None, config_file, options)
     inputs = Inputs(image=target, svg=init_svg)
-    _run_job("refine", inputs, config, Outputs.beside(inputs.main, output, report, comparison), quiet)
+    _run_job("refine", inputs, config, _outputs(inputs.main, output, report, comparison, options), quiet)
 
 
 
@@ -391,7 +437,7 @@ def refine(target, init_svg, output, report, comparison, config_file, quiet, **o
 def trace(target, preset, paths, colors, min_area, tolerance, refine, output, report, comparison,
           config_file, quiet, **options):
     """Trace TARGET into an SVG (colour regions fitted with cubic curves), then refine it."""
-    from vecfit.jobs.protocol import Inputs, Outputs
+    from vecfit.jobs.protocol import Inputs
 
     if not refine:
         options["iterations"] = 0  # the trace written as it is
@@ -400,7 +446,7 @@ def trace(target, preset, paths, colors, min_area, tolerance, refine, output, re
     if config["optimize"]["iterations"] > 0:
         _import_torch_holding_ctrl_c()  # (a trace written as it is needs no torch)
     inputs = Inputs(image=target)
-    _run_job("trace", inputs, config, Outputs.beside(inputs.main, output, report, comparison), quiet)
+    _run_job("trace", inputs, config, _outputs(inputs.main, output, report, comparison, options), quiet)
 
 
 @main.command()
@@ -415,12 +461,12 @@ def trace(target, preset, paths, colors, min_area, tolerance, refine, output, re
 def paint(target, paths, kind, preset, frames, output, report, comparison, config_file, quiet,
           **options):
     """Paint TARGET with random strokes or shapes fitted by gradient descent."""
-    from vecfit.jobs.protocol import Inputs, Outputs
+    from vecfit.jobs.protocol import Inputs
 
     config = _resolve_config("paint", preset, config_file, options,
                              extra={"paint": {"paths": paths, "kind": kind}})
     inputs = Inputs(image=target)
-    _run_job("paint", inputs, config, Outputs.beside(inputs.main, output, report, comparison, frames), quiet)
+    _run_job("paint", inputs, config, _outputs(inputs.main, output, report, comparison, options, frames), quiet)
 
 
 @main.command()
@@ -435,11 +481,11 @@ def edit(init_svg, edited, mask, output, report, comparison, config_file, quiet,
     parameters are fitted to EDITED, changing as little as possible outside the edit.
     Writes NAME.vecfit.svg (elements, ids and groups kept), a report and a comparison
     picture (original | edited | result | difference)."""
-    from vecfit.jobs.protocol import Inputs, Outputs
+    from vecfit.jobs.protocol import Inputs
 
     config = _resolve_config("edit", None, config_file, options)
     inputs = Inputs(image=edited, svg=init_svg, mask=mask)
-    _run_job("edit", inputs, config, Outputs.beside(inputs.main, output, report, comparison), quiet)
+    _run_job("edit", inputs, config, _outputs(inputs.main, output, report, comparison, options), quiet)
 
 @main.command()
 @click.argument("svg", type=click.Path(dir_okay=False))
@@ -454,14 +500,14 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
     group kept), a report and a comparison picture (input | plain scaling | retargeted).
     --iterations N sets the Adam iterations of the whole run, divided between the rounds
     and the final fit as configs/retarget.toml divides them."""
-    from vecfit.jobs.protocol import Inputs, Outputs
+    from vecfit.jobs.protocol import Inputs
 
     # --iterations is the whole run's: the job divides it between its rounds
     total, options["iterations"] = options["iterations"], None
     config = _resolve_config("retarget", None, config_file, options,
                              extra={"retarget": {"width": width, "height": height, "iterations": total}})
     inputs = Inputs(svg=svg)
-    _run_job("retarget", inputs, config, Outputs.beside(inputs.main, output, report, comparison), quiet)
+    _run_job("retarget", inputs, config, _outputs(inputs.main, output, report, comparison, options), quiet)
 
 
 # ------------------------------------------------------------------------------ batch
@@ -492,9 +538,11 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
               help="Run the images on this Dask distributed scheduler (needs the "
                    "'distributed' package; paths must be the same on the workers).")
 @click.option("--device", **DEVICE_OPTION)
+@click.option("--format", "output_format", type=click.Choice(["svg", "pdf", "dxf"]), default="svg",
+              show_default=True, help="Write each result as NAME.svg, NAME.pdf or NAME.dxf.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar or per-image lines.")
 def batch(in_dir, out_dir, mode, width, height, config_file, preset, effort, init_dir, jobs, threads,
-          resume, scheduler, device, quiet):
+          resume, scheduler, device, output_format, quiet):
     """Run refine, trace, paint or edit on every image in IN_DIR (*.png, *.jpg, *.jpeg,
     *.bmp, *.tif, *.tiff, *.webp; not recursive), or retarget on every SVG there (*.svg,
     *.svgz; --width and/or --height give the new size), writing NAME.svg, NAME.report.json and
@@ -521,7 +569,7 @@ def batch(in_dir, out_dir, mode, width, height, config_file, preset, effort, ini
             result = run_batch(in_dir, out_dir, mode, config_file=config_file, preset=preset,
                                effort=effort, jobs=jobs, threads=threads, resume=resume, init_dir=init_dir,
                                scheduler=scheduler, reporter=reporter, device=device,
-                               width=width, height=height)
+                               width=width, height=height, format=output_format)
         except BatchUsageError as e:
             _echo_err(f"error: {e}")
             sys.exit(EXIT_USAGE)

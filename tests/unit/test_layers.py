@@ -10,7 +10,7 @@ LAYERS = [
     ["vecfit.io"],                       # files, images, compositing
     ["vecfit.scene"],                    # the Scene and its geometry
     ["vecfit.renderer", "vecfit.svg"],   # drawing it; reading and writing it
-    ["vecfit.fitting", "vecfit.editing", "vecfit.initial"],
+    ["vecfit.fitting", "vecfit.editing", "vecfit.initial", "vecfit.export"],
     ["vecfit.jobs", "vecfit.pydiffvg"],
     ["vecfit.batch"],
     ["vecfit.cli", "vecfit", "vecfit.__main__"],  # the command line and the public API

@@ -60,7 +60,8 @@ class Task:
     torch_threads: int = 0     # > 0: torch.set_num_threads(this) before the job
 
     def outputs(self) -> Outputs:
-        return Outputs(Path(self.svg), Path(self.report), Path(self.comparison))
+        from vecfit.export import format_for
+        return Outputs(Path(self.svg), Path(self.report), Path(self.comparison), format=format_for(self.svg))
 
     def inputs(self) -> Inputs:
         if self.mode in ON_SVGS:  # the "image" is the SVG to work on
@@ -88,8 +89,8 @@ def find_svgs(folder: Path) -> list[Path]:
                   key=lambda p: p.name)
 
 
-def outputs_for(image: Path, out_dir: Path, name: str) -> Outputs:
-    return Outputs.beside(image, out_dir / f"{name}.svg")
+def outputs_for(image: Path, out_dir: Path, name: str, fmt: str = "svg") -> Outputs:
+    return Outputs.beside(image, out_dir / f"{name}.{fmt}")
 
 
 def empty_row(name: str, file: str, status: str, reason: str = "", init_svg=None) -> dict:
@@ -143,7 +144,7 @@ def finished_report(task: Task) -> dict | None:
     mse = (report.get("optimized") or {}).get("mse")
     if not isinstance(mse, (int, float)) or not math.isfinite(mse):
         return None
-    if not (out.svg.is_file() and out.comparison.is_file()):
+    if not (out.svg.is_file() and out.comparison.is_file()) or report.get("format", "svg") != out.format:
         return None
     if comparable(report["config"]) != comparable(task.config):
         return None
@@ -182,7 +183,7 @@ def svg_index(folder: Path) -> dict[str, list[Path]]:
 
 
 def make_plan(in_dir: Path, out_dir: Path, mode: str, config: dict, *, init_dir: Path | None = None,
-              resume: bool = True, job: str | None = None, torch_threads: int = 0) -> Plan:
+              resume: bool = True, job: str | None = None, torch_threads: int = 0, fmt: str = "svg") -> Plan:
     """The rows decided without running anything (unpaired, colliding names, finished)
     and the tasks left to run."""
     plan = Plan()
@@ -216,7 +217,7 @@ def make_plan(in_dir: Path, out_dir: Path, mode: str, config: dict, *, init_dir:
                     f"several SVGs for {image.name}: {', '.join(sorted(p.name for p in pairs))}")
                 continue
             init_svg = pairs[0]
-        out = outputs_for(image, out_dir, name)
+        out = outputs_for(image, out_dir, name, fmt)
         task = Task(name=name, file=image.name, mode=mode, image=str(image),
                     init_svg=None if init_svg is None else str(init_svg), svg=str(out.svg),
                     report=str(out.report), comparison=str(out.comparison),

@@ -61,7 +61,7 @@ def resolve_config(mode: str, preset: str | None = None, config_file=None, devic
 
 
 _TMP = re.compile(r"^\.(?P<name>.+)\.[A-Za-z0-9_]{8}\.tmp$")
-_OUR_SUFFIXES = (".svg", ".svgz", ".report.json", ".compare.png", *SUMMARY_FILES)
+_OUR_SUFFIXES = (".svg", ".svgz", ".pdf", ".dxf", ".report.json", ".compare.png", *SUMMARY_FILES)
 
 
 def remove_stale_temporaries(out_dir: Path) -> list[Path]:
@@ -120,7 +120,7 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
               jobs: int = 1, threads: int | None = None, resume: bool = True, init_dir=None,
               scheduler: str | None = None, client=None, job: str | None = None,
               reporter=None, device: str | None = None, width: str | None = None,
-              height: str | None = None, effort: str | None = None) -> BatchResult:
+              height: str | None = None, effort: str | None = None, format: str = "svg") -> BatchResult:
     """Runs ``mode`` (refine, trace, paint, edit) on every image directly in ``in_dir``, or
     retarget on every SVG there (to ``width`` and/or ``height``: pixels or a percentage), writing
     NAME.svg, NAME.report.json and NAME.compare.png per image and the summary into
@@ -136,6 +136,7 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
     device: where pixels are shaded (auto, cpu, cuda[:N]; default: the config's).
     effort: every image's effort, quick, normal or best (configs/: the mode's [efforts]
     tables; default: the config file's, else normal).
+    format: what each result is written as, svg, pdf or dxf (NAME.svg, NAME.pdf, NAME.dxf).
 
     Raises BatchUsageError before any work when the run cannot start."""
     started = time.time()
@@ -161,6 +162,8 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
         raise BatchUsageError("--width and --height are for --mode retarget")
     if mode == "retarget" and not size:
         raise BatchUsageError("--mode retarget needs --width (and/or --height)")
+    if format not in ("svg", "pdf", "dxf"):
+        raise BatchUsageError(f"unknown output format {format!r} (svg, pdf or dxf)")
     if jobs < 0 or (threads is not None and threads < 1):
         raise BatchUsageError("jobs must be >= 0 and threads >= 1")
     config = resolve_config(mode, preset, config_file, device, size, effort)
@@ -177,7 +180,7 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
 
     with _Lock(out_dir):
         remove_stale_temporaries(out_dir)
-        plan = make_plan(in_dir, out_dir, mode, config, init_dir=init_dir, resume=resume, job=job)
+        plan = make_plan(in_dir, out_dir, mode, config, init_dir=init_dir, resume=resume, job=job, fmt=format)
         cores = available_cores()
         if client is not None:
             workers, per_worker = 0, threads or 1

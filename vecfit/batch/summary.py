@@ -167,7 +167,8 @@ def write_html(path: Path, meta: dict, rows: list[dict]) -> None:
     for row in rows:
         thumbs = row.get("thumbs") or {}
         links = [_link(row[k], label) for k, label in
-                 (("svg", "SVG"), ("comparison", "comparison"), ("report", "report")) if row.get(k)]
+                 (("svg", Path(row.get("svg") or "x.svg").suffix[1:].upper()),  # SVG, PDF or DXF
+                  ("comparison", "comparison"), ("report", "report")) if row.get(k)]
         reason = row.get("reason") or ""
         if row.get("warnings"):
             reason = "; ".join(filter(None, [reason, *row["warnings"]]))

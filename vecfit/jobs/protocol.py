@@ -64,12 +64,15 @@ class Inputs:
 @dataclass
 class Outputs:
     """The files a job writes; None writes nothing there (the Python API writes nothing
-    unless asked). ``text`` is set by the job: the SVG it wrote, or would have written."""
+    unless asked). ``text`` is set by the job: the SVG it wrote, or would have written.
+    ``format``: what ``svg`` is written as, svg, pdf or dxf (vecfit/export/); ``text``
+    is the SVG whatever the format."""
     svg: Path | None
     report: Path | None
     comparison: Path | None
     frames: Path | None = None  # paint: a folder for frame_NNNNN.png and a GIF
     text: str | None = None
+    format: str = "svg"
 
     @classmethod
     def nowhere(cls) -> "Outputs":
@@ -77,8 +80,11 @@ class Outputs:
 
     def names(self) -> dict:
         """The report's entries naming the outputs (None where nothing is written)."""
-        return {key: None if path is None else str(path)
-                for key, path in (("output", self.svg), ("comparison", self.comparison), ("report", self.report))}
+        names = {key: None if path is None else str(path)
+                 for key, path in (("output", self.svg), ("comparison", self.comparison), ("report", self.report))}
+        if self.format != "svg":  # (an SVG's report stays as it was)
+            names["format"] = self.format
+        return names
 
     def forget_report(self) -> None:
         """The report marks a finished run: an old one must not sit beside new outputs if
@@ -87,23 +93,34 @@ class Outputs:
             self.report.unlink(missing_ok=True)
 
     def keep_svg(self, payload: bytes) -> None:
-        """The job's SVG (UTF-8 bytes): kept as ``text``, and written where asked."""
+        """The job's SVG (UTF-8 bytes): kept as ``text``, and written where asked, as SVG
+        or converted to ``format``."""
         from vecfit.svg.write import write_bytes
         self.text = payload.decode("utf-8")
-        if self.svg is not None:
+        if self.svg is None:
+            return
+        if self.format == "svg":
             write_bytes(self.svg, payload)
+        else:
+            from vecfit import export
+            export.write(self.svg, export.svg_to(payload, self.format))
 
     @classmethod
     def beside(cls, main: Path, svg: Path | None = None, report: Path | None = None,
-               comparison: Path | None = None, frames: Path | None = None) -> "Outputs":
+               comparison: Path | None = None, frames: Path | None = None,
+               format: str | None = None) -> "Outputs":
         """Defaults: NAME.vecfit.svg next to ``main`` (the input outputs are named after);
-        the report and the picture take the SVG's name with .report.json and .compare.png."""
+        the report and the picture take the SVG's name with .report.json and .compare.png.
+        ``format`` (svg, pdf, dxf; default: the output's suffix, else svg) names the
+        default NAME.vecfit.pdf or .dxf; an output named for another format is refused."""
+        from vecfit.export import SUFFIXES, format_for
         main = Path(main)
-        svg = Path(svg) if svg else main.with_name(main.stem + ".vecfit.svg")
-        stem = svg.with_suffix("") if svg.suffix.lower() in (".svg", ".svgz") else svg
+        fmt = format_for(svg, format)
+        svg = Path(svg) if svg else main.with_name(main.stem + f".vecfit.{fmt}")
+        stem = svg.with_suffix("") if svg.suffix.lower() in SUFFIXES else svg
         return cls(svg, Path(report) if report else stem.with_name(stem.name + ".report.json"),
                    Path(comparison) if comparison else stem.with_name(stem.name + ".compare.png"),
-                   None if frames is None else Path(frames))
+                   None if frames is None else Path(frames), format=fmt)
 
     def check_against(self, inputs: Inputs) -> None:
         """Refuses outputs that would overwrite an input or each other."""
