@@ -12,7 +12,10 @@ Scenes (a 64-unit canvas rendered at 64 px; --samples N: N x N samples per pixel
             gradient fill and stroke-width 1e7 (the fuzzer's failing case);
   across    N cubics whose control points are spread over the whole canvas (each
             segment crosses every row of tiles: the worst case, where a segment reaches
-            most pixels), filled.
+            most pixels), filled;
+  canvas    issue 41's case: N cubics spread over a 200-unit canvas (viewBox) drawn at
+            64 px, filled and stroked 2 units wide (run the analytical mode with
+            --samples 1, as the issue does).
 The paths are built as Scenes (300,000 segments is over the SVG reader's limit). Each row:
 the median wall time over --repeats of `vecfit.render` (forward: packing included) and
 of the backward pass of a random image adjoint into every point (backward), and each
@@ -30,6 +33,7 @@ import warnings
 from contextlib import contextmanager
 
 import common  # noqa: F401  (OMP_WAIT_POLICY before torch)
+from machine import machine_unit
 
 import numpy as np
 import torch
@@ -43,18 +47,21 @@ TEMPLATES = {
     "wide": ('<defs><linearGradient id="g"><stop offset="0" stop-color="red"/><stop offset="1" stop-color="blue"/>'
              '</linearGradient></defs><path d="M 0 0 L 1 1 Z" fill="url(#g)" stroke="green" stroke-width="1e7"/>'),
     "across": '<path d="M 0 0 L 1 1 Z" fill="#3a6" fill-rule="evenodd"/>',
+    "canvas": '<path d="M 0 0 L 1 1 Z" fill="#3a6" stroke="#123" stroke-width="2"/>',
 }
+SPAN = {"canvas": 200.0}  # user units the control points spread over (others: the 64 px canvas)
 
 
 def geometry(kind: str, n: int, seed: int = 0) -> Path:
     rng = random.Random(seed)
     degrees = np.array([3] * n if kind != "wide" else [(1, 2, 3)[i % 3] for i in range(n)], dtype=np.int64)
-    step = {"walk": 2.0, "wide": 6.0, "across": None}[kind]
-    x = y = 32.0
+    step = {"walk": 2.0, "wide": 6.0, "across": None, "canvas": None}[kind]
+    span = SPAN.get(kind, 64.0)
+    x = y = span / 2
     pts = [(x, y)]
     for _ in range(int(degrees.sum()) - 1):  # closed: the last segment ends at the start
         if step is None:
-            x, y = rng.uniform(0, 64), rng.uniform(0, 64)
+            x, y = rng.uniform(0, span), rng.uniform(0, span)
         else:
             x = min(max(x + rng.uniform(-step, step), 0.0), 64.0)
             y = min(max(y + rng.uniform(-step, step), 0.0), 64.0)
@@ -64,7 +71,8 @@ def geometry(kind: str, n: int, seed: int = 0) -> Path:
 
 def scene_of(kind: str, n: int, tmp) -> vecfit.Scene:
     svg = tmp / f"{kind}.svg"
-    svg.write_text(f'<svg {NS} width="64" height="64">{TEMPLATES[kind]}</svg>')
+    span = SPAN.get(kind, 64.0)
+    svg.write_text(f'<svg {NS} width="64" height="64" viewBox="0 0 {span:g} {span:g}">{TEMPLATES[kind]}</svg>')
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         scene = vecfit.load_svg(svg)
@@ -133,8 +141,10 @@ def main():
     parser.add_argument("--budget", type=float, default=120.0, help="seconds a pass may take")
     a = parser.parse_args()
     sizes = [int(s) for s in a.sizes.split(",")]
+    unit = machine_unit()
+    print(f"machine unit R = {unit:.4f} s (benchmarks/machine.py)")
     print(f"{'path':7} {'segments':>9} {'mode':9} {'forward s':>10} {'backward s':>11} {'fwd us/seg':>11} "
-          f"{'bwd us/seg':>11}")
+          f"{'bwd us/seg':>11} {'forward R':>10} {'backward R':>11}")
     cell = lambda v, w: f"{v:{w}.3f}" if v is not None else f"{'>' + format(a.budget, 'g'):>{w}}"  # noqa: E731
     per = lambda v, n, w: f"{1e6 * v / n:{w}.2f}" if v is not None else f"{'-':>{w}}"  # noqa: E731
     with tempfile.TemporaryDirectory() as tmp:
@@ -149,8 +159,9 @@ def main():
                     scene = scene_of(kind, n, FsPath(tmp))
                     fwd, bwd = timed(scene, mode, a.samples, a.threads, a.repeats, a.budget)
                     over = fwd is None or bwd is None
+                    in_r = lambda v, w: f"{v / unit:{w}.2f}" if v is not None else f"{'-':>{w}}"  # noqa: E731
                     print(f"{kind:7} {n:9} {mode:9} {cell(fwd, 10)} {cell(bwd, 11)} {per(fwd, n, 11)} "
-                          f"{per(bwd, n, 11)}", flush=True)
+                          f"{per(bwd, n, 11)} {in_r(fwd, 10)} {in_r(bwd, 11)}", flush=True)
 
 
 if __name__ == "__main__":
