@@ -154,6 +154,8 @@ class ClipPath:
     units: str = "userSpaceOnUse"           # or "objectBoundingBox"
     clip: Optional["ClipPath"] = None        # a clip-path on the <clipPath> itself
     source: Any = None                      # the <clipPath> element's id or handle
+    viewport: bool = False                  # the reader's own clip of a nested <svg>'s viewport:
+                                            # no element of the file, so never optimised
 
 
 @dataclass
@@ -270,13 +272,14 @@ class Scene:
         return any(x.clip is not None or x.mask is not None or x.filter is not None or x.blend != "normal"
                    for x in (*self.shapes, *self.groups))
 
-    def effect_contents(self) -> list[tuple["Scene", bool]]:
+    def effect_contents(self, viewports: bool = True) -> list[tuple["Scene", bool]]:
         """(content, is a clip) of every distinct clip and mask, nested ones included,
-        each once."""
+        each once (without the viewport clips of nested <svg> elements if not
+        ``viewports``)."""
         out, seen = [], set()
 
         def visit(effect):
-            if effect is None or id(effect) in seen:
+            if effect is None or id(effect) in seen or (not viewports and getattr(effect, "viewport", False)):
                 return
             seen.add(id(effect))
             out.append((effect.content, isinstance(effect, ClipPath)))
@@ -355,7 +358,7 @@ class Scene:
             add("transforms", group.transform)
         # What clips and masks draw is optimised with the rest (a clip's paints and
         # opacities do not show, so only its geometry and transforms are offered).
-        for content, clip_only in (self.effect_contents() if _nested else ()):
+        for content, clip_only in (self.effect_contents(viewports=False) if _nested else ()):
             for kind, tensors in content.parameters(_nested=False).items():
                 if clip_only and kind not in ("points", "radii", "transforms"):
                     continue

@@ -334,7 +334,7 @@ class Reader:
         rect = Shape(geometry=Rect(p_min=arrays.zeros(2), p_max=lim.tensor(np.array([width, height]))),
                      fill=solid(BLACK))
         view = arrays.identity() if inverse_view is None else lim.tensor(np.asarray(inverse_view))
-        return ClipPath(content=Scene(width=self.width, height=self.height, shapes=[rect], view=view))
+        return ClipPath(content=Scene(width=self.width, height=self.height, shapes=[rect], view=view), viewport=True)
 
     def _group(self, transform, opacity, parent, element, effects=None) -> int:
         lim = Limiter()

@@ -237,8 +237,10 @@ def svg_bytes(scene: Scene, document, *, full: bool = False, background=None,
 
     done: set = set()
     for shape, orig, places in zip(shapes, shapes_before, decimals):
-        if shape.source in done:
-            continue  # <use> instances of an element already written
+        if shape.source is None or shape.source in done:
+            # (None: a shape of the reader's own, not of the file: the viewport clip of a
+            # nested <svg>; <use> instances of an element already written)
+            continue
         if writer.shape(shape, orig, places):
             done.add(shape.source)
     if writer.averaged:
@@ -247,7 +249,7 @@ def svg_bytes(scene: Scene, document, *, full: bool = False, background=None,
                       f"written with the mean of their widths as stroke-width", VecfitWarning, stacklevel=3)
     done = set()
     for group, orig in zip(groups, groups_before):
-        if group.source in done:
+        if group.source is None or group.source in done:
             continue
         if writer.group(group, orig):
             done.add(group.source)

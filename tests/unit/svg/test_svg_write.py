@@ -487,3 +487,25 @@ def test_use_instances_and_transforms(tmp_path):
     assert _element(out, "g").get("transform") == "matrix(1 0 0 1 0 4)"
     b = quiet_load(out)
     assert_scenes_equal(scene, b)
+
+
+def test_a_nested_svg_is_written_back_and_its_viewport_clip_is_not_optimised(tmp_path):
+    """A nested <svg> clips to its viewport with a rect of the reader's own (no element
+    of the file): it is neither offered to the optimiser nor looked for in the file (the
+    fuzzer's third campaign: every refine of such a file failed with 'no element None')."""
+    src = tmp_path / "nested.svg"
+    src.write_text(f'<svg xmlns="{SVG_NS}" width="32" height="32"><rect width="32" height="32" fill="#888"/>'
+                   '<svg x="4" y="4" width="20" height="20" viewBox="0 0 10 10">'
+                   '<circle cx="5" cy="5" r="6" fill="red"/></svg></svg>')
+    scene = quiet_load(src)
+    viewport_rect = [s for content, _ in scene.effect_contents() for s in content.shapes]
+    assert len(viewport_rect) == 1 and viewport_rect[0].source is None
+    offered = {id(t) for ts in scene.parameters().values() for t in ts}
+    assert id(viewport_rect[0].geometry.p_max) not in offered
+    with torch.no_grad():
+        scene.shapes[-1].geometry.center += 1.0  # the circle moved
+    out = tmp_path / "out.svg"
+    quiet_write(scene, src, out)
+    circle = [e for e in ET.parse(out).getroot().iter(f"{{{SVG_NS}}}circle")][0]
+    assert (float(circle.get("cx")), float(circle.get("cy"))) == (6.0, 6.0)
+    assert len(list(ET.parse(out).getroot().iter(f"{{{SVG_NS}}}svg"))) == 2
