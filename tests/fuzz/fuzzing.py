@@ -14,7 +14,11 @@ and retarget, and renders under 7 px on a side; hundreds to thousands of tiny sh
 or refined). Clip paths, masks and filters (issue 27): references to themselves, to each
 other in a loop, to nothing; masks and clips nested up to 1,000 deep; huge, zero and
 negative deviations, regions of zero area, offsets past the canvas, unknown steps;
-rendered, refined and listed by info. The cases run in a worker
+rendered, refined and listed by info. Families of the third campaign (issue 41): images as
+cameras and other programs write them (every EXIF orientation, broken EXIF, 16-bit,
+palette, CMYK, WebP, TIFF, animated GIF, 1 x N, truncated, empty) through every job that
+reads an image; outputs as PDF and DXF (by name or --format, some contradictory) from
+jobs and render, each checked complete. The cases run in a worker
 process that imports vecfit once and calls the command line's main in-process (click's
 runner): starting a Python that imports torch costs 1-2 s a case. The worker is killed
 and restarted after a signal or a time-out, which are recorded as failures.
@@ -457,6 +461,78 @@ def effects_svg(rng: random.Random) -> bytes:
 
 # ------------------------------------------------------------------------------ cases
 
+# ------------------------------------------------- families from the third campaign
+
+def format_image(rng: random.Random) -> tuple[str, bytes]:
+    """(file name, bytes) of an image in a format or layout a camera, a scanner or another
+    program writes (issue 41): every EXIF orientation and broken EXIF (JPEG and PNG's
+    eXIf), 16-bit, palette with a transparent index, CMYK, WebP, TIFF, animated GIF,
+    1 x N pixels; some truncated or empty."""
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    photo = Image.open(ROOT / "examples" / "chelsea.png").convert("RGB").resize((36, 24))
+    kind = rng.randrange(12)
+
+    def saved(im, fmt, **kw):
+        buf = io.BytesIO()
+        im.save(buf, format=fmt, **kw)
+        return buf.getvalue()
+
+    if kind <= 1:  # an EXIF orientation, 1 to 8 or out of range
+        exif = Image.Exif()
+        exif[0x0112] = rng.choice([1, 2, 3, 4, 5, 6, 7, 8, 0, 9, 65535])
+        fmt = "JPEG" if kind == 0 else "PNG"
+        name, data = f"oriented.{fmt.lower()}", saved(photo, fmt, exif=exif.tobytes())
+    elif kind == 2:  # EXIF that is not EXIF
+        junk = bytes(rng.randrange(256) for _ in range(rng.choice([0, 3, 16, 200])))
+        fmt = rng.choice(["JPEG", "PNG"])
+        name, data = f"badexif.{fmt.lower()}", saved(photo, fmt, exif=rng.choice([b"Exif\x00\x00", b"MM\x00*"]) + junk)
+    elif kind == 3:
+        a = np.asarray(photo).astype(np.uint16) * 257
+        name, data = "deep.png", saved(Image.fromarray(a[..., 0]), "PNG")  # 16-bit grey
+    elif kind == 4:
+        im = photo.convert("P", palette=Image.Palette.ADAPTIVE, colors=rng.choice([2, 16, 256]))
+        name, data = "indexed.png", saved(im, "PNG", transparency=rng.randrange(2))
+    elif kind == 5:
+        name, data = "cmyk.jpg", saved(photo.convert("CMYK"), "JPEG")
+    elif kind == 6:
+        im = photo.convert("RGBA") if rng.random() < 0.5 else photo
+        name, data = "photo.webp", saved(im, "WEBP", lossless=rng.random() < 0.5)
+    elif kind == 7:
+        im = rng.choice([photo, photo.convert("RGBA"), photo.convert("CMYK"), photo.convert("I;16")])
+        name, data = "scan.tiff", saved(im, "TIFF")
+    elif kind == 8:
+        frames = [photo, photo.transpose(Image.Transpose.FLIP_LEFT_RIGHT), Image.new("RGB", (36, 24), "red")]
+        name, data = "moving.gif", saved(frames[0], "GIF", save_all=True, append_images=frames[1:], duration=50, loop=0)
+    elif kind == 9:
+        w, h = (1, rng.choice([1, 2, 50, 300])) if rng.random() < 0.5 else (rng.choice([2, 50, 300]), 1)
+        name, data = "line.png", saved(photo.resize((w, h)), "PNG")
+    elif kind == 10:
+        name, data = rng.choice(["empty.webp", "empty.tiff", "empty.gif", "empty.jpg"]), b""
+    else:
+        name, data = "clear.webp", saved(Image.new("RGBA", (20, 20), (0, 0, 0, 0)), "WEBP", lossless=True)
+    if kind < 10 and rng.random() < 0.15:
+        data = data[:rng.randrange(1, max(2, len(data)))]
+    return name, data
+
+
+def output_format_args(rng: random.Random) -> tuple[list[str], list[str]]:
+    """An output in SVG, PDF or DXF, by name or by --format (issue 38), with the files the
+    command may write; some contradictory (a usage error, nothing written)."""
+    fmt = rng.choice(["svg", "pdf", "dxf"])
+    how = rng.random()
+    if how < 0.45:
+        args = ["-o", f"out.{fmt}"]
+    elif how < 0.9:
+        args = ["-o", "out", "--format", fmt] if rng.random() < 0.5 else ["--format", fmt, "-o", f"out.{fmt}"]
+    else:
+        args = ["-o", "out.svg", "--format", rng.choice(["pdf", "dxf"])]
+    return args, ["out.svg", "out.pdf", "out.dxf", "out", "out.report.json", "out.compare.png"]
+
+
 @dataclass
 class Case:
     index: int
@@ -472,6 +548,9 @@ def make_case(seed: int, index: int, seeds: list[Path] | None = None) -> Case:
     rng = random.Random(f"{seed}:{index}")
     seeds = seeds if seeds is not None else _seed_files()
     roll = rng.random()
+    if roll < 0.1:  # images as cameras and other programs write them; outputs as PDF and DXF
+        return _third_campaign_case(rng, index)
+    roll = (roll - 0.1) / 0.9  # (the older families keep their shares)
     if roll < 0.12:  # an image through refine / trace / paint, a few iterations
         name, data = image_case(rng)
         command = rng.choice(["refine", "trace", "paint"])
@@ -576,6 +655,39 @@ def make_case(seed: int, index: int, seeds: list[Path] | None = None) -> Case:
                 outputs=["out.png"])
 
 
+def _third_campaign_case(rng: random.Random, index: int) -> Case:
+    if rng.random() < 0.6:  # an image format through every job that reads an image
+        name, data = format_image(rng)
+        command = rng.choice(["refine", "trace", "trace", "paint", "edit"])
+        files = {name: data, "init.svg": (f'<svg {NS} viewBox="0 0 36 24"><rect width="36" height="24" fill="#888"/>'
+                                          f'<circle cx="12" cy="12" r="8" fill="red"/></svg>').encode()}
+        args = {"refine": ["refine", name, "init.svg"], "trace": ["trace", name, "--paths", "6"],
+                "paint": ["paint", name, "--paths", "4"], "edit": ["edit", "init.svg", name]}[command]
+        args += ["-o", "out.svg", "--iterations", str(rng.choice([0, 2])), "--max-size", "48", "-q",
+                 "--samples", "1", "--threads", "1"]
+        return Case(index, "formats", command, args, files, timeout=60,
+                    outputs=["out.svg", "out.report.json", "out.compare.png"])
+    # an output format: a job's result, or render's conversion, of a hostile SVG
+    out_args, outputs = output_format_args(rng)
+    import io
+
+    import numpy as np
+    from PIL import Image
+    buf = io.BytesIO()
+    Image.fromarray((np.random.default_rng(index).random((24, 24, 3)) * 255).astype(np.uint8)).save(buf, "PNG")
+    svg = rng.choice([grammar_svg, effects_svg, dashed_svg])(rng)
+    svg = re.sub(rb"\b(nan|inf|infinity)\b", b"1e39", svg, flags=re.I)
+    command = rng.choice(["trace", "refine", "render"])
+    if command == "render":
+        fmt = rng.choice(["pdf", "dxf"])
+        return Case(index, "outputs", "render", ["render", "in.svg", "-o", f"out.{fmt}"], {"in.svg": svg},
+                    timeout=30, outputs=[f"out.{fmt}"])
+    args = (["trace", "target.png", "--paths", "5"] if command == "trace" else ["refine", "target.png", "in.svg"])
+    args += [*out_args, "--iterations", str(rng.choice([0, 2])), "-q", "--samples", "1", "--threads", "1"]
+    return Case(index, "outputs", command, args, {"target.png": buf.getvalue(), "in.svg": svg},
+                timeout=60, outputs=outputs)
+
+
 # ----------------------------------------------------------------------------- oracle
 
 def verdict(case: Case, folder: Path, outcome: dict) -> str | None:
@@ -598,13 +710,17 @@ def verdict(case: Case, folder: Path, outcome: dict) -> str | None:
     stray = [n for n in names if n.endswith(".tmp") or n.startswith(".")]
     if stray:
         return f"left behind: {', '.join(sorted(stray))}"
+    results = [n for n in case.outputs if not n.endswith((".report.json", ".compare.png"))]
+    if code == 0 and results and not any((folder / n).exists() for n in results):
+        return f"exit 0 but no {' or '.join(results)}"
     for name in case.outputs:
         path = folder / name
         if not path.exists():
-            if code == 0 and name in ("out.png", "out.svg"):
-                return f"exit 0 but no {name}"
             continue
-        if name.endswith(".svg"):
+        head = path.read_bytes()[:64].lstrip()
+        kind = (".pdf" if head.startswith(b"%PDF-") else ".svg" if head.startswith((b"<", b"\xef\xbb\xbf<"))
+                else ".dxf") if name == "out" else path.suffix  # (an output named without a suffix)
+        if kind == ".svg":
             text = path.read_text(encoding="utf-8", errors="replace")
             if not text.rstrip().endswith("</svg>"):
                 return f"{name} is not a complete SVG"
@@ -615,7 +731,13 @@ def verdict(case: Case, folder: Path, outcome: dict) -> str | None:
                         for file, data in case.files.items() if file.endswith(".svg"))
             if found > given:
                 return f"{name} has nan or inf in it"
-        elif name.endswith(".png"):
+        elif kind == ".pdf":
+            if not path.read_bytes().rstrip().endswith(b"%%EOF"):
+                return f"{name} is not a complete PDF"
+        elif kind == ".dxf":
+            if not path.read_bytes().rstrip().endswith(b"EOF"):
+                return f"{name} is not a complete DXF"
+        elif kind == ".png":
             from PIL import Image
             try:
                 with Image.open(path) as im:
