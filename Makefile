@@ -49,7 +49,8 @@ SANITIZE_TESTS := tests/unit/renderer/test_render_basics.py tests/unit/renderer/
 	tests/unit/renderer/test_point_widths.py tests/oracles/test_golden.py tests/oracles/test_conformance.py \
 	tests/fuzz/test_hostile.py tests/fuzz/test_fuzz.py tests/unit/renderer/test_long_paths.py \
 	tests/unit/pydiffvg/test_pydiffvg_scripts.py tests/unit/initial/test_tracer_merge.py \
-	tests/unit/initial/test_tracer_fit.py tests/unit/initial/test_tracer_subpixel.py
+	tests/unit/initial/test_tracer_fit.py tests/unit/initial/test_tracer_subpixel.py \
+	tests/oracles/test_fig9.py tests/oracles/test_filter_radius.py
 sanitize: install
 	$(PY) -m pip install -q pybind11
 	cmake -S . -B $(SANITIZE_BUILD) -DVECFIT_SANITIZE=ON -DCMAKE_BUILD_TYPE=Release \
