@@ -30,6 +30,8 @@ from vecfit.svg.precision import shape_decimals
 from vecfit.svg.stats import design_stats
 from vecfit.svg.write import svg_bytes
 
+from vecfit.palette import colour_entry, parse_palette
+
 from .config import output_precision
 from .protocol import Outputs, listener
 
@@ -138,14 +140,16 @@ def cut_crossed_outlines(scene: Scene, keep: set, config: dict, pixels=None) -> 
 
 def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, config: dict, outputs: Outputs,
                   progress=None, inputs: dict | None = None, hooks=(), keep_alpha=(),
-                  generated: bool = False) -> dict:
+                  generated: bool = False, drop_background: bool = False) -> dict:
     """Optimise ``scene`` (read from ``document``) against ``target`` with the
     ``[optimize]`` settings of ``config``; writes the SVG, the comparison picture and the
     report (last, so a report means a finished run). Returns the report. ``inputs`` are
     extra report entries (a callable value is called when the report is made); ``hooks``
     and ``keep_alpha`` go to the optimisation loop. ``generated``: the Scene is vecfit's own
     (a trace, random strokes), so under ``optimize.alpha = "auto"`` its colours start
-    opaque unless the target has translucent areas (vecfit/fitting/opacity.py)."""
+    opaque unless the target has translucent areas (vecfit/fitting/opacity.py).
+    ``drop_background``: the background is not written (trace --remove-background: the
+    shapes were fitted over it as over transparency)."""
     started = time.perf_counter()
     progress = listener(progress)
     # The report marks a finished run: an old one must not sit beside new outputs if this
@@ -154,6 +158,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     # "auto" settled once, for the loop, the full-size renders and the report alike
     opt = {**config["optimize"], "device": devices.device_name(devices.resolve(config["optimize"]["device"]))}
     background = background_for(target, opt["background"])
+    palette = parse_palette(opt.get("palette"))
     h, w = target.shape[:2]
     small = downscaled(target, opt["max_size"])
     sh, sw = small.shape[:2]
@@ -178,7 +183,14 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         if generated and settings.alpha == "auto" and not goal.wants_translucency:
             make_opaque(scene)
         progress.start(settings.iterations)
-        result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
+        if palette is None:
+            result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
+        else:  # every paint ends on the palette (vecfit/palette.py)
+            from vecfit.fitting.opacity import has_translucent_areas
+            from vecfit.palette import optimize_on_palette
+            translucent = background is None and has_translucent_areas(small[..., 3])
+            result, _ = optimize_on_palette(scene, goal, settings, palette, progress=progress, hooks=hooks,
+                                            keep_alpha=keep_alpha, translucent=translucent)
     else:
         progress.start(0)
         result = _not_optimised(scene, opt)
@@ -195,9 +207,15 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     # The SVG must look like what was optimised: where the shapes leave the canvas
     # uncovered, the background is written in as a first rect.
     covered = float(final_image[..., 3].min()) >= OPAQUE
-    svg_background = background if background is not None and not covered else None
+    svg_background = background if background is not None and not covered and not drop_background else None
     written = svg_bytes(scene, document, background=svg_background, precision=output_precision(config),
                         pixels=(w, h))
+    layers = None
+    if config["output"].get("group_by", "none") != "none":
+        from vecfit.svg.layers import group_by_colour
+        written, layers = group_by_colour(written)
+        for line in layers["warnings"]:
+            warnings.warn(line)
     outputs.keep_svg(written)
     if outputs.comparison is not None:
         save_comparison(outputs.comparison, target_rgb, initial_rgb, final_rgb)
@@ -227,6 +245,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         "shapes": len(scene.shapes),
         "untangled_outlines": untangled,  # outlines the fit made cross themselves, cut into simple loops
         "file": design_stats(written),  # what a designer finds in the SVG written
+        **({} if palette is None and layers is None else {"colours": colour_entry(written, palette, layers)}),
         "parameters": {**result.parameters, "total": sum(result.parameters.values())},
         "loss": opt["loss"],
         "loss_curve": result.losses,
