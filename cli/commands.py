@@ -258,7 +258,7 @@ def optimize_options(f):
 
 
 def colour_options(f):
-    """--palette and --group-by: trace, refine, paint (vecfit/palette.py, vecfit/svg/layers.py)."""
+    """--palette and --group-by: trace, refine, paint (vecfit/jobs/palette.py, vecfit/svg/layers.py)."""
     f = click.option("--group-by", "group_by", type=click.Choice(["none", "colour", "color"]),
                      help="colour: one <g> (an Inkscape layer) per colour, in stacking order.")(f)
     return click.option("--palette", metavar="COLOURS|FILE|auto:N",
@@ -507,9 +507,11 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
               help="Run the images on this Dask distributed scheduler (needs the "
                    "'distributed' package; paths must be the same on the workers).")
 @click.option("--device", **DEVICE_OPTION)
+@click.option("--remove-background", is_flag=True, help="trace: leave the border's flat colour out.")
+@colour_options
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar or per-image lines.")
 def batch(in_dir, out_dir, mode, width, height, config_file, preset, effort, init_dir, jobs, threads,
-          resume, scheduler, device, quiet):
+          resume, scheduler, device, remove_background, palette, group_by, quiet):
     """Run refine, trace, paint or edit on every image in IN_DIR (*.png, *.jpg, *.jpeg,
     *.bmp, *.tif, *.tiff, *.webp; not recursive), or retarget on every SVG there (*.svg,
     *.svgz; --width and/or --height give the new size), writing NAME.svg, NAME.report.json and
@@ -536,7 +538,8 @@ def batch(in_dir, out_dir, mode, width, height, config_file, preset, effort, ini
             result = run_batch(in_dir, out_dir, mode, config_file=config_file, preset=preset,
                                effort=effort, jobs=jobs, threads=threads, resume=resume, init_dir=init_dir,
                                scheduler=scheduler, reporter=reporter, device=device,
-                               width=width, height=height)
+                               width=width, height=height, palette=palette, group_by=group_by,
+                               remove_background=remove_background)
         except BatchUsageError as e:
             _echo_err(f"error: {e}")
             sys.exit(EXIT_USAGE)

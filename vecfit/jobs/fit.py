@@ -30,7 +30,7 @@ from vecfit.svg.precision import shape_decimals
 from vecfit.svg.stats import design_stats
 from vecfit.svg.write import svg_bytes
 
-from vecfit.palette import colour_entry, parse_palette
+from .palette import colour_entry, nearest_colour, parse_palette
 
 from .config import output_precision
 from .protocol import Outputs, listener
@@ -159,6 +159,8 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     opt = {**config["optimize"], "device": devices.device_name(devices.resolve(config["optimize"]["device"]))}
     background = background_for(target, opt["background"])
     palette = parse_palette(opt.get("palette"))
+    if palette is not None and palette.auto is None:  # a background written in is a paint too
+        background = nearest_colour(background, palette.rgb)
     h, w = target.shape[:2]
     small = downscaled(target, opt["max_size"])
     sh, sw = small.shape[:2]
@@ -185,12 +187,13 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         progress.start(settings.iterations)
         if palette is None:
             result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
-        else:  # every paint ends on the palette (vecfit/palette.py)
+        else:  # every paint ends on the palette (vecfit/jobs/palette.py)
             from vecfit.fitting.opacity import has_translucent_areas
-            from vecfit.palette import optimize_on_palette
+            from .palette import optimize_on_palette
             translucent = background is None and has_translucent_areas(small[..., 3])
-            result, _ = optimize_on_palette(scene, goal, settings, palette, progress=progress, hooks=hooks,
-                                            keep_alpha=keep_alpha, translucent=translucent)
+            result, used = optimize_on_palette(scene, goal, settings, palette, progress=progress, hooks=hooks,
+                                               keep_alpha=keep_alpha, translucent=translucent)
+            background = nearest_colour(background, used / 255.0)  # auto:N's: one of the N
     else:
         progress.start(0)
         result = _not_optimised(scene, opt)

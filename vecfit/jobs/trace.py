@@ -13,7 +13,7 @@ from vecfit.scene import Rect, Solid
 from vecfit.scene.arrays import numpy_arrays
 from vecfit.initial.tracer.background import border_colour, without_background
 from vecfit.io.colors import fitting_background
-from vecfit.palette import parse_palette
+from .palette import parse_palette
 from vecfit.svg.numbers import hex_color
 
 from .config import settings_of

@@ -138,6 +138,15 @@ def nearest(rgb: np.ndarray, palette_rgb: np.ndarray) -> np.ndarray:
     return nearest_centre(to_lab(np.reshape(rgb, (-1, 3))), to_lab(palette_rgb)).astype(np.int64)
 
 
+def nearest_colour(rgba, palette_rgb: np.ndarray):
+    """An RGBA tuple's colour replaced by its nearest palette colour (None stays None, as
+    does any colour when the palette is empty)."""
+    if rgba is None or not len(palette_rgb):
+        return rgba
+    rgb = np.asarray(palette_rgb, np.float64).reshape(-1, 3)[nearest(np.array([rgba[:3]]), palette_rgb)[0]]
+    return (*map(float, rgb), *rgba[3:])
+
+
 def from_lab(lab: np.ndarray) -> np.ndarray:
     """CIELAB [n, 3] back to sRGB [n, 3] in [0, 1] (clipped): the inverse of to_lab."""
     from vecfit.initial.tracer.quantize import D65_WHITE, SRGB_TO_XYZ
