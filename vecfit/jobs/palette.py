@@ -404,6 +404,31 @@ def _joined(results):
                   point_rate=first.point_rate)
 
 
+# ------------------------------------------------------------------- the trace
+
+def traced_on_palette(image: np.ndarray, settings, colours: np.ndarray):
+    """The trace (vecfit.initial.tracer) painted with ``colours`` exactly: of its two ways
+    (palette_by "pixels" and "regions"), the one whose render is closer to ``image`` (MSE
+    over its own corner colour for opaque images, premultiplied RGBA else)."""
+    from vecfit.initial.tracer import trace_image
+    from vecfit.renderer.forward import render_numpy
+    from vecfit.scene.arrays import numpy_arrays
+    from vecfit.svg.read import scene_of
+
+    h, w = image.shape[:2]
+    best, best_error = None, np.inf
+    for way in ("pixels", "regions"):
+        traced = trace_image(image, settings, palette=colours, palette_by=way)
+        with numpy_arrays():
+            drawn = render_numpy(scene_of(traced.document), w, h, samples=2)
+        a, b = np.asarray(drawn, np.float64), np.asarray(image, np.float64)
+        error = float(((a[..., :3] * a[..., 3:] - b[..., :3] * b[..., 3:]) ** 2).mean()
+                      + ((a[..., 3] - b[..., 3]) ** 2).mean())
+        if error < best_error:
+            best, best_error = traced, error
+    return best
+
+
 # ------------------------------------------------------------------- the report
 
 def written_colours(svg: bytes) -> list[str]:

@@ -13,7 +13,7 @@ from vecfit.scene import Rect, Solid
 from vecfit.scene.arrays import numpy_arrays
 from vecfit.initial.tracer.background import border_colour, without_background
 from vecfit.io.colors import fitting_background
-from .palette import parse_palette
+from .palette import parse_palette, traced_on_palette
 from vecfit.svg.numbers import hex_color
 
 from .config import settings_of
@@ -36,8 +36,10 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     if settings.remove_background:
         config, traced_image, removed = _background_removed(config, target, progress)
     progress.status(f"tracing {target_path} ({target.shape[1]}x{target.shape[0]})")
-    traced = trace_image(traced_image, settings,
-                         palette=None if palette is None or palette.auto is not None else palette.colors)
+    if palette is None or palette.auto is not None:
+        traced = trace_image(traced_image, settings)
+    else:
+        traced = traced_on_palette(traced_image, settings, palette.colors)
     progress.status(f"traced: {traced.paths} paths, {traced.segments} segments, {traced.colors} colours "
                     f"in {traced.seconds:.1f} s")
     # Written as it is, the trace is read as NumPy: rendered and written without torch.
