@@ -188,11 +188,9 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         if palette is None:
             result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
         else:  # every paint ends on the palette (vecfit/jobs/palette.py)
-            from vecfit.fitting.opacity import has_translucent_areas
             from .palette import optimize_on_palette
-            translucent = background is None and has_translucent_areas(small[..., 3])
             result, used = optimize_on_palette(scene, goal, settings, palette, progress=progress, hooks=hooks,
-                                               keep_alpha=keep_alpha, translucent=translucent)
+                                               keep_alpha=keep_alpha)
             background = nearest_colour(background, used / 255.0)  # auto:N's: one of the N
     else:
         progress.start(0)

@@ -30,8 +30,10 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     target, orientation = load_target(inputs.image, return_orientation=True)
     settings = settings_of(TraceSettings, config["trace"], seed=config["optimize"]["seed"])
     palette = parse_palette(config["optimize"]["palette"])
-    if palette is not None and palette.auto is not None:  # N colour classes, painted flat
-        settings = dataclasses.replace(settings, colors=palette.auto, palette=True)
+    if palette is not None and palette.auto is not None and config["optimize"]["iterations"] == 0:
+        # written as traced: N colour classes, each painted flat (the fit would otherwise
+        # start from the full trace and fit N shared colours: vecfit/jobs/palette.py)
+        settings = dataclasses.replace(settings, colors=min(settings.colors, palette.auto), palette=True)
     traced_image, removed = target, None
     if settings.remove_background:
         config, traced_image, removed = _background_removed(config, target, progress)
