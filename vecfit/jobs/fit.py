@@ -159,7 +159,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     opt = {**config["optimize"], "device": devices.device_name(devices.resolve(config["optimize"]["device"]))}
     background = background_for(target, opt["background"])
     palette = parse_palette(opt.get("palette"))
-    if palette is not None and palette.auto is None:  # a background written in is a paint too
+    if palette is not None and palette.auto is None and not drop_background:  # a background written in is a paint too
         background = nearest_colour(background, palette.rgb)
     h, w = target.shape[:2]
     small = downscaled(target, opt["max_size"])
@@ -191,7 +191,8 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
             from .palette import optimize_on_palette
             result, used = optimize_on_palette(scene, goal, settings, palette, progress=progress, hooks=hooks,
                                                keep_alpha=keep_alpha)
-            background = nearest_colour(background, used / 255.0)  # auto:N's: one of the N
+            if not drop_background:  # auto:N's: one of the N
+                background = nearest_colour(background, used / 255.0)
     else:
         progress.start(0)
         result = _not_optimised(scene, opt)

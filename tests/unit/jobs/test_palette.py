@@ -166,6 +166,16 @@ def test_remove_background_leaves_the_page_transparent_and_scores_as_before(tmp_
     assert psnr_over(svg, target, page) >= psnr_over(kept, target, page) - 0.5
 
 
+def test_remove_background_with_a_palette_scores_over_the_colour_removed(tmp_path):
+    target = poster_png(tmp_path / "in.png")
+    page = (240 / 255, 240 / 255, 235 / 255, 1.0)
+    for palette in ("auto:3", "#c83c28,#285ab4,#fac81e"):
+        svg, report = vecfit.trace(tmp_path / "in.png", settings={
+            **FAST, "optimize": {**FAST["optimize"], "palette": palette}, "trace": {"remove_background": True}})
+        assert report["background"] == "#f0f0eb" and "#f0f0eb" not in paints(svg)
+        assert report["optimized"]["psnr"] > 25 and psnr_over(svg, target, page) > 25
+
+
 def test_remove_background_takes_the_colour_given(tmp_path):
     """The colour given is removed where it touches the border (a blue band on the left
     edge), not where it does not (the blue square inside); the page's colour stays."""
