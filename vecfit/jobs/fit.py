@@ -30,9 +30,8 @@ from vecfit.svg.precision import shape_decimals
 from vecfit.svg.stats import design_stats
 from vecfit.svg.write import svg_bytes
 
-from .palette import colour_entry, nearest_colour, parse_palette
-
 from .config import output_precision
+from .palette import colour_entry, nearest_colour, parse_palette
 from .protocol import Outputs, listener
 
 OPAQUE = 0.999  # a target whose every alpha is at least this is treated as opaque
@@ -140,7 +139,7 @@ def cut_crossed_outlines(scene: Scene, keep: set, config: dict, pixels=None) -> 
 
 def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, config: dict, outputs: Outputs,
                   progress=None, inputs: dict | None = None, hooks=(), keep_alpha=(),
-                  generated: bool = False, drop_background: bool = False) -> dict:
+                  generated: bool = False, removed_background: tuple | None = None) -> dict:
     """Optimise ``scene`` (read from ``document``) against ``target`` with the
     ``[optimize]`` settings of ``config``; writes the SVG, the comparison picture and the
     report (last, so a report means a finished run). Returns the report. ``inputs`` are
@@ -148,8 +147,9 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     and ``keep_alpha`` go to the optimisation loop. ``generated``: the Scene is vecfit's own
     (a trace, random strokes), so under ``optimize.alpha = "auto"`` its colours start
     opaque unless the target has translucent areas (vecfit/fitting/opacity.py).
-    ``drop_background``: the background is not written (trace --remove-background: the
-    shapes were fitted over it as over transparency)."""
+    ``removed_background``: an opaque RGBA fitted over in place of optimize.background and
+    never written (trace --remove-background: the shapes fitted over it as over
+    transparency)."""
     started = time.perf_counter()
     progress = listener(progress)
     # The report marks a finished run: an old one must not sit beside new outputs if this
@@ -157,7 +157,8 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     outputs.forget_report()
     # "auto" settled once, for the loop, the full-size renders and the report alike
     opt = {**config["optimize"], "device": devices.device_name(devices.resolve(config["optimize"]["device"]))}
-    background = background_for(target, opt["background"])
+    drop_background = removed_background is not None
+    background = removed_background if drop_background else background_for(target, opt["background"])
     palette = parse_palette(opt.get("palette"))
     if palette is not None and palette.auto is None and not drop_background:  # a background written in is a paint too
         background = nearest_colour(background, palette.rgb)

@@ -9,15 +9,15 @@ import numpy as np
 
 from vecfit.errors import VecfitError
 from vecfit.initial.tracer import TraceSettings, trace_image
-from vecfit.scene import Rect, Solid
-from vecfit.scene.arrays import numpy_arrays
 from vecfit.initial.tracer.background import border_colour, without_background
 from vecfit.io.colors import fitting_background
-from .palette import parse_palette, traced_on_palette
+from vecfit.scene import Rect, Solid
+from vecfit.scene.arrays import numpy_arrays
 from vecfit.svg.numbers import hex_color
 
 from .config import settings_of
 from .fit import OPAQUE, fit_and_write, generated_scene, load_target
+from .palette import parse_palette, traced_on_palette
 from .protocol import Inputs, Outputs, listener
 
 
@@ -36,7 +36,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
         settings = dataclasses.replace(settings, colors=min(settings.colors, palette.auto), palette=True)
     traced_image, removed = target, None
     if settings.remove_background:
-        config, traced_image, removed = _background_removed(config, target, progress)
+        traced_image, removed = _background_removed(config, target, progress)
     progress.status(f"tracing {target_path} ({target.shape[1]}x{target.shape[0]})")
     if palette is None or palette.auto is not None:
         traced = trace_image(traced_image, settings)
@@ -55,24 +55,21 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     backdrop = [s.fill.color for s in scene.shapes[:1]
                 if isinstance(s.geometry, Rect) and isinstance(s.fill, Solid)]
     return fit_and_write(scene, traced.document, target, config, outputs, progress, keep_alpha=backdrop, generated=True,
-                         drop_background=removed is not None,
+                         removed_background=removed,
                          inputs={"command": "trace", "target": str(target_path), "orientation": orientation,
                                  "trace": {"paths": traced.paths, "segments": traced.segments,
                                            "colors": traced.colors, "seconds": traced.seconds},
-                                 **({} if removed is None else {"removed_background": removed})})
+                                 **({} if removed is None else {"removed_background": hex_color(removed)})})
 
 
 def _background_removed(config: dict, target, progress):
-    """trace --remove-background (initial/tracer/background.py): the config fitting over
-    the background colour, the image to trace (the background transparent), and the
-    colour removed (#rrggbb; None, and the config as it was, for a target that already
-    has transparency)."""
+    """trace --remove-background (initial/tracer/background.py): the image to trace (the
+    background transparent) and the colour removed (RGBA, fitted over and not written;
+    None, and the image as it is, for a target that already has transparency)."""
     if float(target[..., 3].min()) < OPAQUE:
         progress.status("remove-background: the image already has transparency; nothing removed")
-        return config, target, None
+        return target, None
     given = config["optimize"]["background"].strip().lower()
     colour = border_colour(target[..., :3]) if given in ("auto", "none") else \
         np.array(fitting_background(given)[:3])
-    removed = hex_color(colour)
-    optimize_table = {**config["optimize"], "background": removed}
-    return {**config, "optimize": optimize_table}, without_background(target, colour), removed
+    return without_background(target, colour), (*map(float, colour), 1.0)

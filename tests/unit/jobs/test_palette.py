@@ -159,6 +159,7 @@ def test_remove_background_leaves_the_page_transparent_and_scores_as_before(tmp_
     kept, _ = vecfit.trace(tmp_path / "in.png", settings=FAST)
     svg, report = vecfit.trace(tmp_path / "in.png", settings={**FAST, "trace": {"remove_background": True}})
     assert report["removed_background"] == "#f0f0eb"
+    assert report["config"]["optimize"]["background"] == "auto"  # the settings as given: batch resumes on them
     assert "#f0f0eb" not in paints(svg) and "vecfit-background" not in svg
     bare = drawn(svg, 64, 48)
     assert bare[:3, :, 3].max() < 0.01 and bare[:, -3:, 3].max() < 0.01  # the page's edges: nothing drawn
