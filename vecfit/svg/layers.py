@@ -90,21 +90,24 @@ def group_by_colour(svg: bytes) -> tuple[bytes, dict]:
         line = (f"--group-by colour: the SVG has elements that are not shapes at its top level "
                 f"(<{local_name(others[0].tag)}>, ...): left ungrouped")
         return svg, {"layers": [], "split": [], "warnings": [line]}
-    layers: list[dict] = []  # {"key", "elements", "boxes"} bottom to top
+    layers: list[dict] = []  # {"key", "elements"} bottom to top
+    top: dict[str, int] = {}  # colour -> index of its topmost layer
+    boxes = np.zeros((len(children), 4))  # the grouped shapes' boxes, and their layers
+    layer_of = np.zeros(len(children), np.int64)
+    placed = 0
     for child in children:
         shape = by_element.get(id(child))
         if shape is None or child.get("id") == BACKGROUND_ID:
             continue
         key, box = _colour_key(shape), shape_box(shape)
         box = np.zeros(4) if box is None else box
-        last = next((i for i in range(len(layers) - 1, -1, -1) if layers[i]["key"] == key), None)
-        if last is not None and not any(_overlaps(box, np.array(l["boxes"])) for l in layers[last + 1:]):
-            target = layers[last]
-        else:
-            target = {"key": key, "elements": [], "boxes": []}
-            layers.append(target)
-        target["elements"].append(child)
-        target["boxes"].append(box)
+        last = top.get(key)
+        if last is None or _overlaps(box, boxes[:placed][layer_of[:placed] > last]):
+            last = top[key] = len(layers)
+            layers.append({"key": key, "elements": []})
+        layers[last]["elements"].append(child)
+        boxes[placed], layer_of[placed] = box, last
+        placed += 1
     if not layers:
         return svg, {"layers": [], "split": [], "warnings": []}
 
