@@ -178,8 +178,8 @@ def test_remove_background_with_a_palette_scores_over_the_colour_removed(tmp_pat
 
 
 def test_remove_background_takes_the_colour_given(tmp_path):
-    """The colour given is removed where it touches the border (a blue band on the left
-    edge), not where it does not (the blue square inside); the page's colour stays."""
+    """The colour given is removed wherever it is (a blue band on the left edge and the
+    blue square inside), not the page's dominant colour, which stays."""
     target = poster_png(tmp_path / "in.png")
     image = Image.fromarray(np.rint(target * 255).astype(np.uint8))
     ImageDraw.Draw(image).rectangle((0, 0, 4, 47), fill=(40, 90, 180))
@@ -189,7 +189,8 @@ def test_remove_background_takes_the_colour_given(tmp_path):
         "trace": {"remove_background": True}})
     assert report["removed_background"] == "#285ab4" and "#f0f0eb" in paints(svg)
     bare = drawn(svg, 64, 48)
-    assert bare[:, :4, 3].max() < 0.01 and bare[20:30, 40:50, 3].min() > 0.99
+    assert bare[:, :4, 3].max() < 0.01 and bare[20:30, 40:50, 3].max() < 0.01
+    assert bare[2:5, 20:30, 3].min() > 0.99  # the off-white page is drawn
 
 
 # ------------------------------------------------------------------ colour layers
