@@ -318,11 +318,11 @@ def optimize_on_palette(scene, goal, settings, palette: Palette, *, progress=Non
     ``palette`` (see the module's docstring); returns (the loop's Result, the colours
     used: uint8 [k, 3]).
 
-    A scene that starts on the palette (a trace on it; auto:N: at most N distinct paints)
-    keeps its colours throughout: a list's frozen, auto's N shared and fitted with the
-    geometry. (Free colours snapped back after the fit lost a flag's trace 1 dB: the
-    outlines had settled on the drifted colours.) Any other scene is fitted with free
-    colours first, then snapped, then polished (geometry only, auto's colours shared)."""
+    auto:N: the paints are clustered into N at once and fitted as N shared colours
+    throughout. A list: a scene already on it (a trace) keeps its colours frozen
+    throughout (free colours snapped back after the fit lost a flag's trace 1 dB: the
+    outlines had settled on the drifted colours); any other scene is fitted with free
+    colours first, then snapped, then polished (geometry only)."""
     import dataclasses
     from vecfit.fitting.loop import optimize
     from vecfit.fitting.result import Result
@@ -357,12 +357,12 @@ def optimize_on_palette(scene, goal, settings, palette: Palette, *, progress=Non
             if "points" in lr:
                 lr["points"] = float(lr["points"]) * POLISH_RATE
             last = dataclasses.replace(last, lr=lr, coarse=0.0, lr_warmup=min(settings.lr_warmup, 3))
+        from vecfit.errors import VecfitError
         try:
             results.append(optimize(scene, goal, last, progress=progress, hooks=polish_hooks,
                                     keep_alpha=keep_alpha))
-        except Exception as e:  # e.g. nothing left to optimise (no geometry rates): keep the snap
-            from vecfit.errors import VecfitError
-            if not isinstance(e, VecfitError):
+        except VecfitError as e:  # colours were all it had to fit (no geometry rates): keep the snap
+            if not str(e).startswith("nothing to optimise"):
                 raise
     if tied is not None:
         chosen = tied.finish()

@@ -137,6 +137,11 @@ def test_refine_and_paint_snap_free_colours_to_the_palette(tmp_path):
     svg, report = vecfit.refine(tmp_path / "in.png", init,
                                 settings={"optimize": {"iterations": 24, "threads": 1, "palette": palette}})
     assert paints(svg) == set(palette.split(","))
+    # colours the only thing fitted: the geometry-only polish has nothing to move
+    frozen = {"points": 0.0, "radii": 0.0, "stroke_widths": 0.0}
+    svg, _ = vecfit.refine(tmp_path / "in.png", init, settings={"optimize": {
+        "iterations": 12, "threads": 1, "palette": palette, "lr": frozen}})
+    assert paints(svg) == set(palette.split(","))
     svg, _ = vecfit.paint(tmp_path / "in.png", settings={"optimize": {"iterations": 12, "threads": 1,
                                                                       "palette": "auto:3"},
                                                          "paint": {"paths": 6}})
