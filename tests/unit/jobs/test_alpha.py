@@ -4,7 +4,6 @@ render, alpha included, scores >= 35 dB over white and over black."""
 from __future__ import annotations
 
 import io
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,12 +11,13 @@ from PIL import Image
 
 import vecfit
 from helpers import need
+from shared_data import SHARED
 from vecfit.fitting.metrics import compare
 from vecfit.io.images import read_image
 from vecfit.svg.document import SvgDocument
 from vecfit.svg.read import scene_of
 
-REALWORLD = Path(__file__).resolve().parents[4] / "shared" / "realworld" / "cases"
+REALWORLD = SHARED / "realworld" / "cases"
 
 
 def soft_disc(size=(64, 48)) -> np.ndarray:
