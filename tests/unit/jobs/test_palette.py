@@ -246,3 +246,20 @@ def test_without_the_options_the_report_has_no_colour_entry(tmp_path):
     same, _ = vecfit.trace(tmp_path / "in.png", settings={"optimize": {"iterations": 0, "palette": ""},
                                                           "output": {"group_by": "none"}})
     assert "colours" not in report and svg == same and "inkscape" not in svg
+
+
+def test_batch_takes_the_colour_options_and_summarises_them(tmp_path):
+    import csv
+    (tmp_path / "in").mkdir()
+    poster_png(tmp_path / "in" / "a.png")
+    result = run("batch", tmp_path / "in", "-o", tmp_path / "out", "--mode", "trace", "--effort", "quick",
+                 "--palette", "auto:3", "--group-by", "colour", "--remove-background", "-q")
+    assert result.exit_code == 0, result.output
+    row = next(csv.DictReader(open(tmp_path / "out" / "summary.csv")))
+    assert row["palette"] == "auto:3" and int(row["file_colours"]) <= 3 and int(row["layers"]) >= 1
+    assert "#f0f0eb" not in paints((tmp_path / "out" / "a.svg").read_text())
+    for bad in (["--palette", "auto:0"], ["--palette", str(tmp_path / "none.gpl")]):
+        result = run("batch", tmp_path / "in", "-o", tmp_path / "bad", "--mode", "trace", *bad, "-q")
+        assert result.exit_code == 2 and not (tmp_path / "bad").exists(), result.output
+    result = run("batch", tmp_path / "in", "-o", tmp_path / "bad", "--mode", "paint", "--remove-background", "-q")
+    assert result.exit_code == 2 and "trace" in result.output
