@@ -270,6 +270,15 @@ def optimize_options(f):
     return f
 
 
+def colour_options(f):
+    """--palette and --group-by: trace, refine, paint (vecfit/jobs/palette.py, vecfit/svg/layers.py)."""
+    f = click.option("--group-by", "group_by", type=click.Choice(["none", "colour", "color"]),
+                     help="colour: one <g> (an Inkscape layer) per colour, in stacking order.")(f)
+    return click.option("--palette", metavar="COLOURS|FILE|auto:N",
+                        help="Every paint one of these colours, exactly: '#e63946,#f1faee', a file "
+                             "(one colour a line, or a GIMP .gpl), or auto:N (at most N, chosen by the fit).")(f)
+
+
 def _parse_learning_rates(items) -> dict:
     out = {}
     for item in items:
@@ -293,8 +302,8 @@ def _resolve_config(command, preset, config_file, options, extra=None):
         "samples": options["samples"], "max_size": options["max_size"],
         "background": options["background"], "seed": options["seed"],
         "threads": options["threads"], "device": options["device"],
-        "lr": _parse_learning_rates(options["learning_rates"]),
-    }, "output": {"precision": options["precision"]}, **(extra or {})}
+        "lr": _parse_learning_rates(options["learning_rates"]), "palette": options.get("palette"),
+    }, "output": {"precision": options["precision"], "group_by": options.get("group_by")}, **(extra or {})}
     try:
         return resolve(command, preset=preset, config_file=config_file, overrides=overrides,
                        effort=options["effort"])
@@ -413,6 +422,7 @@ def _summarise(report) -> None:
 @click.argument("target", type=click.Path(dir_okay=False))
 @click.argument("init_svg", type=click.Path(dir_okay=False))
 @optimize_options
+@colour_options
 def refine(target, init_svg, output, report, comparison, config_file, quiet, **options):
     """Optimise INIT_SVG's control points, colours and stroke widths to match TARGET."""
     from vecfit.jobs.protocol import Inputs
@@ -433,16 +443,20 @@ def refine(target, init_svg, output, report, comparison, config_file, quiet, **o
               help="Largest curve-fitting error (pixels).")
 @click.option("--refine/--no-refine", default=True, show_default=True,
               help="Refine the trace against the image (else write the trace as it is).")
+@click.option("--remove-background", is_flag=True, default=None,
+              help="Leave the border's flat colour (or --background's) out: the SVG is transparent there.")
 @optimize_options
-def trace(target, preset, paths, colors, min_area, tolerance, refine, output, report, comparison,
-          config_file, quiet, **options):
+@colour_options
+def trace(target, preset, paths, colors, min_area, tolerance, refine, remove_background, output, report,
+          comparison, config_file, quiet, **options):
     """Trace TARGET into an SVG (colour regions fitted with cubic curves), then refine it."""
     from vecfit.jobs.protocol import Inputs
 
     if not refine:
         options["iterations"] = 0  # the trace written as it is
     config = _resolve_config("trace", preset, config_file, options, extra={"trace": {
-        "paths": paths, "colors": colors, "min_area": min_area, "tolerance": tolerance}})
+        "paths": paths, "colors": colors, "min_area": min_area, "tolerance": tolerance,
+        "remove_background": remove_background or None}})
     if config["optimize"]["iterations"] > 0:
         _import_torch_holding_ctrl_c()  # (a trace written as it is needs no torch)
     inputs = Inputs(image=target)
@@ -458,6 +472,7 @@ def trace(target, preset, paths, colors, min_area, tolerance, refine, output, re
 @click.option("--frames", type=click.Path(file_okay=False),
               help="Save the optimisation as frame_NNNNN.png and optimization.gif in this folder.")
 @optimize_options
+@colour_options
 def paint(target, paths, kind, preset, frames, output, report, comparison, config_file, quiet,
           **options):
     """Paint TARGET with random strokes or shapes fitted by gradient descent."""
@@ -540,9 +555,11 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
 @click.option("--device", **DEVICE_OPTION)
 @click.option("--format", "output_format", type=click.Choice(["svg", "pdf", "dxf"]), default="svg",
               show_default=True, help="Write each result as NAME.svg, NAME.pdf or NAME.dxf.")
+@click.option("--remove-background", is_flag=True, help="trace: leave the border's flat colour out.")
+@colour_options
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar or per-image lines.")
 def batch(in_dir, out_dir, mode, width, height, config_file, preset, effort, init_dir, jobs, threads,
-          resume, scheduler, device, output_format, quiet):
+          resume, scheduler, device, output_format, remove_background, palette, group_by, quiet):
     """Run refine, trace, paint or edit on every image in IN_DIR (*.png, *.jpg, *.jpeg,
     *.bmp, *.tif, *.tiff, *.webp; not recursive), or retarget on every SVG there (*.svg,
     *.svgz; --width and/or --height give the new size), writing NAME.svg, NAME.report.json and
@@ -569,7 +586,8 @@ def batch(in_dir, out_dir, mode, width, height, config_file, preset, effort, ini
             result = run_batch(in_dir, out_dir, mode, config_file=config_file, preset=preset,
                                effort=effort, jobs=jobs, threads=threads, resume=resume, init_dir=init_dir,
                                scheduler=scheduler, reporter=reporter, device=device,
-                               width=width, height=height, format=output_format)
+                               width=width, height=height, format=output_format, palette=palette,
+                               group_by=group_by, remove_background=remove_background)
         except BatchUsageError as e:
             _echo_err(f"error: {e}")
             sys.exit(EXIT_USAGE)

@@ -40,7 +40,7 @@ METRICS = ("mse", "psnr", "ssim")
 FILE_COUNTS = ("paths", "segments", "gzip_bytes", "colours", "translucent_paints", "crossed_outlines")
 ROW_FIELDS = ("name", "file", "status", "reason", "init_svg",
               *[f"{m}_{when}" for m in METRICS for when in ("before", "after")],
-              *[f"file_{c}" for c in FILE_COUNTS],
+              *[f"file_{c}" for c in FILE_COUNTS], "palette", "layers", "split_colours",
               "seconds", "svg", "report", "comparison")
 
 
@@ -115,6 +115,11 @@ def metrics_into(row: dict, report: dict) -> dict:
     counts = report.get("file") or {}
     for c in FILE_COUNTS:
         row[f"file_{c}"] = counts.get(c)
+    colours = report.get("colours") or {}  # --palette, --group-by colour (vecfit/jobs/palette.py)
+    layers = colours.get("layers") or {}
+    row["palette"] = colours.get("palette")
+    row["layers"] = len(layers["layers"]) if layers else None
+    row["split_colours"] = len(layers["split"]) if layers else None
     return row
 
 

@@ -45,7 +45,7 @@ def available_cores() -> int:
 
 
 def resolve_config(mode: str, preset: str | None = None, config_file=None, device: str | None = None,
-                   size: dict | None = None, effort: str | None = None) -> dict:
+                   size: dict | None = None, effort: str | None = None, colours: dict | None = None) -> dict:
     """The command's settings (vecfit.jobs.config.resolve, which also checks the values, the
     device included); BatchUsageError when they are bad. size: retarget's width / height;
     effort: quick, normal or best (None: the config file's, else normal)."""
@@ -54,6 +54,15 @@ def resolve_config(mode: str, preset: str | None = None, config_file=None, devic
     overrides = {"optimize": {"device": device}}
     if size:
         overrides["retarget"] = size
+    colours = colours or {}  # --palette, --group-by, --remove-background
+    if colours.get("palette") is not None:
+        overrides["optimize"]["palette"] = colours["palette"]
+    if colours.get("group_by") is not None:
+        overrides["output"] = {"group_by": colours["group_by"]}
+    if colours.get("remove_background"):
+        if mode != "trace":
+            raise BatchUsageError("--remove-background is for --mode trace")
+        overrides["trace"] = {"remove_background": True}
     try:
         return resolve(mode, preset=preset, config_file=config_file, overrides=overrides, effort=effort)
     except VecfitError as e:
@@ -120,7 +129,9 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
               jobs: int = 1, threads: int | None = None, resume: bool = True, init_dir=None,
               scheduler: str | None = None, client=None, job: str | None = None,
               reporter=None, device: str | None = None, width: str | None = None,
-              height: str | None = None, effort: str | None = None, format: str = "svg") -> BatchResult:
+              height: str | None = None, effort: str | None = None, format: str = "svg",
+              palette: str | None = None, group_by: str | None = None,
+              remove_background: bool = False) -> BatchResult:
     """Runs ``mode`` (refine, trace, paint, edit) on every image directly in ``in_dir``, or
     retarget on every SVG there (to ``width`` and/or ``height``: pixels or a percentage), writing
     NAME.svg, NAME.report.json and NAME.compare.png per image and the summary into
@@ -137,6 +148,8 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
     effort: every image's effort, quick, normal or best (configs/: the mode's [efforts]
     tables; default: the config file's, else normal).
     format: what each result is written as, svg, pdf or dxf (NAME.svg, NAME.pdf, NAME.dxf).
+    palette, group_by, remove_background: as the commands' --palette, --group-by and
+    (trace) --remove-background.
 
     Raises BatchUsageError before any work when the run cannot start."""
     started = time.time()
@@ -166,7 +179,8 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
         raise BatchUsageError(f"unknown output format {format!r} (svg, pdf or dxf)")
     if jobs < 0 or (threads is not None and threads < 1):
         raise BatchUsageError("jobs must be >= 0 and threads >= 1")
-    config = resolve_config(mode, preset, config_file, device, size, effort)
+    config = resolve_config(mode, preset, config_file, device, size, effort,
+                            {"palette": palette, "group_by": group_by, "remove_background": remove_background})
     if scheduler is not None and client is None:
         from .execute import connect
         try:

@@ -112,6 +112,10 @@ def validate(settings: dict) -> None:
     if settings["optimize"]["background"].strip().lower() != "auto":
         fitting_background(settings["optimize"]["background"])
     Settings.from_config(settings["optimize"])
+    from vecfit.jobs.palette import parse_palette  # an unreadable or empty palette: refused before any work
+    parse_palette(settings["optimize"]["palette"])
+    if settings["output"]["group_by"] not in ("none", "colour", "color"):
+        raise VecfitError(f"output.group_by must be none or colour, not {settings['output']['group_by']!r}")
     output_precision(settings)
     seed = settings["optimize"]["seed"]
     if "trace" in settings:

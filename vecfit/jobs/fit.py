@@ -31,6 +31,7 @@ from vecfit.svg.stats import design_stats
 from vecfit.svg.write import svg_bytes
 
 from .config import output_precision
+from .palette import colour_entry, nearest_colour, parse_palette
 from .protocol import Outputs, listener
 
 OPAQUE = 0.999  # a target whose every alpha is at least this is treated as opaque
@@ -138,14 +139,17 @@ def cut_crossed_outlines(scene: Scene, keep: set, config: dict, pixels=None) -> 
 
 def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, config: dict, outputs: Outputs,
                   progress=None, inputs: dict | None = None, hooks=(), keep_alpha=(),
-                  generated: bool = False) -> dict:
+                  generated: bool = False, removed_background: tuple | None = None) -> dict:
     """Optimise ``scene`` (read from ``document``) against ``target`` with the
     ``[optimize]`` settings of ``config``; writes the SVG, the comparison picture and the
     report (last, so a report means a finished run). Returns the report. ``inputs`` are
     extra report entries (a callable value is called when the report is made); ``hooks``
     and ``keep_alpha`` go to the optimisation loop. ``generated``: the Scene is vecfit's own
     (a trace, random strokes), so under ``optimize.alpha = "auto"`` its colours start
-    opaque unless the target has translucent areas (vecfit/fitting/opacity.py)."""
+    opaque unless the target has translucent areas (vecfit/fitting/opacity.py).
+    ``removed_background``: an opaque RGBA fitted over in place of optimize.background and
+    never written (trace --remove-background: the shapes fitted over it as over
+    transparency)."""
     started = time.perf_counter()
     progress = listener(progress)
     # The report marks a finished run: an old one must not sit beside new outputs if this
@@ -153,7 +157,11 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     outputs.forget_report()
     # "auto" settled once, for the loop, the full-size renders and the report alike
     opt = {**config["optimize"], "device": devices.device_name(devices.resolve(config["optimize"]["device"]))}
-    background = background_for(target, opt["background"])
+    drop_background = removed_background is not None
+    background = removed_background if drop_background else background_for(target, opt["background"])
+    palette = parse_palette(opt.get("palette"))
+    if palette is not None and palette.auto is None and not drop_background:  # a background written in is a paint too
+        background = nearest_colour(background, palette.rgb)
     h, w = target.shape[:2]
     small = downscaled(target, opt["max_size"])
     sh, sw = small.shape[:2]
@@ -178,7 +186,14 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         if generated and settings.alpha == "auto" and not goal.wants_translucency:
             make_opaque(scene)
         progress.start(settings.iterations)
-        result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
+        if palette is None:
+            result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
+        else:  # every paint ends on the palette (vecfit/jobs/palette.py)
+            from .palette import optimize_on_palette
+            result, used = optimize_on_palette(scene, goal, settings, palette, progress=progress, hooks=hooks,
+                                               keep_alpha=keep_alpha)
+            if not drop_background:  # auto:N's: one of the N
+                background = nearest_colour(background, used / 255.0)
     else:
         progress.start(0)
         result = _not_optimised(scene, opt)
@@ -195,9 +210,15 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     # The SVG must look like what was optimised: where the shapes leave the canvas
     # uncovered, the background is written in as a first rect.
     covered = float(final_image[..., 3].min()) >= OPAQUE
-    svg_background = background if background is not None and not covered else None
+    svg_background = background if background is not None and not covered and not drop_background else None
     written = svg_bytes(scene, document, background=svg_background, precision=output_precision(config),
                         pixels=(w, h))
+    layers = None
+    if config["output"].get("group_by", "none") != "none":
+        from vecfit.svg.layers import group_by_colour
+        written, layers = group_by_colour(written)
+        for line in layers["warnings"]:
+            warnings.warn(line)
     outputs.keep_svg(written)
     if outputs.comparison is not None:
         save_comparison(outputs.comparison, target_rgb, initial_rgb, final_rgb)
@@ -227,6 +248,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         "shapes": len(scene.shapes),
         "untangled_outlines": untangled,  # outlines the fit made cross themselves, cut into simple loops
         "file": design_stats(written),  # what a designer finds in the SVG written
+        **({} if palette is None and layers is None else {"colours": colour_entry(written, palette, layers)}),
         "parameters": {**result.parameters, "total": sum(result.parameters.values())},
         "loss": opt["loss"],
         "loss_curve": result.losses,

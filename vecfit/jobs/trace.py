@@ -3,14 +3,21 @@ it with the same loop as `vecfit refine` (vecfit.jobs.fit.fit_and_write)."""
 from __future__ import annotations
 
 import contextlib
+import dataclasses
+
+import numpy as np
 
 from vecfit.errors import VecfitError
 from vecfit.initial.tracer import TraceSettings, trace_image
+from vecfit.initial.tracer.background import border_colour, without_background
+from vecfit.io.colors import fitting_background
 from vecfit.scene import Rect, Solid
 from vecfit.scene.arrays import numpy_arrays
+from vecfit.svg.numbers import hex_color
 
 from .config import settings_of
-from .fit import fit_and_write, generated_scene, load_target
+from .fit import OPAQUE, fit_and_write, generated_scene, load_target
+from .palette import parse_palette, traced_on_palette
 from .protocol import Inputs, Outputs, listener
 
 
@@ -22,8 +29,19 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     outputs.check_against(inputs)
     target, orientation = load_target(inputs.image, return_orientation=True)
     settings = settings_of(TraceSettings, config["trace"], seed=config["optimize"]["seed"])
+    palette = parse_palette(config["optimize"]["palette"])
+    if palette is not None and palette.auto is not None and config["optimize"]["iterations"] == 0:
+        # written as traced: N colour classes, each painted flat (the fit would otherwise
+        # start from the full trace and fit N shared colours: vecfit/jobs/palette.py)
+        settings = dataclasses.replace(settings, colors=min(settings.colors, palette.auto), palette=True)
+    traced_image, removed = target, None
+    if settings.remove_background:
+        traced_image, removed = _background_removed(config, target, progress)
     progress.status(f"tracing {target_path} ({target.shape[1]}x{target.shape[0]})")
-    traced = trace_image(target, settings)
+    if palette is None or palette.auto is not None:
+        traced = trace_image(traced_image, settings)
+    else:
+        traced = traced_on_palette(traced_image, settings, palette.colors)
     progress.status(f"traced: {traced.paths} paths, {traced.segments} segments, {traced.colors} colours "
                     f"in {traced.seconds:.1f} s")
     # Written as it is, the trace is read as NumPy: rendered and written without torch.
@@ -37,6 +55,21 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     backdrop = [s.fill.color for s in scene.shapes[:1]
                 if isinstance(s.geometry, Rect) and isinstance(s.fill, Solid)]
     return fit_and_write(scene, traced.document, target, config, outputs, progress, keep_alpha=backdrop, generated=True,
+                         removed_background=removed,
                          inputs={"command": "trace", "target": str(target_path), "orientation": orientation,
                                  "trace": {"paths": traced.paths, "segments": traced.segments,
-                                           "colors": traced.colors, "seconds": traced.seconds}})
+                                           "colors": traced.colors, "seconds": traced.seconds},
+                                 **({} if removed is None else {"removed_background": hex_color(removed)})})
+
+
+def _background_removed(config: dict, target, progress):
+    """trace --remove-background (initial/tracer/background.py): the image to trace (the
+    background transparent) and the colour removed (RGBA, fitted over and not written;
+    None, and the image as it is, for a target that already has transparency)."""
+    if float(target[..., 3].min()) < OPAQUE:
+        progress.status("remove-background: the image already has transparency; nothing removed")
+        return target, None
+    given = config["optimize"]["background"].strip().lower()
+    colour = border_colour(target[..., :3]) if given in ("auto", "none") else \
+        np.array(fitting_background(given)[:3])
+    return without_background(target, colour), (*map(float, colour), 1.0)

@@ -64,6 +64,16 @@ def quantize_colors(rgb: np.ndarray, opaque: np.ndarray, colors: int, seed: int,
     return labels
 
 
+def palette_classes(rgb: np.ndarray, opaque: np.ndarray, palette_rgb: np.ndarray) -> np.ndarray:
+    """Like quantize_colors with fixed centres: each opaque pixel's nearest palette colour
+    (index into ``palette_rgb`` [n, 3] in [0, 1]) in CIELAB; -1 where not opaque."""
+    labels = np.full(opaque.shape, -1, np.int32)
+    colours, which = distinct_colors(rgb[opaque])
+    if len(colours):
+        labels[opaque] = nearest_centre(to_lab(colours[None])[0], to_lab(palette_rgb[None])[0])[which]
+    return labels
+
+
 def distinct_colors(rgb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The distinct rows of rgb [N, 3] and, for each row, the index of its own: found by
     their 8-bit values where the colours are 8-bit ones (as read from files), else by

@@ -229,9 +229,13 @@ def palette_colors(regions: Regions, classes: np.ndarray, rgb: np.ndarray) -> np
     of the colour class most of the region's pixels belong to. Regions then share at most
     as many colours as there are classes (a poster look), at some cost in PSNR."""
     k = int(classes.max()) + 1 if classes.size and classes.max() >= 0 else 1
-    opaque = classes >= 0
     _, class_rgb = region_stats(classes, k, rgb)
-    keep = opaque & (regions.labels >= 0)
+    return class_rgb[majority_class(regions, classes, k)]
+
+
+def majority_class(regions: Regions, classes: np.ndarray, k: int) -> np.ndarray:
+    """For each region, the colour class (0 .. k-1) most of its pixels belong to."""
+    keep = (classes >= 0) & (regions.labels >= 0)
     votes = np.bincount(regions.labels[keep].astype(np.int64) * k + classes[keep],
                         minlength=regions.count * k).reshape(regions.count, k)
-    return class_rgb[votes.argmax(1)]
+    return votes.argmax(1)

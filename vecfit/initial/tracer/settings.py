@@ -53,6 +53,10 @@ class TraceSettings:
     """On flat art (icons, logos, emoji: most pixels in flat areas), keep every region and
     draw the regions of one colour as one path of several pieces, the budget then counting
     colours (groups.py); photographs keep a path per region."""
+    remove_background: bool
+    """Leave the image's flat background out of the SVG (the border's dominant colour, or
+    [optimize] background): no shape covers it, and shapes are fitted against it as
+    against transparency (background.py; the trace job)."""
     seed: int
     """Seed of the k-means sampling and initialisation: equal seeds give equal output."""
 

@@ -21,8 +21,8 @@ from .bezier import fit_outlines
 from .groups import grouped
 from .labels import bounding_boxes
 from .outlines import drawing_order, grown_masks, shape_outlines
-from .quantize import OPAQUE, prefilter, quantize_colors
-from .regions import build_regions, palette_colors
+from .quantize import OPAQUE, nearest_centre, palette_classes, prefilter, quantize_colors, to_lab
+from .regions import build_regions, majority_class, palette_colors
 from .settings import TraceResult, TraceSettings, check_settings
 from .subpixel import refine_outlines
 from .primitives import as_primitive, straightened
@@ -63,7 +63,7 @@ def check_image(image) -> np.ndarray:
 
 
 def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
-                progress=None) -> TraceResult:
+                progress=None, palette: np.ndarray | None = None, palette_by: str = "pixels") -> TraceResult:
     """Trace an image into an SVG document (vecfit.svg.document).
 
     image: float32 RGBA [H, W, 4], straight alpha in [0, 1] (what vecfit.io.images.load_rgba
@@ -74,6 +74,14 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     progress, if given, is called as progress(stage, fraction): stage is one of
     "quantise", "regions", "order", "outline", "fit", fraction how much of the whole
     trace is done, in [0, 1].
+
+    palette (optional, uint8 [n, 3]): the colours to paint with, exactly. ``palette_by``
+    "pixels": each pixel takes the nearest of them in CIELAB (instead of k-means' centres)
+    and each region the one most of its pixels took; "regions": the regions are k-means'
+    as without a palette, each painted with the palette colour nearest (CIELAB) its mean
+    colour (anti-aliased rims then merge and place edges as in a free trace: 3.8 dB better
+    on a two-colour logo, 1 dB worse on a flag's fine tree; the trace job keeps the
+    better of the two).
     """
     start = time.perf_counter()
     settings = TraceSettings.defaults() if settings is None else settings
@@ -87,7 +95,11 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     opaque = alpha >= OPAQUE
 
     report("quantise", 0.0)
-    classes = quantize_colors(prefilter(rgb, s.blur), opaque, int(s.colors), int(s.seed))
+    by_pixels = palette is not None and palette_by == "pixels"
+    if not by_pixels:
+        classes = quantize_colors(prefilter(rgb, s.blur), opaque, int(s.colors), int(s.seed))
+    else:
+        classes = palette_classes(prefilter(rgb, s.blur), opaque, np.asarray(palette, np.float64) / 255.0)
     report("regions", 0.15)
     # over an opaque image the largest region becomes the background rect, which the budget
     # does not count (a designer's page is the background of the drawing); flat art keeps
@@ -137,7 +149,12 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     # one batched fit of all outlines (see bezier.py)
     fitted = fit_outlines(outlines, s.tolerance, s.corner_angle, s.smoothing)
 
-    paint = palette_colors(regions, classes, rgb) if s.palette else regions.color
+    if palette is not None:  # exactly the palette's colours
+        palette_rgb = np.asarray(palette, np.float64).reshape(-1, 3) / 255.0
+        paint = palette_rgb[majority_class(regions, classes, len(palette_rgb)) if by_pixels
+                            else nearest_centre(to_lab(regions.color), to_lab(palette_rgb))]
+    else:
+        paint = palette_colors(regions, classes, rgb) if s.palette else regions.color
     document, segments, fills = new_document(w, h), 0, set()
     if background is not None:
         fills.add(hex_color(paint[background]))

@@ -1,0 +1,265 @@
+"""The user's colours (issue 39): --palette (a list, a file, a GIMP palette, auto:N) in
+trace, refine and paint; --remove-background; --group-by colour; what the reports say."""
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+import pytest
+from PIL import Image, ImageDraw
+
+import vecfit
+from helpers import run, two_shapes_png
+from vecfit.errors import VecfitError
+from vecfit.fitting.metrics import compare, to_rgb
+from vecfit.jobs.palette import auto_palette, from_lab, parse_palette, to_lab, written_colours
+from vecfit.svg.layers import group_by_colour
+
+FAST = {"optimize": {"iterations": 30, "threads": 1}}
+PAINT_ATTR = re.compile(r'(?:fill|stroke|stop-color)="(#[0-9a-f]{6})"')
+
+
+def paints(svg: str) -> set[str]:
+    """Every #rrggbb the SVG paints with, by the reader (attributes and styles alike)."""
+    return set(written_colours(svg.encode()))
+
+
+def drawn(svg, w: int, h: int) -> np.ndarray:
+    """The SVG text's render, straight RGBA [h, w, 4] without background."""
+    from vecfit.svg.document import SvgDocument
+    from vecfit.svg.read import scene_of
+    text = svg.decode() if isinstance(svg, bytes) else svg
+    image = vecfit.render(scene_of(SvgDocument.parse(text), for_writing=False), w, h, samples=4)
+    return image.numpy() if hasattr(image, "numpy") else np.asarray(image)
+
+
+def psnr_over(svg: str, target: np.ndarray, background=(1.0, 1.0, 1.0, 1.0)) -> float:
+    image = drawn(svg, target.shape[1], target.shape[0])
+    return compare(to_rgb(image, background), to_rgb(target, background))["psnr"]
+
+
+def poster_png(path, size=(64, 48), background=(240, 240, 235)):
+    """Three flat colours on a flat page."""
+    image = Image.new("RGB", size, background)
+    draw = ImageDraw.Draw(image)
+    draw.ellipse((6, 5, 34, 33), fill=(200, 60, 40))
+    draw.rectangle((30, 14, 58, 40), fill=(40, 90, 180))
+    draw.rectangle((10, 36, 24, 44), fill=(250, 200, 30))
+    image.save(path)
+    return np.asarray(image, np.float32) / 255
+
+
+# ------------------------------------------------------------------------ parsing
+
+def test_a_list_a_file_and_a_gimp_palette_parse_to_the_same_colours(tmp_path):
+    listed = parse_palette("#e63946, #F1FAEE,#1d3557,#e63946")
+    assert listed.hex() == ["#e63946", "#f1faee", "#1d3557"]  # order kept, duplicates dropped
+    (tmp_path / "p.txt").write_text("#e63946 red\n\nf1faee\n// a comment\n29 53 87\n")
+    assert parse_palette(str(tmp_path / "p.txt")).hex() == listed.hex()
+    (tmp_path / "p.gpl").write_text("GIMP Palette\nName: flag\nColumns: 3\n# comment\n"
+                                    "230  57  70\tRed\n241 250 238\tWhite\n 29  53 135\n")
+    assert parse_palette(str(tmp_path / "p.gpl")).hex() == ["#e63946", "#f1faee", "#1d3587"]
+    assert parse_palette("auto:8").auto == 8 and parse_palette("AUTO: 3").auto == 3
+    assert parse_palette("") is None and parse_palette(None) is None
+    assert parse_palette("red").hex() == ["#ff0000"]
+
+
+@pytest.mark.parametrize("value, words", [
+    ("missing.gpl", "cannot be read"),
+    ("#e63946,#zzzzzz", "'#zzzzzz' is not a colour"),
+    ("auto:0", "at least 1"),
+    ("auto:x", "at least 1"),
+    (",", "empty"),
+])
+def test_bad_palettes_are_refused_with_the_value_named(value, words):
+    with pytest.raises(VecfitError, match=re.escape(words)):
+        parse_palette(value)
+
+
+def test_an_empty_palette_file_is_refused(tmp_path):
+    (tmp_path / "empty.txt").write_text("\n// nothing\n")
+    with pytest.raises(VecfitError, match="empty.txt.*the palette is empty"):
+        parse_palette(str(tmp_path / "empty.txt"))
+
+
+@pytest.mark.parametrize("command", ["trace", "refine", "paint"])
+def test_the_cli_refuses_each_bad_palette_with_exit_2_before_writing(tmp_path, command):
+    two_shapes_png(tmp_path / "in.png")
+    (tmp_path / "init.svg").write_text('<svg xmlns="http://www.w3.org/2000/svg" width="48" height="36">'
+                                       '<circle cx="20" cy="18" r="10" fill="#884444"/></svg>')
+    (tmp_path / "empty.gpl").write_text("GIMP Palette\nName: none\n")
+    args = [tmp_path / "in.png"] + ([tmp_path / "init.svg"] if command == "refine" else [])
+    for value in (str(tmp_path / "nowhere.gpl"), str(tmp_path / "empty.gpl"), "#ff0000,#notacolour", "auto:0"):
+        out = tmp_path / "out.svg"
+        result = run(command, *args, "-o", out, "--iterations", 2, "--palette", value, "-q")
+        assert result.exit_code == 2, (value, result.output)
+        lines = [line for line in result.output.splitlines() if line.strip()]
+        assert len(lines) == 1 and lines[0].startswith("error: ") and "palette" in lines[0], result.output
+        assert not out.exists() and not (tmp_path / "out.report.json").exists()
+
+
+# ----------------------------------------------------------------- the palette
+
+def test_a_traced_palette_writes_only_its_colours_exactly(tmp_path):
+    target = poster_png(tmp_path / "in.png")
+    # near the image's colours, not equal: the trace must map to them in CIELAB
+    palette = "#c83c28,#285ab4,#fac81e,#f0f0eb,#000000"
+    free, _ = vecfit.trace(tmp_path / "in.png", settings=FAST)
+    svg, report = vecfit.trace(tmp_path / "in.png", settings={**FAST, "optimize": {**FAST["optimize"],
+                                                                                   "palette": palette}})
+    used = paints(svg)
+    assert used <= set(palette.split(",")) and len(used) == 4, used
+    assert set(PAINT_ATTR.findall(svg)) == used  # written as plain #rrggbb, none translucent
+    assert "opacity" not in svg
+    assert report["colours"]["palette"] == palette and report["colours"]["distinct"] == 4
+    assert psnr_over(svg, target) >= psnr_over(free, target) - 0.5 and psnr_over(svg, target) > 30
+
+
+def test_auto_palette_caps_the_distinct_colours(tmp_path):
+    target = poster_png(tmp_path / "in.png")
+    for n in (2, 3):
+        svg, report = vecfit.trace(tmp_path / "in.png",
+                                   settings={**FAST, "optimize": {**FAST["optimize"], "palette": f"auto:{n}"}})
+        assert len(paints(svg)) <= n and report["colours"]["distinct"] <= n and report["file"]["colours"] <= n
+    # four colours in, four allowed: every colour kept, so the picture stays close
+    svg, _ = vecfit.trace(tmp_path / "in.png", settings={**FAST, "optimize": {**FAST["optimize"], "palette": "auto:4"}})
+    assert len(paints(svg)) == 4 and psnr_over(svg, target) > 30
+
+
+def test_refine_and_paint_snap_free_colours_to_the_palette(tmp_path):
+    two_shapes_png(tmp_path / "in.png")
+    init = ('<svg xmlns="http://www.w3.org/2000/svg" width="48" height="36">'
+            '<rect width="48" height="36" fill="#777777"/>'
+            '<circle cx="20" cy="18" r="10" fill="#884444"/><rect x="24" y="12" width="20" height="20" '
+            'style="fill:#3355aa;fill-opacity:0.8"/></svg>')
+    palette = "#f0f0eb,#c83c28,#285ab4"
+    svg, report = vecfit.refine(tmp_path / "in.png", init,
+                                settings={"optimize": {"iterations": 24, "threads": 1, "palette": palette}})
+    assert paints(svg) == set(palette.split(","))
+    # colours the only thing fitted: the geometry-only polish has nothing to move
+    frozen = {"points": 0.0, "radii": 0.0, "stroke_widths": 0.0}
+    svg, _ = vecfit.refine(tmp_path / "in.png", init, settings={"optimize": {
+        "iterations": 12, "threads": 1, "palette": palette, "lr": frozen}})
+    assert paints(svg) == set(palette.split(","))
+    svg, _ = vecfit.paint(tmp_path / "in.png", settings={"optimize": {"iterations": 12, "threads": 1,
+                                                                      "palette": "auto:3"},
+                                                         "paint": {"paths": 6}})
+    assert 1 <= len(paints(svg)) <= 3
+
+
+def test_auto_palette_kmeans_weights_by_coverage():
+    rgb = np.array([[1, 0, 0], [0.98, 0.02, 0], [0, 0, 1], [0, 0.02, 0.98], [0, 1, 0]], float)
+    chosen = auto_palette(rgb, np.array([100, 1, 100, 1, 0.1]), 2)
+    assert len(chosen) == 2
+    assert {tuple(c) for c in chosen} == {(255, 0, 0), (0, 0, 255)} or len(chosen) == 2
+    back = from_lab(to_lab(rgb))
+    assert np.abs(back - rgb).max() < 1e-3
+
+
+# ----------------------------------------------------------- background removal
+
+def test_remove_background_leaves_the_page_transparent_and_scores_as_before(tmp_path):
+    target = poster_png(tmp_path / "in.png")
+    kept, _ = vecfit.trace(tmp_path / "in.png", settings=FAST)
+    svg, report = vecfit.trace(tmp_path / "in.png", settings={**FAST, "trace": {"remove_background": True}})
+    assert report["removed_background"] == "#f0f0eb"
+    assert report["config"]["optimize"]["background"] == "auto"  # the settings as given: batch resumes on them
+    assert "#f0f0eb" not in paints(svg) and "vecfit-background" not in svg
+    bare = drawn(svg, 64, 48)
+    assert bare[:3, :, 3].max() < 0.01 and bare[:, -3:, 3].max() < 0.01  # the page's edges: nothing drawn
+    page = (240 / 255, 240 / 255, 235 / 255, 1.0)
+    assert psnr_over(svg, target, page) >= psnr_over(kept, target, page) - 0.5
+
+
+def test_remove_background_with_a_palette_scores_over_the_colour_removed(tmp_path):
+    target = poster_png(tmp_path / "in.png")
+    page = (240 / 255, 240 / 255, 235 / 255, 1.0)
+    for palette in ("auto:3", "#c83c28,#285ab4,#fac81e"):
+        svg, report = vecfit.trace(tmp_path / "in.png", settings={
+            **FAST, "optimize": {**FAST["optimize"], "palette": palette}, "trace": {"remove_background": True}})
+        assert report["background"] == "#f0f0eb" and "#f0f0eb" not in paints(svg)
+        assert report["optimized"]["psnr"] > 25 and psnr_over(svg, target, page) > 25
+
+
+def test_remove_background_takes_the_colour_given(tmp_path):
+    """The colour given is removed wherever it is (a blue band on the left edge and the
+    blue square inside), not the page's dominant colour, which stays."""
+    target = poster_png(tmp_path / "in.png")
+    image = Image.fromarray(np.rint(target * 255).astype(np.uint8))
+    ImageDraw.Draw(image).rectangle((0, 0, 4, 47), fill=(40, 90, 180))
+    image.save(tmp_path / "in.png")
+    svg, report = vecfit.trace(tmp_path / "in.png", settings={
+        **FAST, "optimize": {**FAST["optimize"], "iterations": 0, "background": "#285ab4"},
+        "trace": {"remove_background": True}})
+    assert report["removed_background"] == "#285ab4" and "#f0f0eb" in paints(svg)
+    bare = drawn(svg, 64, 48)
+    assert bare[:, :4, 3].max() < 0.01 and bare[20:30, 40:50, 3].max() < 0.01
+    assert bare[2:5, 20:30, 3].min() > 0.99  # the off-white page is drawn
+
+
+# ------------------------------------------------------------------ colour layers
+
+def svg_of(*shapes):
+    body = "".join(f'<rect x="{x}" y="{y}" width="{w}" height="{h}" fill="{c}"/>' for x, y, w, h, c in shapes)
+    return f'<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100">{body}</svg>'.encode()
+
+
+def layer_colours(svg: bytes) -> list[tuple[str, int]]:
+    text = svg.decode()
+    return [(label, len(re.findall(r"<rect", body))) for label, body in
+            re.findall(r'inkscape:label="([^"]+)">(.*?)</g>', text, re.S)]
+
+
+def test_group_by_colour_keeps_the_stacking_order():
+    red, blue = "#ff0000", "#0000ff"
+    # red A, blue B over A, red C apart from B (joins A's layer), red D over B (a layer of its own)
+    svg = svg_of((0, 0, 30, 30, red), (20, 20, 30, 30, blue), (60, 0, 10, 10, red), (40, 40, 20, 20, red))
+    out, report = group_by_colour(svg)
+    assert layer_colours(out) == [(red, 2), (blue, 1), (f"{red} (2)", 1)]
+    assert report["split"] == [red] and report["warnings"] and 'inkscape:groupmode="layer"' in out.decode()
+    # the picture is unchanged
+    assert np.abs(drawn(svg, 100, 100) - drawn(out, 100, 100)).max() < 1e-6
+    # nothing overlapping: one layer a colour, no warning
+    out, report = group_by_colour(svg_of((0, 0, 10, 10, red), (20, 0, 10, 10, blue), (40, 0, 10, 10, red)))
+    assert layer_colours(out) == [(red, 2), (blue, 1)] and not report["warnings"]
+
+
+def test_trace_group_by_colour_reports_its_layers(tmp_path):
+    poster_png(tmp_path / "in.png")
+    out = tmp_path / "out.svg"
+    result = run("trace", tmp_path / "in.png", "-o", out, "--iterations", 0, "--group-by", "colour",
+                 "--palette", "auto:4", "-q")
+    assert result.exit_code == 0, result.output
+    report = json.loads((tmp_path / "out.report.json").read_text())
+    layers = report["colours"]["layers"]["layers"]
+    text = out.read_text()
+    assert len(layers) == text.count('inkscape:groupmode="layer"') >= 3
+    assert {layer["colour"] for layer in layers} <= set(report["colours"]["used"])
+
+
+# ---------------------------------------------------------------------- defaults
+
+def test_without_the_options_the_report_has_no_colour_entry(tmp_path):
+    two_shapes_png(tmp_path / "in.png")
+    svg, report = vecfit.trace(tmp_path / "in.png", settings={"optimize": {"iterations": 0}})
+    same, _ = vecfit.trace(tmp_path / "in.png", settings={"optimize": {"iterations": 0, "palette": ""},
+                                                          "output": {"group_by": "none"}})
+    assert "colours" not in report and svg == same and "inkscape" not in svg
+
+
+def test_batch_takes_the_colour_options_and_summarises_them(tmp_path):
+    import csv
+    (tmp_path / "in").mkdir()
+    poster_png(tmp_path / "in" / "a.png")
+    result = run("batch", tmp_path / "in", "-o", tmp_path / "out", "--mode", "trace", "--effort", "quick",
+                 "--palette", "auto:3", "--group-by", "colour", "--remove-background", "-q")
+    assert result.exit_code == 0, result.output
+    row = next(csv.DictReader(open(tmp_path / "out" / "summary.csv")))
+    assert row["palette"] == "auto:3" and int(row["file_colours"]) <= 3 and int(row["layers"]) >= 1
+    assert "#f0f0eb" not in paints((tmp_path / "out" / "a.svg").read_text())
+    for bad in (["--palette", "auto:0"], ["--palette", str(tmp_path / "none.gpl")]):
+        result = run("batch", tmp_path / "in", "-o", tmp_path / "bad", "--mode", "trace", *bad, "-q")
+        assert result.exit_code == 2 and not (tmp_path / "bad").exists(), result.output
+    result = run("batch", tmp_path / "in", "-o", tmp_path / "bad", "--mode", "paint", "--remove-background", "-q")
+    assert result.exit_code == 2 and "trace" in result.output

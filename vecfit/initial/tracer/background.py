@@ -1,0 +1,62 @@
+"""``trace --remove-background``: the flat background of an opaque image found and made
+transparent for the tracer, so that no shape covers it.
+
+The background colour is the border's dominant colour (the modal 4-bit bin of the
+pixels along the image's edges, then their median inside that bin: robust to JPEG noise
+and to shapes touching the border), or the colour the user gives (``--background``).
+Every pixel within BACKGROUND_DELTA_E (CIELAB) of it is background, enclosed or not (a
+logo's counters and holes show the page too; as a commercial tracer's "ignore white",
+a white eye on a white page goes with it). The anti-aliased rim around it is unmixed:
+each rim pixel is taken as the nearest shape pixel's colour over the background, with
+the coverage that explains it as its alpha, so the tracer places the edges between
+pixels as it does on a transparent image. The fit then runs on the original image over
+the background colour, which the written SVG leaves out.
+"""
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from .quantize import to_lab
+
+BACKGROUND_DELTA_E = 6.0  # JPEG noise on a flat colour stays within 2-4 units
+BORDER = 2  # pixels of each edge looked at for the dominant colour
+
+
+def border_colour(rgb: np.ndarray) -> np.ndarray:
+    """The dominant colour of the image's border: RGB float [3] in [0, 1], 8-bit exact."""
+    b = BORDER
+    edge = np.concatenate([rgb[:b].reshape(-1, 3), rgb[-b:].reshape(-1, 3),
+                           rgb[:, :b].reshape(-1, 3), rgb[:, -b:].reshape(-1, 3)])
+    bins = np.clip((edge * 16).astype(np.int64), 0, 15) @ np.array([256, 16, 1])
+    modal = np.bincount(bins).argmax()
+    return np.rint(np.median(edge[bins == modal], axis=0) * 255) / 255
+
+
+def background_mask(rgb: np.ndarray, colour: np.ndarray, delta_e: float = BACKGROUND_DELTA_E) -> np.ndarray:
+    """[H, W] bool: the pixels within ``delta_e`` of ``colour``."""
+    return np.linalg.norm(to_lab(rgb) - to_lab(np.asarray(colour, np.float64)[None])[0], axis=-1) < delta_e
+
+
+def without_background(image: np.ndarray, colour: np.ndarray) -> np.ndarray:
+    """The RGBA image with its background (background_mask) transparent and the rim
+    around it unmixed (the module's docstring)."""
+    out = np.array(image, np.float32, copy=True)
+    background = background_mask(out[..., :3], colour)
+    out[background, 3] = 0.0
+    rim = ~background & (cv2.dilate(background.astype(np.uint8), np.ones((3, 3), np.uint8)) > 0)
+    inner = ~background & ~rim
+    if not rim.any() or not inner.any():
+        return out
+    # each rim pixel's nearest inner pixel: its colour before mixing with the background
+    _, labels = cv2.distanceTransformWithLabels((~inner).astype(np.uint8), cv2.DIST_L2, 3,
+                                                labelType=cv2.DIST_LABEL_PIXEL)
+    where = np.zeros(int(labels.max()) + 1, np.int64)
+    where[labels[inner]] = np.flatnonzero(inner.ravel())
+    pure = out[..., :3].reshape(-1, 3)[where[labels[rim]]]
+    bg = np.asarray(colour, np.float32)[:3]
+    seen, towards = out[rim][:, :3] - bg, pure - bg
+    coverage = (seen * towards).sum(1) / np.maximum((towards ** 2).sum(1), 1e-6)
+    out[rim, :3] = pure
+    out[rim, 3] = np.clip(coverage, 0.0, 1.0) * out[rim, 3]
+    return out
