@@ -341,11 +341,12 @@ def format_relative_path_data(points, degrees, subpaths, decimals: int = 2) -> s
         fmt_many(a, decimals)  # raises, naming the value
     unit = 10 ** int(decimals)
     q = np.rint(a * unit).astype(np.int64).tolist()
-    fractions = [""] + [f".{f:0{decimals}d}".rstrip("0") for f in range(1, unit)] if decimals > 0 else [""]
 
     def number(v: int) -> str:
+        # (a table of every fraction's text was 10^decimals strings made per path: at 6
+        # decimals a 1,096-path file took minutes)
         whole, frac = divmod(abs(v), unit)
-        text = f"{whole}{fractions[frac]}"
+        text = f"{whole}.{frac:0{decimals}d}".rstrip("0") if frac else str(whole)
         return "-" + text if v < 0 and text != "0" else text
 
     def joined(values) -> str:
