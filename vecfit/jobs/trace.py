@@ -38,5 +38,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
                 if isinstance(s.geometry, Rect) and isinstance(s.fill, Solid)]
     return fit_and_write(scene, traced.document, target, config, outputs, progress, keep_alpha=backdrop, generated=True,
                          inputs={"command": "trace", "target": str(target_path), "orientation": orientation,
+                                 "style": settings.style,
                                  "trace": {"paths": traced.paths, "segments": traced.segments,
-                                           "colors": traced.colors, "seconds": traced.seconds}})
+                                           "colors": traced.colors, "seconds": traced.seconds,
+                                           "strokes": traced.strokes, "warnings": traced.warnings}})
