@@ -108,7 +108,7 @@ def ink_colors(rgb: np.ndarray, ink: np.ndarray, lab: np.ndarray, colors: int, s
     kept: list[tuple[np.ndarray, int]] = []  # (Lab centre, pixels), merged greedily by count
     for i in np.argsort(-counts).tolist():
         for j, (c, n) in enumerate(kept):
-            if np.hypot(*(c - centres[i])) < SAME_INK:
+            if np.linalg.norm(c - centres[i]) < SAME_INK:
                 kept[j] = ((c * n + centres[i] * counts[i]) / (n + counts[i]), n + counts[i])
                 break
         else:
@@ -250,9 +250,14 @@ def _sample(image: np.ndarray, xy: np.ndarray) -> np.ndarray:
     0 outside."""
     shape = xy.shape[:-1]
     flat = xy.reshape(-1, 2).astype(np.float32) - 0.5
-    out = cv2.remap(image.astype(np.float32), flat[:, :1].reshape(-1, 1), flat[:, 1:].reshape(-1, 1),
+    n = len(flat)
+    side = 1024  # cv2.remap takes maps under 32767 on a side: the points as rows of 1024
+    rows = max(1, -(-n // side))
+    maps = np.zeros((rows * side, 2), np.float32) - 10
+    maps[:n] = flat
+    out = cv2.remap(image.astype(np.float32), maps[:, 0].reshape(rows, side), maps[:, 1].reshape(rows, side),
                     cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
-    return out.reshape(shape)
+    return out.reshape(-1)[:n].reshape(shape)
 
 
 def centred(points: np.ndarray, closed: bool, ink: np.ndarray, radius: float) -> tuple[np.ndarray, float | None]:
@@ -447,7 +452,7 @@ def trace_strokes(image: np.ndarray, settings: TraceSettings, progress=None) -> 
     if background is None:
         ink = opaque
     else:
-        ink = opaque & (np.hypot(*(lab - to_lab(background[None, None])).transpose(2, 0, 1)) > INK_CONTRAST)
+        ink = opaque & (np.linalg.norm(lab - to_lab(background[None, None]), axis=-1) > INK_CONTRAST)
     inks = ink_colors(rgb, ink, lab.astype(np.float32), int(s.colors), int(s.seed))
     if background is None:  # over transparency each ink covers by its alpha
         which = np.argmin(((lab[..., None, :] - to_lab(inks[None])[0]) ** 2).sum(-1), -1) if len(inks) else \

@@ -20,9 +20,11 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-# A spur is an end branch shorter than this many times the line's half width at its
-# junction: where a wide line turns a sharp outer corner, its skeleton forks towards it.
-SPUR_LENGTH = 1.2
+# A spur is an end branch whose end's disk (its distance to the outline) lies within this
+# many times the disk at its junction: it adds next to nothing to the shape (where a wide
+# line turns a sharp outer corner, or its outline has a bump, the skeleton forks towards
+# it). A short line out of a junction reaches past the junction's disk.
+SPUR_LENGTH = 1.5
 # Two edges meeting at a junction are one line where they continue each other within this
 # many degrees of straight.
 MAX_BEND = 50.0
@@ -127,8 +129,10 @@ def _prune(skel: np.ndarray, radius: np.ndarray) -> bool:
         a_end, b_end = len(links[a]) == 1, len(links[b]) == 1
         if a_end == b_end:
             continue  # end to end (a line) or junction to junction
-        junction = b if a_end else a
-        if len(path) - 1 < SPUR_LENGTH * max(float(radius.reshape(-1)[junction]), 1.5):
+        junction, end = (b, a) if a_end else (a, b)
+        w = skel.shape[1]
+        reach = np.hypot(junction % w - end % w, junction // w - end // w) + float(radius.reshape(-1)[end])
+        if reach <= SPUR_LENGTH * max(float(radius.reshape(-1)[junction]), 1.5):
             flat[[q for q in path if q not in junction_of]] = False
             removed = True
     return removed
