@@ -60,6 +60,9 @@ LINE_TOLERANCE = 1.0
 # Smoothing (sigma, pixels) of a centerline before its fit (at least; the trace's
 # `smoothing` if larger).
 SMOOTHING = 2.0
+# A closed centerline within this many pixels of an ellipse is one (the fills' 0.35 is
+# for edges placed from the anti-aliasing; a centerline's points wobble more).
+ELLIPSE_TOLERANCE = 0.75
 CAPS = ("round", "butt", "square")
 JOINS = ("round", "miter", "bevel")
 
@@ -363,7 +366,7 @@ def fitted_strokes(chains, radius: np.ndarray, ink: np.ndarray, color: str, s: T
         fitted = fit_outlines(loops, s.tolerance, s.corner_angle, s.smoothing, CORNER_REACH)
         for c, loop, segs in zip(smooth, loops, fitted):
             outline = straightened(segs, s.lines) if s.lines > 0 else None
-            shape = as_primitive(loop, outline, s.lines, 0.35) if outline is not None and s.primitives else None
+            shape = as_primitive(loop, outline, s.lines, ELLIPSE_TOLERANCE) if outline is not None and s.primitives else None
             if shape is not None:
                 numbers = dict(zip(shape.attributes, fmt_many(list(shape.attributes.values()), DECIMALS)))
                 out.append(Stroke(shape.tag, numbers, 4, widths[id(c)], color))
