@@ -36,7 +36,12 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     # worth ~2 dB on photos).
     backdrop = [s.fill.color for s in scene.shapes[:1]
                 if isinstance(s.geometry, Rect) and isinstance(s.fill, Solid)]
+    hooks = ()
+    if settings.style != "fills":  # strokes' cubics kept from folding back (vecfit/fitting/tame.py)
+        from vecfit.fitting.tame import tame_stroke_cubics
+        hooks = (tame_stroke_cubics,)
     return fit_and_write(scene, traced.document, target, config, outputs, progress, keep_alpha=backdrop, generated=True,
+                         hooks=hooks,
                          inputs={"command": "trace", "target": str(target_path), "orientation": orientation,
                                  "style": settings.style,
                                  "trace": {"paths": traced.paths, "segments": traced.segments,
