@@ -63,7 +63,16 @@ SMOOTHING = 2.0
 # A closed centerline within this many pixels of an ellipse is one (the fills' 0.35 is
 # for edges placed from the anti-aliasing; a centerline's points wobble more).
 ELLIPSE_TOLERANCE = 0.75
-CAPS = ("round", "butt", "square")
+# Coverage below this is paper (a scan's noise; 0.03 noise sigma, JPEG ringing).
+NOISE_FLOOR = 0.12
+# A background or ink colour within this of pure white or black (each channel) is that:
+# paper and ink of a scan or a photo of a drawing come out a shade off (noise clipped at
+# white and black, JPEG), where a designer's are pure.
+SNAP = 0.04
+CAPS = ("round", "butt", "square")  # (the first of each is the default)
+# Another cap or join is chosen where its render's squared error is this share of the
+# default's or less.
+CLEARLY_BETTER = 0.8
 JOINS = ("round", "miter", "bevel")
 
 
@@ -79,6 +88,16 @@ class Stroke:
 
 # ---------------------------------------------------------------------- colours
 
+def snapped(rgb: np.ndarray) -> np.ndarray:
+    """Colours [..., 3] within SNAP of white or black made white or black."""
+    rgb = np.array(rgb, np.float64)
+    white = (rgb >= 1 - SNAP).all(-1)
+    black = (rgb <= SNAP).all(-1)
+    rgb[white] = 1.0
+    rgb[black] = 0.0
+    return rgb
+
+
 def border_color(rgb: np.ndarray, alpha: np.ndarray) -> np.ndarray | None:
     """The median colour of the image's border pixels; None where the border is mostly
     transparent (then the background is transparency)."""
@@ -86,7 +105,7 @@ def border_color(rgb: np.ndarray, alpha: np.ndarray) -> np.ndarray | None:
     border_alpha = np.concatenate([alpha[0], alpha[-1], alpha[:, 0], alpha[:, -1]])
     if np.mean(border_alpha >= OPAQUE) < 0.5:
         return None
-    return np.median(border[border_alpha >= OPAQUE], axis=0)
+    return snapped(np.median(border[border_alpha >= OPAQUE], axis=0))
 
 
 def ink_colors(rgb: np.ndarray, ink: np.ndarray, lab: np.ndarray, colors: int, seed: int) -> np.ndarray:
@@ -121,7 +140,7 @@ def ink_colors(rgb: np.ndarray, ink: np.ndarray, lab: np.ndarray, colors: int, s
     pixels_rgb, pixels_lab = rgb[chosen], lab[chosen]
     centres_lab = np.array([c for c, _ in kept])
     nearest = np.argmin(((pixels_lab[:, None, :] - centres_lab[None]) ** 2).sum(-1), 1)
-    return np.array([pixels_rgb[nearest == i].mean(0) for i in range(len(kept))])
+    return snapped(np.array([pixels_rgb[nearest == i].mean(0) for i in range(len(kept))]))
 
 
 def coverage(rgb: np.ndarray, background: np.ndarray, inks: np.ndarray):
@@ -280,9 +299,11 @@ def centred(points: np.ndarray, closed: bool, ink: np.ndarray, radius: float) ->
     reach = radius + 2.5
     offsets = np.arange(-reach, reach + 1e-9, 0.5)
     profile = _sample(ink, points[:, None, :] + offsets[None, :, None] * normal[:, None, :])
+    # a clean profile crosses one line: no ink at its two ends (beyond a scan's noise)
+    clean = (profile[:, :2].max(1) < NOISE_FLOOR * 2) & (profile[:, -2:].max(1) < NOISE_FLOOR * 2)
+    profile = np.where(profile < NOISE_FLOOR, 0.0, profile)  # noise in the paper adds no width
     mass = profile.sum(1) * 0.5
-    # a clean profile crosses one line: no ink at its two ends
-    clean = (profile[:, :2].max(1) < 0.05) & (profile[:, -2:].max(1) < 0.05) & (mass > 0.5)
+    clean &= mass > 0.5
     if not clean.any():
         return points, None
     width = float(np.median(mass[clean]))
@@ -432,9 +453,17 @@ def _choose_caps(strokes: list[Stroke], w: int, h: int, background, image: np.nd
         target = image[..., :3] * image[..., 3:] + under * (1 - image[..., 3:])
         return float(((rgb - target) ** 2).sum())
 
+    # round unless another is clearly better: thinning leaves ends and acute corners short
+    # of where they are, which a square cap or a miter covers at first, and the refinement
+    # then moves them out (a miter's spike and a square's corners overshoot)
+    def best(options, err):
+        errors = {o: err(o) for o in options}
+        choice = min(errors, key=errors.get)
+        return choice if errors[choice] < CLEARLY_BETTER * errors[options[0]] else options[0]
+
     has_ends = any(st.tag == "path" and not st.geometry["d"].rstrip().lower().endswith("z") for st in strokes)
-    cap = min(CAPS, key=lambda c: error(c, "round")) if has_ends else "round"
-    join = min(JOINS, key=lambda j: error(cap, j))
+    cap = best(CAPS, lambda c: error(c, "round")) if has_ends else "round"
+    join = best(JOINS, lambda j: error(cap, j))
     return cap, join
 
 
