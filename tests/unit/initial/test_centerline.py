@@ -154,3 +154,18 @@ def test_no_line_work_gives_the_fills_trace_and_a_warning():
 def test_bad_style_settings_are_refused(changes, word):
     with pytest.raises(VecfitError, match=word):
         trace_image(np.ones((16, 16, 3), np.float32), TraceSettings.defaults(**changes))
+
+
+def test_mixed_draws_areas_as_fills_under_their_outlines_without_a_warning():
+    image = drawn('<circle cx="64" cy="64" r="40" fill="#f0c020" stroke-width="5"/>'
+                  '<path d="M44 80 Q64 96 84 80" stroke-width="4"/>')
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", VecfitWarning)
+        result = trace_image(image, TraceSettings.defaults(style="mixed"))
+    found = strokes_of(result.svg)
+    filled = [f for f in found if f.get("fill", "#") != "none"]
+    stroked = [f for f in found if f.get("fill") == "none"]
+    assert len(stroked) == 2 and len(filled) >= 1
+    yellow = [f for f in filled if f["fill"].lower().startswith("#f")]
+    assert yellow, result.svg  # the face, run on under its outline
+    assert psnr(rendered(result.svg), image[..., :3]) > 24

@@ -43,8 +43,8 @@ INK_CONTRAST = 20.0
 # Ink colours closer than this (CIELAB) are one ink.
 SAME_INK = 18.0
 # A piece is line work where its strokes, drawn at their widths, cover at least this share
-# of it and cover little outside it (intersection over union).
-MIN_COVER = 0.7
+# of it and at most 1 - this share of what they draw is outside it (each within a pixel).
+MIN_COVER = 0.85
 # Pieces of ink smaller than this many pixels are specks.
 MIN_PIECE = 12
 # Centerlines shorter than this (pixels) are dots: drawn as a round-capped stroke of no length.
@@ -526,7 +526,8 @@ def trace_strokes(image: np.ndarray, settings: TraceSettings, progress=None) -> 
     # the pixels the strokes draw (with their anti-aliased rims), taken out of the image
     # handed to the fills
     drawn = cv2.dilate(stroked.astype(np.uint8), np.ones((5, 5), np.uint8)) > 0
-    drawn &= ~cv2.dilate(left_over.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+    if s.style == "strokes":  # (mixed paints the lines over from their surroundings, areas included)
+        drawn &= ~cv2.dilate(left_over.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
     warnings_given = []
     thick = int(left_over.sum())
     if not strokes:
@@ -543,10 +544,14 @@ def trace_strokes(image: np.ndarray, settings: TraceSettings, progress=None) -> 
         return dataclasses.replace(result, seconds=time.perf_counter() - start, warnings=warnings_given)
     if thick >= max(MIN_PIECE, s.min_area) or (s.style == "mixed" and background is None and thick):
         rest = image.copy()
-        if s.style == "mixed":  # the areas run on under the lines
-            fill_in = cv2.inpaint(np.clip(rest[..., :3] * 255, 0, 255).astype(np.uint8),
-                                  drawn.astype(np.uint8), 3, cv2.INPAINT_TELEA)
-            rest[drawn, :3] = fill_in[drawn] / 255.0
+        if s.style == "mixed":  # the areas run on under the lines: each drawn pixel takes
+            # the colour of the nearest pixel not drawn (flat, as the areas are; inpainting's
+            # gradients came back as specks)
+            _, nearest = cv2.distanceTransformWithLabels(drawn.astype(np.uint8), cv2.DIST_L2, 3,
+                                                         labelType=cv2.DIST_LABEL_PIXEL)
+            outside = np.flatnonzero(~drawn.reshape(-1))  # label k: the k-th pixel not drawn
+            source = outside[np.clip(nearest[drawn] - 1, 0, len(outside) - 1)]
+            rest[drawn] = rest.reshape(-1, 4)[source]
         elif background is None:
             rest[drawn, 3] = 0
         else:
@@ -577,5 +582,9 @@ def _fits(chains, piece: np.ndarray, radius: np.ndarray, origin, widest: float) 
         return False
     local = [dataclasses.replace(c, points=c.points - origin) for c in chains]
     drawn = drawn_mask(local, radius)
-    union = int((drawn | piece).sum())
-    return union > 0 and int((drawn & piece).sum()) / union >= MIN_COVER
+    # judged a pixel either way: a thin line's width is rounded to whole pixels here
+    near_drawn = cv2.dilate(drawn.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+    near_piece = cv2.dilate(piece.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+    covered = (piece & near_drawn).sum() / max(int(piece.sum()), 1)
+    spilled = (drawn & ~near_piece).sum() / max(int(drawn.sum()), 1)
+    return covered >= MIN_COVER and spilled <= 1 - MIN_COVER
