@@ -567,10 +567,14 @@ def trace_strokes(image: np.ndarray, settings: TraceSettings, progress=None) -> 
             outside = np.flatnonzero(~drawn.reshape(-1))  # label k: the k-th pixel not drawn
             source = outside[np.clip(nearest[drawn] - 1, 0, len(outside) - 1)]
             rest[drawn] = rest.reshape(-1, 4)[source]
-        elif background is None:
-            rest[drawn, 3] = 0
+        # what the fills trace: the ink left over, its rims, and (mixed) the lines' pixels
+        # painted over; the rest is paper (a scan's noise in it came back as a thousand specks)
+        keep = cv2.dilate(left_over.astype(np.uint8), np.ones((5, 5), np.uint8)).astype(bool)
+        paper = ~(keep | drawn) if s.style == "mixed" else ~keep | drawn
+        if background is None:
+            rest[paper, 3] = 0
         else:
-            rest[drawn, :3] = background
+            rest[paper, :3] = background
         traced = trace_image(rest, fills_settings)
         document, paths, segments, colors = traced.document, traced.paths, traced.segments, traced.colors
     else:
