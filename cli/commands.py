@@ -441,13 +441,16 @@ def refine(target, init_svg, output, report, comparison, config_file, quiet, **o
 @click.option("--min-area", type=click.FloatRange(min=0), help="Speckle removal: smallest region (pixels).")
 @click.option("--tolerance", type=click.FloatRange(min=0, min_open=True),
               help="Largest curve-fitting error (pixels).")
+@click.option("--style", type=click.Choice(["fills", "strokes", "mixed"]),
+              help="fills: filled outlines; strokes: line work as stroked centerlines; mixed: "
+                   "fills for areas, strokes for line work.  [default: fills]")
 @click.option("--refine/--no-refine", default=True, show_default=True,
               help="Refine the trace against the image (else write the trace as it is).")
 @click.option("--remove-background", is_flag=True, default=None,
               help="Leave the border's flat colour (or --background's) out: the SVG is transparent there.")
 @optimize_options
 @colour_options
-def trace(target, preset, paths, colors, min_area, tolerance, refine, remove_background, output, report,
+def trace(target, preset, paths, colors, min_area, tolerance, style, refine, remove_background, output, report,
           comparison, config_file, quiet, **options):
     """Trace TARGET into an SVG (colour regions fitted with cubic curves), then refine it."""
     from vecfit.jobs.protocol import Inputs
@@ -455,7 +458,7 @@ def trace(target, preset, paths, colors, min_area, tolerance, refine, remove_bac
     if not refine:
         options["iterations"] = 0  # the trace written as it is
     config = _resolve_config("trace", preset, config_file, options, extra={"trace": {
-        "paths": paths, "colors": colors, "min_area": min_area, "tolerance": tolerance,
+        "paths": paths, "colors": colors, "min_area": min_area, "tolerance": tolerance, "style": style,
         "remove_background": remove_background or None}})
     if config["optimize"]["iterations"] > 0:
         _import_torch_holding_ctrl_c()  # (a trace written as it is needs no torch)
@@ -540,6 +543,8 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
 @click.option("--preset", help="A preset of the mode's file in configs/.")
 @click.option("--effort", type=click.Choice(["quick", "normal", "best"]),
               help="Every image's effort (as the mode's --effort).  [default: normal]")
+@click.option("--style", type=click.Choice(["fills", "strokes", "mixed"]),
+              help="trace: every image's style (as trace's --style).")
 @click.option("--init-dir", type=click.Path(exists=True, file_okay=False),
               help="refine, edit: the folder of the SVGs (default: IN_DIR).")
 @click.option("-j", "--jobs", type=click.IntRange(min=0), default=1, show_default=True,
@@ -558,7 +563,7 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
 @click.option("--remove-background", is_flag=True, help="trace: leave the border's flat colour out.")
 @colour_options
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar or per-image lines.")
-def batch(in_dir, out_dir, mode, width, height, config_file, preset, effort, init_dir, jobs, threads,
+def batch(in_dir, out_dir, mode, width, height, config_file, preset, effort, style, init_dir, jobs, threads,
           resume, scheduler, device, output_format, remove_background, palette, group_by, quiet):
     """Run refine, trace, paint or edit on every image in IN_DIR (*.png, *.jpg, *.jpeg,
     *.bmp, *.tif, *.tiff, *.webp; not recursive), or retarget on every SVG there (*.svg,
@@ -587,7 +592,7 @@ def batch(in_dir, out_dir, mode, width, height, config_file, preset, effort, ini
                                effort=effort, jobs=jobs, threads=threads, resume=resume, init_dir=init_dir,
                                scheduler=scheduler, reporter=reporter, device=device,
                                width=width, height=height, format=output_format, palette=palette,
-                               group_by=group_by, remove_background=remove_background)
+                               group_by=group_by, remove_background=remove_background, style=style)
         except BatchUsageError as e:
             _echo_err(f"error: {e}")
             sys.exit(EXIT_USAGE)

@@ -45,7 +45,8 @@ def available_cores() -> int:
 
 
 def resolve_config(mode: str, preset: str | None = None, config_file=None, device: str | None = None,
-                   size: dict | None = None, effort: str | None = None, colours: dict | None = None) -> dict:
+                   size: dict | None = None, effort: str | None = None, colours: dict | None = None,
+                   style: str | None = None) -> dict:
     """The command's settings (vecfit.jobs.config.resolve, which also checks the values, the
     device included); BatchUsageError when they are bad. size: retarget's width / height;
     effort: quick, normal or best (None: the config file's, else normal)."""
@@ -63,6 +64,10 @@ def resolve_config(mode: str, preset: str | None = None, config_file=None, devic
         if mode != "trace":
             raise BatchUsageError("--remove-background is for --mode trace")
         overrides["trace"] = {"remove_background": True}
+    if style is not None:  # trace's --style
+        if mode != "trace":
+            raise BatchUsageError(f"--style is trace's, not {mode}'s")
+        overrides.setdefault("trace", {})["style"] = style
     try:
         return resolve(mode, preset=preset, config_file=config_file, overrides=overrides, effort=effort)
     except VecfitError as e:
@@ -131,7 +136,7 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
               reporter=None, device: str | None = None, width: str | None = None,
               height: str | None = None, effort: str | None = None, format: str = "svg",
               palette: str | None = None, group_by: str | None = None,
-              remove_background: bool = False) -> BatchResult:
+              remove_background: bool = False, style: str | None = None) -> BatchResult:
     """Runs ``mode`` (refine, trace, paint, edit) on every image directly in ``in_dir``, or
     retarget on every SVG there (to ``width`` and/or ``height``: pixels or a percentage), writing
     NAME.svg, NAME.report.json and NAME.compare.png per image and the summary into
@@ -180,7 +185,7 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
     if jobs < 0 or (threads is not None and threads < 1):
         raise BatchUsageError("jobs must be >= 0 and threads >= 1")
     config = resolve_config(mode, preset, config_file, device, size, effort,
-                            {"palette": palette, "group_by": group_by, "remove_background": remove_background})
+                            {"palette": palette, "group_by": group_by, "remove_background": remove_background}, style)
     if scheduler is not None and client is None:
         from .execute import connect
         try:

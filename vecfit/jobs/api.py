@@ -23,8 +23,11 @@ def _run(command: str, inputs: Inputs, output, settings, preset, config_file, pr
 
 
 def trace(image, *, output=None, settings: dict | None = None, effort: str | None = None,
-          preset: str | None = None, config_file=None, progress=None) -> tuple[str, dict]:
-    """`vecfit trace` from Python: (SVG text, report)."""
+          preset: str | None = None, config_file=None, progress=None, style: str | None = None) -> tuple[str, dict]:
+    """`vecfit trace` from Python: (SVG text, report). ``style``: "fills", "strokes" or
+    "mixed" (the command's ``--style``; None: the settings')."""
+    if style is not None:
+        settings = {**(settings or {}), "trace": {**(settings or {}).get("trace", {}), "style": style}}
     return _run("trace", Inputs(image=image), output, settings, preset, config_file, progress, effort)
 
 

@@ -54,11 +54,22 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     # worth ~2 dB on photos).
     backdrop = [s.fill.color for s in scene.shapes[:1]
                 if isinstance(s.geometry, Rect) and isinstance(s.fill, Solid)]
+    hooks = ()
+    if settings.style != "fills":
+        # strokes' cubics kept from folding back (vecfit/fitting/tame.py); the traced inks and
+        # paper (flat, snapped to black and white) kept: refined against a scan, they took
+        # its blur and noise (paper #fafafa, ink 3% translucent: 1.5 dB of 28 on a scan)
+        from vecfit.fitting.tame import tame_stroke_cubics
+        hooks = (tame_stroke_cubics,)
+        config = {**config, "optimize": {**config["optimize"], "alpha": "fixed",
+                                         "lr": {**config["optimize"]["lr"], "colors": 0.0}}}
     return fit_and_write(scene, traced.document, target, config, outputs, progress, keep_alpha=backdrop, generated=True,
-                         removed_background=removed,
+                         removed_background=removed, hooks=hooks,
                          inputs={"command": "trace", "target": str(target_path), "orientation": orientation,
+                                 "style": settings.style,
                                  "trace": {"paths": traced.paths, "segments": traced.segments,
-                                           "colors": traced.colors, "seconds": traced.seconds},
+                                           "colors": traced.colors, "seconds": traced.seconds,
+                                           "strokes": traced.strokes, "warnings": traced.warnings},
                                  **({} if removed is None else {"removed_background": hex_color(removed)})})
 
 

@@ -3,10 +3,13 @@ from __future__ import annotations
 
 import math
 import numbers
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 
 from vecfit.errors import VecfitError
 from vecfit.io.configs import defaults
+
+
+STYLES = ("fills", "strokes", "mixed")
 
 
 @dataclass
@@ -57,6 +60,13 @@ class TraceSettings:
     """Leave the image's flat background out of the SVG (the border's dominant colour, or
     [optimize] background): no shape covers it, and shapes are fitted against it as
     against transparency (background.py; the trace job)."""
+    style: str
+    """fills: every region a filled outline; strokes: line work as stroked paths along its
+    centerline (centerline.py), fills only where no stroke fits; mixed: fills for areas and
+    strokes for the line work over them."""
+    max_stroke: float
+    """strokes, mixed: the widest line traced as a stroke, as a fraction of the image's
+    shorter side (thicker ink is traced as fills)."""
     seed: int
     """Seed of the k-means sampling and initialisation: equal seeds give equal output."""
 
@@ -74,6 +84,8 @@ class TraceResult:
     colors: int       # number of distinct fill colours (the background's included)
     segments: int     # their segments (lines and curves; a rect, circle or ellipse counts 4)
     seconds: float
+    strokes: int = 0  # of the paths, those drawn as strokes (--style strokes, mixed)
+    warnings: list = field(default_factory=list)  # what the trace warned of (VecfitWarning)
 
     @property
     def svg(self) -> str:
@@ -87,7 +99,11 @@ def check_settings(s: TraceSettings) -> None:
     def bad(name, why):
         raise VecfitError(f"trace setting {name}={getattr(s, name)!r}: {why}")
 
+    if s.style not in STYLES:
+        bad("style", "must be one of " + ", ".join(STYLES))
     for f in fields(s):
+        if f.name == "style":
+            continue
         v = getattr(s, f.name)
         if isinstance(v, bool) != (f.type in ("bool", bool)):
             bad(f.name, "must be " + ("true or false" if f.type in ("bool", bool) else "a number"))
@@ -109,5 +125,7 @@ def check_settings(s: TraceSettings) -> None:
     for name in ("blur", "overlap", "smoothing", "lines"):
         if getattr(s, name) < 0:
             bad(name, "must not be negative")
+    if not 0 < s.max_stroke <= 1:
+        bad("max_stroke", "must be in (0, 1]")
     if s.seed < 0:
         bad("seed", "must not be negative")

@@ -87,6 +87,9 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     settings = TraceSettings.defaults() if settings is None else settings
     check_settings(settings)
     image = check_image(image)
+    if settings.style != "fills":  # line work as strokes (fills where they do not fit)
+        from .centerline import trace_strokes
+        return trace_strokes(image, settings, progress)
     s = settings
     report = progress or (lambda stage, fraction: None)
     h, w = image.shape[:2]

@@ -1,0 +1,171 @@
+"""--style strokes (vecfit/initial/tracer/centerline.py, skeleton.py): drawn stroke patterns,
+rendered, traced back as stroked paths of the right number, width and place."""
+from __future__ import annotations
+
+import hashlib
+import re
+import warnings
+
+import cv2
+import numpy as np
+import pytest
+
+import vecfit
+from vecfit import VecfitError
+from vecfit.errors import VecfitWarning
+from vecfit.initial.tracer import TraceSettings, trace_image
+from vecfit.initial.tracer.skeleton import centerlines
+
+SIZE = 128
+
+
+def drawn(elements: str, size: int = SIZE) -> np.ndarray:
+    """The stroked elements rendered over white by vecfit: float RGBA [H, W, 4]."""
+    svg = (f'<svg xmlns="http://www.w3.org/2000/svg" width="{size}" height="{size}">'
+           f'<g fill="none" stroke="#202020" stroke-linecap="round" stroke-linejoin="round">{elements}</g></svg>')
+    scene = vecfit.load_svg(_write(svg))
+    return vecfit.render(scene, size, size, samples=4, background=(1, 1, 1, 1)).numpy()
+
+
+def _write(svg: str):
+    import tempfile
+    from pathlib import Path
+    path = Path(tempfile.mkdtemp()) / "drawn.svg"
+    path.write_text(svg)
+    return path
+
+
+def rendered(svg: str, size: int = SIZE) -> np.ndarray:
+    scene = vecfit.load_svg(_write(svg))
+    rgba = vecfit.render(scene, size, size, samples=4, background=(1, 1, 1, 1)).numpy()
+    return rgba[..., :3]
+
+
+def psnr(a, b) -> float:
+    return float(10 * np.log10(1 / max(float(((a - b) ** 2).mean()), 1e-12)))
+
+
+def strokes_of(svg: str) -> list[dict]:
+    """The stroked elements' attributes."""
+    out = []
+    for m in re.finditer(r"<(path|circle|ellipse|rect)\b([^>]*)>", svg):
+        attrs = dict(re.findall(r'([\w-]+)="([^"]*)"', m.group(2)))
+        if attrs.get("id") == "vecfit-background":
+            continue
+        out.append({"tag": m.group(1), **attrs})
+    return out
+
+
+def traced(elements: str, **settings):
+    image = drawn(elements)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", VecfitWarning)  # line work: no fallback warning
+        result = trace_image(image, TraceSettings.defaults(style="strokes", **settings))
+    return image, result
+
+
+@pytest.mark.parametrize("elements, count, width, tag", [
+    ('<path d="M20 30 L108 90" stroke-width="8"/>', 1, 8, "path"),                 # a line
+    ('<path d="M25 20 V100 H105" stroke-width="6"/>', 1, 6, "path"),               # an L: one path, a corner
+    ('<circle cx="64" cy="64" r="38" stroke-width="7"/>', 1, 7, "circle"),         # a circle
+    ('<path d="M20 30 H108 M64 30 V110" stroke-width="8"/>', 2, 8, "path"),        # a T: bar and stem
+    ('<rect x="25" y="30" width="80" height="60" stroke-width="5"/>', 1, 5, "path"),  # a closed outline
+])
+def test_stroke_patterns_come_back_as_strokes(elements, count, width, tag):
+    image, result = traced(elements)
+    found = strokes_of(result.svg)
+    assert len(found) == count, result.svg
+    assert result.strokes == count and result.paths == count
+    for f in found:
+        assert f["fill"] == "none" and f["stroke"].startswith("#")
+        assert abs(float(f["stroke-width"]) - width) < 0.6, f
+    assert found[0]["tag"] == tag
+    # the trace as it is (not refined) draws the picture closely
+    assert psnr(rendered(result.svg), image[..., :3]) > 24
+
+
+def test_a_closed_outline_closes_and_an_open_line_does_not():
+    _, rect = traced('<rect x="25" y="30" width="80" height="60" stroke-width="5"/>')
+    _, line = traced('<path d="M20 30 L108 90" stroke-width="8"/>')
+    assert strokes_of(rect.svg)[0]["d"].rstrip().lower().endswith("z")
+    assert not strokes_of(line.svg)[0]["d"].rstrip().lower().endswith("z")
+
+
+def test_lines_of_two_colours_are_two_inks():
+    image = drawn('<path d="M20 30 H108" stroke-width="6" stroke="#c02020"/>'
+                  '<path d="M20 90 H108" stroke-width="6" stroke="#2040c0"/>')
+    result = trace_image(image, TraceSettings.defaults(style="strokes"))
+    colours = sorted(f["stroke"] for f in strokes_of(result.svg))
+    assert len(colours) == 2
+    reds = [int(c[1:3], 16) for c in colours]
+    assert max(reds) > 150 and min(reds) < 80
+
+
+def test_centerlines_join_straight_through_a_crossing():
+    mask = np.zeros((100, 100), bool)
+    mask[47:54, 10:90] = True
+    mask[10:90, 47:54] = True
+    radius = cv2.distanceTransform(mask.astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+    chains = centerlines(mask, radius)
+    assert len(chains) == 2  # an X of two lines, not four arms
+    for c in chains:
+        span = np.ptp(c.points, axis=0)
+        assert max(span) > 60 and min(span) < 4
+
+
+def test_fills_is_todays_trace_byte_for_byte():
+    # the SHA-256 of main's trace of this picture (before --style existed)
+    img = np.ones((96, 128, 3), np.float32)
+    cv2.circle(img, (40, 50), 25, (0.8, 0.2, 0.1), -1, cv2.LINE_AA)
+    cv2.line(img, (10, 10), (120, 80), (0.1, 0.1, 0.6), 5, cv2.LINE_AA)
+    cv2.rectangle(img, (70, 20), (110, 60), (0.2, 0.7, 0.3), 3, cv2.LINE_AA)
+    for settings in (None, TraceSettings.defaults(style="fills")):
+        svg = trace_image(img, settings).svg
+        assert hashlib.sha256(svg.encode()).hexdigest() == \
+            "a536e4faa96d8ce20137538b901e0d32395cd213fbe6ccf12c20e84496c7f909"
+
+
+def test_thick_shapes_fall_back_to_fills_with_a_warning():
+    image = drawn('<circle cx="64" cy="64" r="30" fill="#202020" stroke="none"/>'
+                  '<path d="M10 120 H118" stroke-width="4"/>')
+    with pytest.warns(VecfitWarning, match="not line work"):
+        result = trace_image(image, TraceSettings.defaults(style="strokes"))
+    found = strokes_of(result.svg)
+    filled = [f for f in found if f.get("fill", "#") != "none"]
+    stroked = [f for f in found if f.get("fill") == "none"]
+    assert len(filled) >= 1 and len(stroked) == 1
+    assert psnr(rendered(result.svg), image[..., :3]) > 24
+
+
+def test_no_line_work_gives_the_fills_trace_and_a_warning():
+    image = np.ones((64, 64, 4), np.float32)
+    image[16:48, 16:48, :3] = (0.2, 0.3, 0.8)  # a block, far thicker than max_stroke
+    with pytest.warns(VecfitWarning, match="no line work"):
+        result = trace_image(image, TraceSettings.defaults(style="strokes", max_stroke=0.1))
+    assert result.paths >= 1 and "<rect" in result.svg or "<path" in result.svg
+    assert psnr(rendered(result.svg, 64), image[..., :3]) > 30
+    with pytest.warns(VecfitWarning, match="no line work"):
+        blank = trace_image(np.ones((32, 32, 3), np.float32), TraceSettings.defaults(style="strokes"))
+    assert "<rect" in blank.svg  # never an empty file
+
+
+@pytest.mark.parametrize("changes, word", [({"style": "lines"}, "style"), ({"max_stroke": 0.0}, "max_stroke"),
+                                           ({"max_stroke": 2.0}, "max_stroke")])
+def test_bad_style_settings_are_refused(changes, word):
+    with pytest.raises(VecfitError, match=word):
+        trace_image(np.ones((16, 16, 3), np.float32), TraceSettings.defaults(**changes))
+
+
+def test_mixed_draws_areas_as_fills_under_their_outlines_without_a_warning():
+    image = drawn('<circle cx="64" cy="64" r="40" fill="#f0c020" stroke-width="5"/>'
+                  '<path d="M44 80 Q64 96 84 80" stroke-width="4"/>')
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", VecfitWarning)
+        result = trace_image(image, TraceSettings.defaults(style="mixed"))
+    found = strokes_of(result.svg)
+    filled = [f for f in found if f.get("fill", "#") != "none"]
+    stroked = [f for f in found if f.get("fill") == "none"]
+    assert len(stroked) == 2 and len(filled) >= 1
+    yellow = [f for f in filled if f["fill"].lower().startswith("#f")]
+    assert yellow, result.svg  # the face, run on under its outline
+    assert psnr(rendered(result.svg), image[..., :3]) > 24
