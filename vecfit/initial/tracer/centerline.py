@@ -452,16 +452,19 @@ def _element(document, stroke: Stroke, cap: str, join: str) -> None:
 
 def _choose_caps(strokes: list[Stroke], w: int, h: int, background, image: np.ndarray) -> tuple[str, str]:
     """The cap and join whose render of the strokes is nearest the image (squared error)."""
-    from vecfit.jobs.fit import generated_scene
+    import warnings
+
     from vecfit.renderer.forward import render_numpy
     from vecfit.scene.arrays import numpy_arrays
+    from vecfit.svg.read import scene_of
 
     def error(cap, join):
         document = new_document(w, h)
         for st in strokes:
             _element(document, st, cap, join)
-        with numpy_arrays():
-            scene = generated_scene(document)
+        with numpy_arrays(), warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # (vecfit's own SVG: nothing to warn of)
+            scene = scene_of(document)
             rgba = render_numpy(scene, w, h, samples=1, threads=1)
         under = np.ones(3) if background is None else background
         rgb = rgba[..., :3] * rgba[..., 3:] + under * (1 - rgba[..., 3:])
