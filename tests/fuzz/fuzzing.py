@@ -18,7 +18,8 @@ rendered, refined and listed by info. Families of the third campaign (issue 41):
 cameras and other programs write them (every EXIF orientation, broken EXIF, 16-bit,
 palette, CMYK, WebP, TIFF, animated GIF, 1 x N, truncated, empty) through every job that
 reads an image; outputs as PDF and DXF (by name or --format, some contradictory) from
-jobs and render, each checked complete. The cases run in a worker
+jobs and render, each checked complete; palettes (lists, files, auto:N, bad ones), colour
+layers, background removal and trace styles. The cases run in a worker
 process that imports vecfit once and calls the command line's main in-process (click's
 runner): starting a Python that imports torch costs 1-2 s a case. The worker is killed
 and restarted after a signal or a time-out, which are recorded as failures.
@@ -533,6 +534,29 @@ def output_format_args(rng: random.Random) -> tuple[list[str], list[str]]:
     return args, ["out.svg", "out.pdf", "out.dxf", "out", "out.report.json", "out.compare.png"]
 
 
+PALETTES = ["#e63946,#f1faee,#1d3557", "auto:3", "auto:1", "auto:0", "auto:-2", "auto:x", "", ",",
+            "#zzzzzz", "red, blue", "#fff", "missing.gpl", "palette.txt", "palette.gpl"]
+
+
+def colour_and_style_args(rng: random.Random, command: str) -> list[str]:
+    """This wave's options (issues 38, 39), valid and not: palettes (lists, files, auto:N,
+    auto:0, bad colours), colour layers, background removal, trace styles."""
+    args = []
+    if rng.random() < 0.5:
+        args += ["--palette", rng.choice(PALETTES)]
+    if rng.random() < 0.3:
+        args += ["--group-by", rng.choice(["colour", "none"])]
+    if command == "trace" and rng.random() < 0.3:
+        args.append("--remove-background")
+    if command == "trace" and rng.random() < 0.4:
+        args += ["--style", rng.choice(["strokes", "mixed", "fills"])]
+    return args
+
+
+PALETTE_FILES = {"palette.txt": b"#ff0000\n00ff00\n  \nblue\n12 34 56\n",
+                 "palette.gpl": b"GIMP Palette\nName: x\n#\n255 0 0 red\n0 0 255\tblue\n"}
+
+
 @dataclass
 class Case:
     index: int
@@ -663,6 +687,9 @@ def _third_campaign_case(rng: random.Random, index: int) -> Case:
                                           f'<circle cx="12" cy="12" r="8" fill="red"/></svg>').encode()}
         args = {"refine": ["refine", name, "init.svg"], "trace": ["trace", name, "--paths", "6"],
                 "paint": ["paint", name, "--paths", "4"], "edit": ["edit", "init.svg", name]}[command]
+        if command != "edit" and rng.random() < 0.4:
+            args += colour_and_style_args(rng, command)
+            files.update(PALETTE_FILES)
         args += ["-o", "out.svg", "--iterations", str(rng.choice([0, 2])), "--max-size", "48", "-q",
                  "--samples", "1", "--threads", "1"]
         return Case(index, "formats", command, args, files, timeout=60,
@@ -683,8 +710,9 @@ def _third_campaign_case(rng: random.Random, index: int) -> Case:
         return Case(index, "outputs", "render", ["render", "in.svg", "-o", f"out.{fmt}"], {"in.svg": svg},
                     timeout=30, outputs=[f"out.{fmt}"])
     args = (["trace", "target.png", "--paths", "5"] if command == "trace" else ["refine", "target.png", "in.svg"])
-    args += [*out_args, "--iterations", str(rng.choice([0, 2])), "-q", "--samples", "1", "--threads", "1"]
-    return Case(index, "outputs", command, args, {"target.png": buf.getvalue(), "in.svg": svg},
+    args += [*out_args, *colour_and_style_args(rng, command), "--iterations", str(rng.choice([0, 2])), "-q",
+             "--samples", "1", "--threads", "1"]
+    return Case(index, "outputs", command, args, {"target.png": buf.getvalue(), "in.svg": svg, **PALETTE_FILES},
                 timeout=60, outputs=outputs)
 
 
