@@ -2,6 +2,7 @@
 #include "scene/tiles.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "common/float_bounds.h"
@@ -102,6 +103,7 @@ struct DrawScratch {
     std::vector<char> full;
     std::vector<int> stamp;
     std::vector<TileRange> item_tiles;
+    std::vector<std::array<float, 4>> stroke_boxes;
     std::vector<std::vector<std::pair<double, int>>> row_crossings;
 };
 
@@ -234,6 +236,16 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
         }
     }
 
+    // Strokes: each piece's box as floats, once (the pieces are 384 bytes each and a long
+    // path's are listed in many tiles: read per listing, they slowed the binning, which
+    // runs one draw on one thread).
+    if (!fill) {
+        scratch.stroke_boxes.resize(d.n_items);
+        for (int k = 0; k < d.n_items; ++k) {
+            const Box& b = sc.stroke_items[d.first_item + k].box;
+            scratch.stroke_boxes[k] = {float_below(b.x0), float_below(b.y0), float_above(b.x1), float_above(b.y1)};
+        }
+    }
     // (room for the draw's items at once: one long path's are most of the bins)
     const size_t needed = items.size() + (size_t)start[w * h];
     if (needed > items.capacity()) items.reserve(std::max(needed, 2 * items.capacity()));
@@ -273,12 +285,12 @@ void bin_path_draw(const PreparedScene& sc, const PreparedDraw& d, int draw_inde
                         crossings.push_back(c);
                     }
                 }
-                else {  // strokes: the piece's heights, read per sample without the piece itself
-                    const StrokeSegment& s = sc.stroke_items[d.first_item + li.item];
-                    li.y0 = float_below(s.box.y0);
-                    li.y1 = float_above(s.box.y1);
-                    li.x0 = float_below(s.box.x0);
-                    li.x1 = float_above(s.box.x1);
+                else {  // strokes: the piece's box, read per sample without the piece itself
+                    const std::array<float, 4>& b = scratch.stroke_boxes[li.item];
+                    li.x0 = b[0];
+                    li.y0 = b[1];
+                    li.x1 = b[2];
+                    li.y1 = b[3];
                 }
                 items.push_back(li);
             }
