@@ -346,6 +346,18 @@ def image_case(rng: random.Random) -> tuple[str, bytes]:
     return "photo.png", encoded(Image.fromarray(photo))
 
 
+def noise_png(index: int, side: int) -> bytes:
+    """A side x side PNG of uniform noise, the same for the same case index: a target that
+    fits nothing well."""
+    import io
+
+    import numpy as np
+    from PIL import Image
+    buf = io.BytesIO()
+    Image.fromarray((np.random.default_rng(index).random((side, side, 3)) * 255).astype(np.uint8)).save(buf, "PNG")
+    return buf.getvalue()
+
+
 # ------------------------------------------------- families from the second campaign
 
 def thin_image(rng: random.Random) -> tuple[str, bytes, int, int]:
@@ -610,16 +622,10 @@ def make_case(seed: int, index: int, seeds: list[Path] | None = None) -> Case:
         return Case(index, "thin", command, args, files, timeout=60,
                     outputs=["out.svg", "out.report.json", "out.compare.png"])
     if roll < 0.19:  # many tiny shapes refined against a small target
-        import io
-
-        import numpy as np
-        from PIL import Image
-        buf = io.BytesIO()
         side = rng.choice([11, 16, 64])
-        Image.fromarray((np.random.default_rng(index).random((side, side, 3)) * 255).astype(np.uint8)).save(buf, "PNG")
         args = ["refine", "target.png", "init.svg", "-o", "out.svg", "--iterations", str(rng.choice([1, 3])), "-q",
                 "--samples", "1", "--threads", "1", "--mode", rng.choice(["mc", "analytic"])]
-        return Case(index, "tiny", "refine", args, {"target.png": buf.getvalue(), "init.svg": tiny_shapes_svg(rng)},
+        return Case(index, "tiny", "refine", args, {"target.png": noise_png(index, side), "init.svg": tiny_shapes_svg(rng)},
                     timeout=60, outputs=["out.svg", "out.report.json", "out.compare.png"])
     if roll < 0.28:  # clip paths, masks and filters: rendered in either mode, listed, refined
         svg = effects_svg(rng)
@@ -627,15 +633,9 @@ def make_case(seed: int, index: int, seeds: list[Path] | None = None) -> Case:
         if command == "info":
             return Case(index, "effects", "info", ["info", "in.svg"], {"in.svg": svg})
         if command == "refine":
-            import io
-
-            import numpy as np
-            from PIL import Image
-            buf = io.BytesIO()
-            Image.fromarray((np.random.default_rng(index).random((32, 32, 3)) * 255).astype(np.uint8)).save(buf, "PNG")
             args = ["refine", "target.png", "in.svg", "-o", "out.svg", "--iterations", "2", "-q", "--samples", "1",
                     "--threads", "1", "--mode", rng.choice(["mc", "analytic"])]
-            return Case(index, "effects", "refine", args, {"target.png": buf.getvalue(), "in.svg": svg},
+            return Case(index, "effects", "refine", args, {"target.png": noise_png(index, 32), "in.svg": svg},
                         timeout=60, outputs=["out.svg", "out.report.json", "out.compare.png"])
         mode = rng.choice(["mc", "analytic"])
         return Case(index, "effects", "render", ["render", "in.svg", "-o", "out.png", "--width", "64", "--mode", mode,
@@ -653,18 +653,12 @@ def make_case(seed: int, index: int, seeds: list[Path] | None = None) -> Case:
             return Case(index, "dashes", "render", ["render", "in.svg", "-o", "out.png", "--width", "64", "--mode", mode,
                                                     "--samples", "1", "--threads", "1"], {"in.svg": svg},
                         timeout=30, outputs=["out.png"])
-        import io
-
-        import numpy as np
-        from PIL import Image
-        buf = io.BytesIO()
-        Image.fromarray((np.random.default_rng(index).random((32, 32, 3)) * 255).astype(np.uint8)).save(buf, "PNG")
         # (the writer keeps attributes it does not change: no NaN or inf words in them,
         # which the oracle would find in out.svg)
         svg = re.sub(rb"\b(nan|inf|infinity)\b", b"1e39", svg, flags=re.I)
         args = ["refine", "target.png", "init.svg", "-o", "out.svg", "--iterations", "2", "-q", "--samples", "1",
                 "--threads", "1", "--mode", mode]
-        return Case(index, "dashes", "refine", args, {"target.png": buf.getvalue(), "init.svg": svg},
+        return Case(index, "dashes", "refine", args, {"target.png": noise_png(index, 32), "init.svg": svg},
                     timeout=60, outputs=["out.svg", "out.report.json", "out.compare.png"])
     kind = "mutation" if roll < 0.6 else "grammar"
     svg = mutated_svg(rng, seeds) if kind == "mutation" else grammar_svg(rng)
@@ -696,12 +690,6 @@ def _third_campaign_case(rng: random.Random, index: int) -> Case:
                     outputs=["out.svg", "out.report.json", "out.compare.png"])
     # an output format: a job's result, or render's conversion, of a hostile SVG
     out_args, outputs = output_format_args(rng)
-    import io
-
-    import numpy as np
-    from PIL import Image
-    buf = io.BytesIO()
-    Image.fromarray((np.random.default_rng(index).random((24, 24, 3)) * 255).astype(np.uint8)).save(buf, "PNG")
     svg = rng.choice([grammar_svg, effects_svg, dashed_svg])(rng)
     svg = re.sub(rb"\b(nan|inf|infinity)\b", b"1e39", svg, flags=re.I)
     command = rng.choice(["trace", "refine", "render"])
@@ -712,7 +700,7 @@ def _third_campaign_case(rng: random.Random, index: int) -> Case:
     args = (["trace", "target.png", "--paths", "5"] if command == "trace" else ["refine", "target.png", "in.svg"])
     args += [*out_args, *colour_and_style_args(rng, command), "--iterations", str(rng.choice([0, 2])), "-q",
              "--samples", "1", "--threads", "1"]
-    return Case(index, "outputs", command, args, {"target.png": buf.getvalue(), "in.svg": svg, **PALETTE_FILES},
+    return Case(index, "outputs", command, args, {"target.png": noise_png(index, 24), "in.svg": svg, **PALETTE_FILES},
                 timeout=60, outputs=outputs)
 
 
