@@ -30,7 +30,7 @@ from vecfit.scene.dashes import dash_pattern
 from vecfit.scene.model import Circle, Ellipse, Scene, Solid
 from vecfit.scene.placement import shape_matrices
 
-from .outline import encloses, f64, flattened, is_dot, num, subpaths, transformed
+from vecfit.scene.outline import encloses, f64, flattened, is_dot, num, subpaths, transformed
 
 MM_PER_PX = 25.4 / 96
 UNITS = {"mm": (4, MM_PER_PX), "in": (1, 1 / 96)}  # $INSUNITS code, drawing units per px

@@ -25,7 +25,7 @@ import numpy as np
 from vecfit.scene.dashes import dash_pattern
 from vecfit.scene.model import ClipPath, LinearGradient, Scene, Solid
 
-from .outline import (Subpath, bbox, encloses, f64, group_chain, is_dot, num, scene_bbox, shape_to, subpaths,
+from vecfit.scene.outline import (Subpath, bbox, encloses, f64, group_chain, is_dot, num, scene_bbox, shape_to, subpaths,
                       transformed, unit_box)
 
 PT_PER_PX = 0.75

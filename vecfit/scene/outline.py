@@ -1,6 +1,8 @@
-"""What both exporters read from a Scene: its floats as float64 NumPy, each shape's
+"""A Scene's shapes as plain outlines, for the passes that read geometry rather than draw
+it (the PDF and DXF exporters, cut-outs): its floats as float64 NumPy, each shape's
 geometry as subpaths of lines and cubics (quadratics raised to cubics, which is exact),
-the matrices from a shape's or a group's own space to another, and bounding boxes."""
+polylines within a tolerance, the matrices from a shape's or a group's own space to
+another, and bounding boxes."""
 from __future__ import annotations
 
 import functools
