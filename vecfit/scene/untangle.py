@@ -72,6 +72,19 @@ def loop_area(segs: list[np.ndarray]) -> float:
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
 
 
+def _speck(loop: list[np.ndarray], tolerance: float, decimals: int | None) -> bool:
+    """Whether a loop fits within ten rounding steps (or tolerances): cut at a crossing,
+    such a loop can round to segments that cross again at every cut, for ever; it is left
+    whole (its area is a hundred steps squared at most: the callers drop it by its area)."""
+    pts = np.concatenate(loop)
+    step = max(tolerance, 10.0 ** -decimals if decimals is not None else 0.0)
+    return float(np.ptp(pts, axis=0).max()) <= 10 * step
+
+
+def _same(a: list[np.ndarray], b: list[np.ndarray]) -> bool:
+    return len(a) == len(b) and all(x.shape == y.shape and np.array_equal(x, y) for x, y in zip(a, b))
+
+
 def simple_loops(segs: list[np.ndarray], tolerance: float, decimals: int | None = None) -> list[list[np.ndarray]]:
     """A closed loop cut at its crossings into loops that do not cross themselves; with
     ``decimals``, each loop's control points rounded to them before it is checked (as the
@@ -82,13 +95,18 @@ def simple_loops(segs: list[np.ndarray], tolerance: float, decimals: int | None 
         if decimals is not None:
             loop = [np.round(c, decimals) for c in loop]
             loop = [c for c in loop if _usable(c)]
-        found = subpath_crossings(*layout_of(loop, True), True, tolerance) if loop else []
+        judged = loop and not _speck(loop, tolerance, decimals)
+        found = subpath_crossings(*layout_of(loop, True), True, tolerance) if judged else []
         if not found or cuts >= MAX_CUTS:
             if loop:
                 done.append(loop)
             continue
         c = found[0]
-        todo.extend(cut_at(loop, c.seg_a, c.t_a, c.seg_b, c.t_b, c.point))
+        pieces = cut_at(loop, c.seg_a, c.t_a, c.seg_b, c.t_b, c.point)
+        if any(_same(piece, loop) for piece in pieces):  # rounding undid the cut: no progress
+            done.append(loop)
+            continue
+        todo.extend(pieces)
         cuts += 1
     return done
 

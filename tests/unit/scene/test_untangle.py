@@ -88,3 +88,15 @@ def test_refine_keeps_the_users_crossing(tmp_path):
     scene = vecfit.load_svg(path)  # (a background rect first: the star leaves the canvas uncovered)
     star = next(i for i, s in enumerate(scene.shapes) if s.source == "star")
     assert crossed_subpaths(scene) == {(star, 0)}
+
+
+def test_a_loop_within_a_few_rounding_steps_is_left_whole_not_cut_for_ever():
+    """Cut at its crossing, a figure-eight a few hundredths of a pixel wide rounds (at 2
+    decimals) to segments that cross again at every cut: it is left whole (the callers
+    drop it by its area); the same figure at full size is still cut in two."""
+    def eight(size):
+        return [np.array([[0, 0], [size, size], [size, -size], [0, 0]], float),
+                np.array([[0, 0], [-size, size], [-size, -size], [0, 0]], float)]
+    from vecfit.scene.untangle import simple_loops
+    assert len(simple_loops(eight(0.03), 1e-4, 2)) == 1
+    assert len(simple_loops(eight(30.0), 1e-4, 2)) == 2
