@@ -4,6 +4,7 @@ back at the designer's number of paths, and the traced file compared with the de
     python benchmarks/roundtrip.py [--sets noto-emoji,fxemoji,flags,logos,devicon,vscode-icons,
                                            fontawesome,tabler] [--limit 10] [--effort quick|normal|best]
                                    [--no-refine] [--rows vecfit,vtracer] [--threads 2]
+                                   [--stacking cutouts [--gap-filler]]
                                    [--json out.json] [--verbose]
 
 The files: the shared real-world corpus (../shared/realworld, its manifest.tsv; sets by name
@@ -18,6 +19,10 @@ white and scored against the target (PSNR, dB, on RGB), and its design_stats com
 the designer's: segments and gzip bytes as multiples of the designer's, colours,
 translucent paints, crossed outlines, paths, and the seconds the tracer took in-process
 (vecfit's first run is preceded by a warm-up trace, so torch's import is not counted).
+
+With --stacking cutouts a row "cutouts" follows vecfit's: the same trace rewritten as pieces
+that do not overlap (vecfit/initial/tracer/cutouts.py, what ``--stacking cutouts`` writes),
+its seconds those of the rewriting alone.
 
 Per set, a table of medians (PSNR, paths, segments x, gzip x, colours, seconds) and sums
 (translucent paints, crossed outlines), the designer's own files first; --verbose adds a
@@ -68,14 +73,20 @@ def png_rgb(png: bytes) -> np.ndarray:
     return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), np.float64) / 255
 
 
-def run_vecfit(png: bytes, paths: int, effort: str, refine: bool, threads: int) -> str:
+def run_vecfit(png: bytes, paths: int, effort: str, refine: bool, threads: int, output: dict | None = None) -> str:
     import vecfit
 
-    settings = {"trace": {"paths": max(1, paths)}, "optimize": {"threads": threads}}
+    settings = {"trace": {"paths": max(1, paths)}, "optimize": {"threads": threads}, "output": output or {}}
     if not refine:
         settings["optimize"]["iterations"] = 0
     svg, _ = vecfit.trace(png, settings=settings, effort=effort if refine else None)
     return svg
+
+
+def run_cutouts(svg: str, width: int, height: int, gap_filler: bool) -> str:
+    from vecfit.initial.tracer.cutouts import cut_out
+
+    return cut_out(svg.encode("utf-8"), (width, height), gap_filler=gap_filler)[0].decode("utf-8")
 
 
 def run_vtracer(png: bytes) -> str:
@@ -160,10 +171,15 @@ def main():
     ap.add_argument("--no-refine", action="store_true", help="vecfit's trace as it is, not refined")
     ap.add_argument("--rows", default=",".join(ROWS), help="vecfit, vtracer (vtracer where importable)")
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--stacking", choices=["stacked", "cutouts"], default="stacked",
+                    help="vecfit's output: stacked shapes, or cut-outs (the stacked row is then added beside)")
+    ap.add_argument("--gap-filler", action="store_true", help="cut-outs: with the gap filler")
     ap.add_argument("--json", type=Path, help="write every file's numbers here")
     ap.add_argument("--verbose", action="store_true", help="a row per file")
     args = ap.parse_args()
     rows = [r for r in args.rows.split(",") if r]
+    if args.stacking == "cutouts" and "vecfit" in rows:  # beside the stacked trace it is cut from
+        rows.insert(rows.index("vecfit") + 1, "cutouts")
     if "vtracer" in rows:
         try:
             import vtracer  # noqa: F401
@@ -194,8 +210,13 @@ def main():
                 for row in rows:
                     start = time.perf_counter()
                     try:
-                        written = (run_vecfit(png, designer["paths"], args.effort, not args.no_refine, args.threads)
-                                   if row == "vecfit" else run_vtracer(png))
+                        if row == "cutouts":  # the stacked row's trace as cut-outs (what --stacking cutouts writes)
+                            written = run_cutouts(stacked, target.shape[1], target.shape[0], args.gap_filler)
+                        else:
+                            written = (run_vecfit(png, designer["paths"], args.effort, not args.no_refine, args.threads)
+                                       if row == "vecfit" else run_vtracer(png))
+                            if row == "vecfit":
+                                stacked = written
                         seconds = time.perf_counter() - start
                         record[row] = {**measure(written, target, folder, designer), "seconds": seconds}
                     except Exception as e:  # one file's failure is reported, not the end of the run

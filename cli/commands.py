@@ -279,6 +279,16 @@ def colour_options(f):
                              "(one colour a line, or a GIMP .gpl), or auto:N (at most N, chosen by the fit).")(f)
 
 
+def stacking_options(f):
+    """--stacking and --gap-filler: trace, refine, paint (vecfit/initial/tracer/cutouts.py)."""
+    f = click.option("--gap-filler", "gap_filler", is_flag=True, default=None,
+                     help="With cut-outs: draw each shared edge first, as a thin stroke, against the "
+                          "seams of renderers that anti-alias each piece on its own.")(f)
+    return click.option("--stacking", type=click.Choice(["stacked", "cutouts"]),
+                         help="stacked: shapes over one another; cutouts: pieces that do not overlap "
+                              "(for cutters and screen printing).  [default: stacked]")(f)
+
+
 def _parse_learning_rates(items) -> dict:
     out = {}
     for item in items:
@@ -303,7 +313,8 @@ def _resolve_config(command, preset, config_file, options, extra=None):
         "background": options["background"], "seed": options["seed"],
         "threads": options["threads"], "device": options["device"],
         "lr": _parse_learning_rates(options["learning_rates"]), "palette": options.get("palette"),
-    }, "output": {"precision": options["precision"], "group_by": options.get("group_by")}, **(extra or {})}
+    }, "output": {"precision": options["precision"], "group_by": options.get("group_by"),
+                  "stacking": options.get("stacking"), "gap_filler": options.get("gap_filler")}, **(extra or {})}
     try:
         return resolve(command, preset=preset, config_file=config_file, overrides=overrides,
                        effort=options["effort"])
@@ -423,6 +434,7 @@ def _summarise(report) -> None:
 @click.argument("init_svg", type=click.Path(dir_okay=False))
 @optimize_options
 @colour_options
+@stacking_options
 def refine(target, init_svg, output, report, comparison, config_file, quiet, **options):
     """Optimise INIT_SVG's control points, colours and stroke widths to match TARGET."""
     from vecfit.jobs.protocol import Inputs
@@ -450,6 +462,7 @@ def refine(target, init_svg, output, report, comparison, config_file, quiet, **o
               help="Leave the border's flat colour (or --background's) out: the SVG is transparent there.")
 @optimize_options
 @colour_options
+@stacking_options
 def trace(target, preset, paths, colors, min_area, tolerance, style, refine, remove_background, output, report,
           comparison, config_file, quiet, **options):
     """Trace TARGET into an SVG (colour regions fitted with cubic curves), then refine it."""
@@ -476,6 +489,7 @@ def trace(target, preset, paths, colors, min_area, tolerance, style, refine, rem
               help="Save the optimisation as frame_NNNNN.png and optimization.gif in this folder.")
 @optimize_options
 @colour_options
+@stacking_options
 def paint(target, paths, kind, preset, frames, output, report, comparison, config_file, quiet,
           **options):
     """Paint TARGET with random strokes or shapes fitted by gradient descent."""
@@ -562,9 +576,11 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
               show_default=True, help="Write each result as NAME.svg, NAME.pdf or NAME.dxf.")
 @click.option("--remove-background", is_flag=True, help="trace: leave the border's flat colour out.")
 @colour_options
+@stacking_options
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar or per-image lines.")
 def batch(in_dir, out_dir, mode, width, height, config_file, preset, effort, style, init_dir, jobs, threads,
-          resume, scheduler, device, output_format, remove_background, palette, group_by, quiet):
+          resume, scheduler, device, output_format, remove_background, palette, group_by, stacking, gap_filler,
+          quiet):
     """Run refine, trace, paint or edit on every image in IN_DIR (*.png, *.jpg, *.jpeg,
     *.bmp, *.tif, *.tiff, *.webp; not recursive), or retarget on every SVG there (*.svg,
     *.svgz; --width and/or --height give the new size), writing NAME.svg, NAME.report.json and
@@ -592,7 +608,8 @@ def batch(in_dir, out_dir, mode, width, height, config_file, preset, effort, sty
                                effort=effort, jobs=jobs, threads=threads, resume=resume, init_dir=init_dir,
                                scheduler=scheduler, reporter=reporter, device=device,
                                width=width, height=height, format=output_format, palette=palette,
-                               group_by=group_by, remove_background=remove_background, style=style)
+                               group_by=group_by, remove_background=remove_background, style=style,
+                               stacking=stacking, gap_filler=gap_filler)
         except BatchUsageError as e:
             _echo_err(f"error: {e}")
             sys.exit(EXIT_USAGE)

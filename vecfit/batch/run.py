@@ -55,11 +55,12 @@ def resolve_config(mode: str, preset: str | None = None, config_file=None, devic
     overrides = {"optimize": {"device": device}}
     if size:
         overrides["retarget"] = size
-    colours = colours or {}  # --palette, --group-by, --remove-background
+    colours = colours or {}  # --palette, --group-by, --remove-background, --stacking, --gap-filler
     if colours.get("palette") is not None:
         overrides["optimize"]["palette"] = colours["palette"]
-    if colours.get("group_by") is not None:
-        overrides["output"] = {"group_by": colours["group_by"]}
+    output = {k: colours[k] for k in ("group_by", "stacking", "gap_filler") if colours.get(k) is not None}
+    if output:
+        overrides["output"] = output
     if colours.get("remove_background"):
         if mode != "trace":
             raise BatchUsageError("--remove-background is for --mode trace")
@@ -136,7 +137,8 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
               reporter=None, device: str | None = None, width: str | None = None,
               height: str | None = None, effort: str | None = None, format: str = "svg",
               palette: str | None = None, group_by: str | None = None,
-              remove_background: bool = False, style: str | None = None) -> BatchResult:
+              remove_background: bool = False, style: str | None = None, stacking: str | None = None,
+              gap_filler: bool | None = None) -> BatchResult:
     """Runs ``mode`` (refine, trace, paint, edit) on every image directly in ``in_dir``, or
     retarget on every SVG there (to ``width`` and/or ``height``: pixels or a percentage), writing
     NAME.svg, NAME.report.json and NAME.compare.png per image and the summary into
@@ -153,8 +155,8 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
     effort: every image's effort, quick, normal or best (configs/: the mode's [efforts]
     tables; default: the config file's, else normal).
     format: what each result is written as, svg, pdf or dxf (NAME.svg, NAME.pdf, NAME.dxf).
-    palette, group_by, remove_background: as the commands' --palette, --group-by and
-    (trace) --remove-background.
+    palette, group_by, remove_background, stacking, gap_filler: as the commands' --palette,
+    --group-by, (trace) --remove-background, --stacking and --gap-filler.
 
     Raises BatchUsageError before any work when the run cannot start."""
     started = time.time()
@@ -185,7 +187,8 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
     if jobs < 0 or (threads is not None and threads < 1):
         raise BatchUsageError("jobs must be >= 0 and threads >= 1")
     config = resolve_config(mode, preset, config_file, device, size, effort,
-                            {"palette": palette, "group_by": group_by, "remove_background": remove_background}, style)
+                            {"palette": palette, "group_by": group_by, "remove_background": remove_background,
+                             "stacking": stacking, "gap_filler": gap_filler}, style)
     if scheduler is not None and client is None:
         from .execute import connect
         try:

@@ -100,6 +100,9 @@ def resolve(command: str, *, preset: str | None = None, config_file=None,
     if overrides:
         settings = merge(settings, _drop_none(overrides), schema, "command line")
     validate(settings)
+    if settings["output"]["stacking"] != "stacked" and command not in ("trace", "refine", "paint"):
+        raise VecfitError(f"output.stacking = cutouts is for trace, refine and paint ({command} keeps the "
+                          "file's own elements)")
     settings["effort"] = effort
     return settings
 
@@ -116,6 +119,12 @@ def validate(settings: dict) -> None:
     parse_palette(settings["optimize"]["palette"])
     if settings["output"]["group_by"] not in ("none", "colour", "color"):
         raise VecfitError(f"output.group_by must be none or colour, not {settings['output']['group_by']!r}")
+    if settings["output"]["stacking"] not in ("stacked", "cutouts"):
+        raise VecfitError(f"output.stacking must be stacked or cutouts, not {settings['output']['stacking']!r}")
+    if settings["output"]["stacking"] == "cutouts" and settings.get("trace", {}).get("style", "fills") != "fills":
+        raise VecfitError("cut-outs are filled pieces: --stacking cutouts needs --style fills")
+    if settings["output"]["gap_filler"] and settings["output"]["stacking"] != "cutouts":
+        raise VecfitError("output.gap_filler (--gap-filler) is for cut-outs (--stacking cutouts)")
     output_precision(settings)
     seed = settings["optimize"]["seed"]
     if "trace" in settings:

@@ -118,6 +118,18 @@ def _render_full(scene, w, h, config):
                       threads=config["threads"], device=config["device"])
 
 
+def _scored(svg: bytes, size: tuple[int, int], target_rgb: np.ndarray, background, opt: dict) -> dict:
+    """The written SVG (cut-outs: not what was optimised) read back, rendered at ``size``
+    and compared with the target: {"psnr", "mse", "ssim"}."""
+    from vecfit.export import scene_of_svg
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        scene, _ = scene_of_svg(svg)
+    rgb = to_rgb(to_numpy(_render_full(scene, size[0], size[1], opt)), background)
+    return {k: v for k, v in compare(rgb, target_rgb).items() if k in ("psnr", "mse", "ssim")}
+
+
 def _not_optimised(scene: Scene, opt: dict) -> Result:
     """The counts the loop would report for 0 iterations (vecfit.fitting.rates.parameter_kinds:
     the kinds with a positive rate and tensors), and its refusal of a scene without any."""
@@ -177,6 +189,12 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     # crossings the user drew stay; those the fit makes (and those a trace's fit gives a
     # sliver's two sides) are cut into simple loops
     drawn_crossed = set() if generated else crossed_subpaths(scene)
+    cutouts = config["output"].get("stacking", "stacked") == "cutouts"
+    if cutouts:  # refused before the work, not after it
+        from vecfit.initial.tracer.cutouts import cutout_problem
+        problem = cutout_problem(scene)
+        if problem is not None:
+            raise VecfitError(f"--stacking cutouts: {document.name}: {problem}")
     if is_tensor(scene.view):
         import torch
         from vecfit.fitting.loop import Settings, Target, optimize
@@ -213,6 +231,12 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     svg_background = background if background is not None and not covered and not drop_background else None
     written = svg_bytes(scene, document, background=svg_background, precision=output_precision(config),
                         pixels=(w, h))
+    cut = None
+    if cutouts:  # the drawing as pieces that do not overlap, scored as written
+        from vecfit.initial.tracer.cutouts import cut_out
+        written, cut = cut_out(written, (w, h), gap_filler=bool(config["output"].get("gap_filler")),
+                               precision=output_precision(config), name=str(document.name))
+        cut = {**cut.as_dict(), **_scored(written, (sw, sh), target_rgb, background, opt)}
     layers = None
     if config["output"].get("group_by", "none") != "none":
         from vecfit.svg.layers import group_by_colour
@@ -247,6 +271,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
                     "iterations": [round(t, 4) for t in result.iteration_seconds]},
         "shapes": len(scene.shapes),
         "untangled_outlines": untangled,  # outlines the fit made cross themselves, cut into simple loops
+        **({} if cut is None else {"cutouts": cut}),  # --stacking cutouts: pieces, chains, and the file's score
         "file": design_stats(written),  # what a designer finds in the SVG written
         **({} if palette is None and layers is None else {"colours": colour_entry(written, palette, layers)}),
         "parameters": {**result.parameters, "total": sum(result.parameters.values())},
