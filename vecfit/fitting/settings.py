@@ -9,9 +9,7 @@ from dataclasses import dataclass, fields
 from vecfit.errors import VecfitError
 from vecfit.io.configs import defaults
 from vecfit.renderer import device as devices
-from vecfit.renderer.options import MODES
-
-LOSSES = ("l2", "l1", "ssim", "pyramid")  # vecfit.fitting.losses implements them
+from vecfit.names import LOSSES, MODES
 ALPHA_MODES = ("auto", "free", "fixed")  # which colours' opacity may change (opacity.py)
 
 PARAMETER_KINDS = ("points", "colors", "stroke_widths", "opacities", "radii", "gradient_points",

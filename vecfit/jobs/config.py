@@ -17,6 +17,7 @@ import dataclasses
 from vecfit.errors import VecfitError
 from vecfit.fitting.settings import Settings  # torch-free: trace --no-refine checks it too
 from vecfit.io.configs import configs_dir, read_toml
+from vecfit.names import EFFORTS
 
 
 def merge(base: dict, changes: dict, schema: dict, source: str, prefix: str = "") -> dict:
@@ -52,7 +53,6 @@ def _checked(value, expected, name: str, source: str):
     return value
 
 
-EFFORTS = ("quick", "normal", "best")
 DEFAULT_EFFORT = "normal"
 
 
