@@ -13,6 +13,7 @@ from pathlib import Path
 import click
 
 from vecfit.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE
+from vecfit.names import EFFORTS, FILTERS, FORMATS, JOBS, LOSSES, MODES, PAINT_KINDS, STYLES
 
 DEVICE_OPTION = dict(metavar="auto|cpu|cuda[:N]",
                      help="Where pixels are shaded: auto (a GPU when vecfit was built with CUDA and "
@@ -110,9 +111,9 @@ def main():
 @click.option("--height", type=click.IntRange(min=1), help="Height in pixels (default: the SVG's).")
 @click.option("--samples", type=click.IntRange(1, 64), default=2, show_default=True,
               help="N: N x N samples per pixel.")
-@click.option("--mode", type=click.Choice(["mc", "analytic"]), default="mc", show_default=True,
+@click.option("--mode", type=click.Choice(MODES), default="mc", show_default=True,
               help="Anti-aliasing: Monte Carlo samples or the analytical prefilter.")
-@click.option("--filter", "filter_", type=click.Choice(["box", "tent", "gaussian", "parabolic", "hann"]), default="box",
+@click.option("--filter", "filter_", type=click.Choice(FILTERS), default="box",
               show_default=True, help="Pixel filter.")
 @click.option("--filter-radius", type=click.FloatRange(min=0.5), default=0.5, show_default=True,
               help="Pixel filter radius in pixels (tent, gaussian).")
@@ -235,7 +236,7 @@ def optimize_options(f):
     options = [
         click.option("-o", "--output", type=click.Path(dir_okay=False),
                      help="Output SVG, or PDF or DXF by its suffix (default: NAME.vecfit.svg next to the target)."),
-        click.option("--format", "output_format", type=click.Choice(["svg", "pdf", "dxf"]),
+        click.option("--format", "output_format", type=click.Choice(FORMATS),
                      help="Write the result as SVG, PDF (print) or DXF (plotters, cutters). "
                           "[default: -o's suffix, else svg]"),
         click.option("--report", type=click.Path(dir_okay=False),
@@ -244,12 +245,12 @@ def optimize_options(f):
                      help="Comparison PNG (default: the output's name + .compare.png)."),
         click.option("--config", "config_file", type=click.Path(dir_okay=False),
                      help="TOML file overriding the defaults in configs/."),
-        click.option("--effort", type=click.Choice(["quick", "normal", "best"]),
+        click.option("--effort", type=click.Choice(EFFORTS),
                      help="quick: a short refinement; normal: the defaults; best: longer "
                           "(configs/: the [efforts] tables).  [default: normal]"),
         click.option("--iterations", "--iters", type=click.IntRange(min=0), help="Adam iterations."),
-        click.option("--loss", type=click.Choice(["l2", "l1", "ssim", "pyramid"]), help="Image loss."),
-        click.option("--mode", type=click.Choice(["mc", "analytic"]),
+        click.option("--loss", type=click.Choice(LOSSES), help="Image loss."),
+        click.option("--mode", type=click.Choice(MODES),
                      help="Anti-aliasing while optimising."),
         click.option("--samples", type=click.IntRange(1, 16), help="N: N x N samples per pixel."),
         click.option("--max-size", type=click.IntRange(min=0),
@@ -453,7 +454,7 @@ def refine(target, init_svg, output, report, comparison, config_file, quiet, **o
 @click.option("--min-area", type=click.FloatRange(min=0), help="Speckle removal: smallest region (pixels).")
 @click.option("--tolerance", type=click.FloatRange(min=0, min_open=True),
               help="Largest curve-fitting error (pixels).")
-@click.option("--style", type=click.Choice(["fills", "strokes", "mixed"]),
+@click.option("--style", type=click.Choice(STYLES),
               help="fills: filled outlines; strokes: line work as stroked centerlines; mixed: "
                    "fills for areas, strokes for line work.  [default: fills]")
 @click.option("--refine/--no-refine", default=True, show_default=True,
@@ -482,7 +483,7 @@ def trace(target, preset, paths, colors, min_area, tolerance, style, refine, rem
 @main.command()
 @click.argument("target", type=click.Path(dir_okay=False))
 @click.option("--paths", type=click.IntRange(min=1), help="Number of strokes or shapes.")
-@click.option("--kind", type=click.Choice(["strokes", "shapes"]),
+@click.option("--kind", type=click.Choice(PAINT_KINDS),
               help="Open cubic strokes or closed filled shapes.")
 @click.option("--preset", help="A preset of configs/paint.toml.")
 @click.option("--frames", type=click.Path(file_okay=False),
@@ -548,16 +549,16 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
 @click.argument("in_dir", type=click.Path(exists=True, file_okay=False))
 @click.option("-o", "--out-dir", required=True, type=click.Path(file_okay=False),
               help="Folder for the outputs and the summary (not IN_DIR).")
-@click.option("--mode", required=True, type=click.Choice(["trace", "refine", "paint", "edit", "retarget"]),
+@click.option("--mode", required=True, type=click.Choice(JOBS),
               help="The command run on each image (retarget: on each SVG).")
 @click.option("--width", metavar="W|P%", help="retarget: the new width, pixels or a percentage (70%).")
 @click.option("--height", metavar="H|P%", help="retarget: the new height (default: unchanged).")
 @click.option("--config", "config_file", type=click.Path(dir_okay=False),
               help="TOML file overriding the defaults in configs/.")
 @click.option("--preset", help="A preset of the mode's file in configs/.")
-@click.option("--effort", type=click.Choice(["quick", "normal", "best"]),
+@click.option("--effort", type=click.Choice(EFFORTS),
               help="Every image's effort (as the mode's --effort).  [default: normal]")
-@click.option("--style", type=click.Choice(["fills", "strokes", "mixed"]),
+@click.option("--style", type=click.Choice(STYLES),
               help="trace: every image's style (as trace's --style).")
 @click.option("--init-dir", type=click.Path(exists=True, file_okay=False),
               help="refine, edit: the folder of the SVGs (default: IN_DIR).")
@@ -572,7 +573,7 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
               help="Run the images on this Dask distributed scheduler (needs the "
                    "'distributed' package; paths must be the same on the workers).")
 @click.option("--device", **DEVICE_OPTION)
-@click.option("--format", "output_format", type=click.Choice(["svg", "pdf", "dxf"]), default="svg",
+@click.option("--format", "output_format", type=click.Choice(FORMATS), default="svg",
               show_default=True, help="Write each result as NAME.svg, NAME.pdf or NAME.dxf.")
 @click.option("--remove-background", is_flag=True, help="trace: leave the border's flat colour out.")
 @colour_options

@@ -1,6 +1,10 @@
 """The resource limits vecfit enforces, in one place (the README's "Limits and
 guarantees" lists them). Inputs past a limit are refused with one line naming it, so that
-no input can make a command crash, hang or take all memory."""
+no input can make a command crash, hang or take all memory.
+
+One limit is the core's alone: groups with opacity nested in each other (each is
+composited as a layer) at most MAX_LAYER_DEPTH deep (csrc/scene/layers.h); prepare_scene
+refuses deeper nesting, and Python keeps no copy of it."""
 
 # Canvas: the root <svg>'s width and height in px. Beyond 1e7 px coordinates lose
 # float32 precision (vecfit.svg.units.LIMIT clamps numbers to the same range); below
@@ -21,9 +25,16 @@ MAX_ELEMENTS = 100_000
 # distances) on 2 cores, the worst case allowed (benchmarks/RESULTS.md).
 MAX_SEGMENTS = 100_000
 
-# Groups with opacity nested in each other (each is composited as a layer); the core's
-# MAX_LAYER_DEPTH in csrc/scene/layers.h.
-MAX_LAYER_DEPTH = 64
+# Elements nested in each other (Python's recursion would fail around 300).
+MAX_NESTING = 200
+
+# Clip paths and masks whose content uses clip paths or masks, ... (each level is a layer
+# of every render); deeper ones are left out, with a warning.
+MAX_EFFECT_NESTING = 16
+
+# Steps run per filter (a filter of thousands would take minutes); a longer filter is left
+# out, with a warning.
+MAX_STEPS = 64
 
 # Target images for refine, trace and paint (and batch): width x height pixels, checked
 # from the header before the pixels are decoded.

@@ -6,7 +6,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 LAYERS = [
-    ["vecfit.errors", "vecfit.limits", "vecfit._core"],
+    ["vecfit.errors", "vecfit.limits", "vecfit.names", "vecfit._core"],
     ["vecfit.io"],                       # files, images, compositing
     ["vecfit.scene"],                    # the Scene and its geometry
     ["vecfit.renderer", "vecfit.svg"],   # drawing it; reading and writing it

@@ -16,10 +16,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from vecfit.jobs.protocol import JOB_MODULES, Inputs, Outputs, same_path
+from vecfit import names
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp")
 SVG_SUFFIXES = (".svg", ".svgz")
-MODES = ("refine", "trace", "paint", "edit", "retarget")
+MODES = names.JOBS  # batch --mode: the job run on each input
 PAIRED = ("refine", "edit")  # modes that pair each image with the SVG of its name
 ON_SVGS = ("retarget",)      # modes whose inputs are the SVGs in IN_DIR, not images
 # The job function of each mode (vecfit.jobs.protocol), as "module:function", imported

@@ -14,6 +14,7 @@ from pathlib import Path
 
 from vecfit.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, VecfitError
 from vecfit.jobs.protocol import same_path
+from vecfit.names import FORMATS
 
 from .plan import FAILED, INTERRUPTED, MODES, NOT_RUN, PAIRED, UNPAIRED, make_plan, result_row
 from .summary import SUMMARY_FILES, THUMBS, count, write_all
@@ -182,8 +183,8 @@ def run_batch(in_dir, out_dir, mode: str, *, config_file=None, preset: str | Non
         raise BatchUsageError("--width and --height are for --mode retarget")
     if mode == "retarget" and not size:
         raise BatchUsageError("--mode retarget needs --width (and/or --height)")
-    if format not in ("svg", "pdf", "dxf"):
-        raise BatchUsageError(f"unknown output format {format!r} (svg, pdf or dxf)")
+    if format not in FORMATS:
+        raise BatchUsageError(f"unknown output format {format!r} (known: {', '.join(FORMATS)})")
     if jobs < 0 or (threads is not None and threads < 1):
         raise BatchUsageError("jobs must be >= 0 and threads >= 1")
     config = resolve_config(mode, preset, config_file, device, size, effort,

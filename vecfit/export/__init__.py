@@ -8,8 +8,7 @@ import warnings
 from pathlib import Path
 
 from vecfit.errors import VecfitError
-
-FORMATS = ("svg", "pdf", "dxf")
+from vecfit.names import FORMATS
 SUFFIXES = {".svg": "svg", ".svgz": "svg", ".pdf": "pdf", ".dxf": "dxf"}
 
 

@@ -7,11 +7,10 @@ import math
 from dataclasses import dataclass, fields
 
 from vecfit.errors import VecfitError
+from vecfit.io.colors import fitting_background
 from vecfit.io.configs import defaults
 from vecfit.renderer import device as devices
-from vecfit.renderer.options import MODES
-
-LOSSES = ("l2", "l1", "ssim", "pyramid")  # vecfit.fitting.losses implements them
+from vecfit.names import LOSSES, MODES
 ALPHA_MODES = ("auto", "free", "fixed")  # which colours' opacity may change (opacity.py)
 
 PARAMETER_KINDS = ("points", "colors", "stroke_widths", "opacities", "radii", "gradient_points",
@@ -39,21 +38,29 @@ class Settings:
     boundary_budget: float  # Monte Carlo boundary samples per image pixel at most (0: no bound)
     dense_outline: float  # control polygon px per image px past which the point rate falls (rates.py)
     dense_points: float  # ... to this rate (px a step) at twice that density
+    max_size: int  # the target downscaled to this longest side to optimise on (0: never)
+    background: str  # auto (the target's corners) | none | a colour (io.colors.fitting_background)
+    eval_samples: int  # N x N samples of the reported metrics and the comparison image
+    palette: str  # the colours written ("" free; vecfit/jobs/palette.py reads it)
     lr: dict
 
     @classmethod
     def defaults(cls, **changes) -> "Settings":
         """configs/refine.toml's [optimize] settings, with ``changes`` (``lr`` replaces the
         whole table of rates)."""
-        return cls.from_config({**defaults("refine", "optimize"), **changes})
+        return cls.from_config({**defaults("refine", "optimize"), **changes}, source="Settings.defaults")
 
     @classmethod
-    def from_config(cls, table: dict) -> "Settings":
-        """From the [optimize] table; its other keys (max_size, background, ...) belong
-        to the job around the loop."""
-        names = {f.name for f in fields(cls)}
-        s = cls(**{k: v for k, v in table.items() if k in names and k != "lr"},
-                lr=dict(table.get("lr", {})))
+    def from_config(cls, table: dict, source: str = "configs/refine.toml") -> "Settings":
+        """From the whole [optimize] table: every key is a field here, and a key that is not
+        (or a field left out) is an error naming ``source`` (the file) and the key."""
+        known = {f.name for f in fields(cls)}
+        unknown, missing = sorted(set(table) - known), sorted(known - set(table) - {"lr"})
+        if unknown or missing:
+            problem = (f"unknown setting 'optimize.{unknown[0]}' (known here: {', '.join(sorted(known))})"
+                       if unknown else f"missing setting 'optimize.{missing[0]}'")
+            raise VecfitError(f"{source}: {problem}")
+        s = cls(**{k: v for k, v in table.items() if k != "lr"}, lr=dict(table.get("lr", {})))
         s.check()
         return s
 
@@ -78,6 +85,12 @@ class Settings:
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
                 raise VecfitError(f"{name} must be a number >= 0, not {value}")
+        if self.max_size < 0:
+            raise VecfitError(f"max_size must be 0 (never downscale) or more, not {self.max_size}")
+        if self.eval_samples < 1:
+            raise VecfitError(f"eval_samples must be at least 1, not {self.eval_samples}")
+        if self.background.strip().lower() != "auto":
+            fitting_background(self.background)
         devices.resolve(self.device)
         for kind, value in self.lr.items():
             if kind not in PARAMETER_KINDS:

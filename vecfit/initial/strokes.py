@@ -21,11 +21,10 @@ import torch
 
 from vecfit.errors import VecfitError
 from vecfit.io.configs import defaults
+from vecfit.names import PAINT_KINDS
 from vecfit.scene import Path as PathGeometry
 from vecfit.svg.document import SvgDocument
 from vecfit.svg.pathdata import format_path_data
-
-PRIMITIVE_KINDS = ("strokes", "shapes")
 
 
 @dataclass
@@ -51,8 +50,8 @@ class PaintSettings:
         return cls(**{**table, **changes})
 
     def check(self) -> None:
-        if self.kind not in PRIMITIVE_KINDS:
-            raise VecfitError(f"kind must be one of {', '.join(PRIMITIVE_KINDS)}, not {self.kind!r}")
+        if self.kind not in PAINT_KINDS:
+            raise VecfitError(f"kind must be one of {', '.join(PAINT_KINDS)}, not {self.kind!r}")
         if self.paths < 1:
             raise VecfitError("paths must be at least 1")
         if self.stroke_segments < 1 or not 1 <= self.shape_segments_min <= self.shape_segments_max:

@@ -16,43 +16,9 @@ import dataclasses
 
 from vecfit.errors import VecfitError
 from vecfit.fitting.settings import Settings  # torch-free: trace --no-refine checks it too
-from vecfit.io.configs import configs_dir, read_toml
+from vecfit.io.configs import configs_dir, merge, packaged, read_toml  # noqa: F401 (configs_dir: for callers)
+from vecfit.names import EFFORTS
 
-
-def merge(base: dict, changes: dict, schema: dict, source: str, prefix: str = "") -> dict:
-    """base updated with changes, each key checked against schema (the defaults)."""
-    out = copy.deepcopy(base)
-    for key, value in changes.items():
-        name = f"{prefix}{key}"
-        if key not in schema:
-            known = ", ".join(sorted(schema))
-            raise VecfitError(f"{source}: unknown setting {name!r} (known here: {known})")
-        expected = schema[key]
-        if isinstance(expected, dict):
-            if not isinstance(value, dict):
-                raise VecfitError(f"{source}: {name} must be a table")
-            out[key] = merge(out.get(key, {}), value, expected, source, name + ".")
-        else:
-            out[key] = _checked(value, expected, name, source)
-    return out
-
-
-def _checked(value, expected, name: str, source: str):
-    if isinstance(expected, bool):
-        ok = isinstance(value, bool)
-    elif isinstance(expected, float):
-        ok = isinstance(value, (int, float)) and not isinstance(value, bool)
-        value = float(value) if ok else value
-    elif isinstance(expected, int):
-        ok = isinstance(value, int) and not isinstance(value, bool)
-    else:
-        ok = isinstance(value, type(expected))
-    if not ok:
-        raise VecfitError(f"{source}: {name} must be {type(expected).__name__}, not {value!r}")
-    return value
-
-
-EFFORTS = ("quick", "normal", "best")
 DEFAULT_EFFORT = "normal"
 
 
@@ -61,11 +27,7 @@ def resolve(command: str, *, preset: str | None = None, config_file=None,
     """The settings of ``command`` (refine, trace, paint, edit, retarget): defaults, its file,
     the effort, a preset, the user's file and the overrides (a nested dict like the files), in
     that order. ``effort`` None: the user's file's top-level ``effort``, else normal."""
-    root = configs_dir()
-    settings = read_toml(root / "refine.toml")
-    efforts = settings.pop("efforts", {})
-    schema = copy.deepcopy(settings)
-    presets: dict = {}
+    settings, schema, efforts, presets = packaged(command)
     user = None if config_file is None else read_toml(config_file)
     if user is not None and "effort" in user:
         chosen = user.pop("effort")
@@ -75,16 +37,7 @@ def resolve(command: str, *, preset: str | None = None, config_file=None,
     effort = DEFAULT_EFFORT if effort is None else effort
     if effort not in EFFORTS:
         raise VecfitError(f"unknown effort {effort!r} (known: {', '.join(EFFORTS)})")
-    if command != "refine":
-        own = read_toml(root / f"{command}.toml")
-        presets = own.pop("presets", {})
-        efforts = own.pop("efforts", {})
-        for key, value in own.items():  # the command's own tables join the schema
-            if key not in schema:
-                if not isinstance(value, dict):
-                    raise VecfitError(f"configs/{command}.toml: {key!r} must be inside a table")
-                schema[key] = copy.deepcopy(value)
-        settings = merge(settings, own, schema, f"configs/{command}.toml")
+    settings = copy.deepcopy(settings)
     if effort != DEFAULT_EFFORT:
         if effort not in efforts:
             raise VecfitError(f"effort {effort!r} is not defined for {command} (configs/{command}.toml "
@@ -109,11 +62,8 @@ def resolve(command: str, *, preset: str | None = None, config_file=None,
 
 def validate(settings: dict) -> None:
     """Checks the values, not just the keys and types: a bad background, loss, rate, trace
-    or paint setting is refused here, before any work starts (VecfitError)."""
-    from vecfit.io.colors import fitting_background
-
-    if settings["optimize"]["background"].strip().lower() != "auto":
-        fitting_background(settings["optimize"]["background"])
+    or paint setting is refused here, before any work starts (VecfitError). [optimize] is
+    checked by its type, Settings."""
     Settings.from_config(settings["optimize"])
     from vecfit.jobs.palette import parse_palette  # an unreadable or empty palette: refused before any work
     parse_palette(settings["optimize"]["palette"])

@@ -16,9 +16,10 @@ from pathlib import Path
 from typing import Callable
 
 from vecfit.errors import VecfitError
+from vecfit.names import JOBS
 
 # The jobs, by command name: each module has run(inputs, config, outputs, progress=None).
-JOB_MODULES = {name: f"vecfit.jobs.{name}" for name in ("refine", "trace", "paint", "edit", "retarget")}
+JOB_MODULES = {name: f"vecfit.jobs.{name}" for name in JOBS}
 
 
 def job_function(name: str) -> Callable[..., dict]:

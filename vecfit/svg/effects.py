@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import re
 
+from vecfit.limits import MAX_STEPS
 from vecfit.scene import Filter, FilterStep
 
 from .color import parse_color
@@ -22,7 +23,6 @@ STEPS = frozenset({"feGaussianBlur", "feOffset", "feFlood", "feColorMatrix", "fe
                    "feBlend", "feDropShadow"})
 _UNSUPPORTED_INPUTS = frozenset({"BackgroundImage", "BackgroundAlpha", "FillPaint", "StrokePaint"})
 COMPOSITE_OPERATORS = frozenset({"over", "in", "out", "atop", "xor", "arithmetic"})
-MAX_STEPS = 64  # steps run per filter (a filter of thousands would take minutes)
 
 
 def func_iri(value) -> str | None:

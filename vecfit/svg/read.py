@@ -54,11 +54,8 @@ DEFAULT_SIZE = 100.0  # resvg's size for a root with neither width/height nor vi
 # take hours and all memory. (Module-level names so that tests can lower them.)
 MAX_ELEMENTS = limits.MAX_ELEMENTS
 MAX_SEGMENTS = limits.MAX_SEGMENTS
-# Elements nested in each other (Python's recursion would fail around 300).
-MAX_NESTING = 200
-# Clip paths and masks whose content uses clip paths or masks, ... (each level is a
-# layer of every render).
-MAX_EFFECT_NESTING = 16
+MAX_NESTING = limits.MAX_NESTING
+MAX_EFFECT_NESTING = limits.MAX_EFFECT_NESTING
 
 
 def load_svg(path) -> Scene:

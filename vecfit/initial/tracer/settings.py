@@ -7,9 +7,7 @@ from dataclasses import dataclass, field, fields
 
 from vecfit.errors import VecfitError
 from vecfit.io.configs import defaults
-
-
-STYLES = ("fills", "strokes", "mixed")
+from vecfit.names import STYLES
 
 
 @dataclass
