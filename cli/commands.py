@@ -13,7 +13,7 @@ from pathlib import Path
 import click
 
 from vecfit.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE
-from vecfit.names import EFFORTS, FILTERS, FORMATS, JOBS, LOSSES, MODES, PAINT_KINDS, STYLES
+from vecfit.names import EFFORTS, FILTERS, FORMATS, JOBS, LOSSES, MODES, PAINT_KINDS, STACKINGS, STYLES
 
 DEVICE_OPTION = dict(metavar="auto|cpu|cuda[:N]",
                      help="Where pixels are shaded: auto (a GPU when vecfit was built with CUDA and "
@@ -285,7 +285,7 @@ def stacking_options(f):
     f = click.option("--gap-filler", "gap_filler", is_flag=True, default=None,
                      help="With cut-outs: draw each shared edge first, as a thin stroke, against the "
                           "seams of renderers that anti-alias each piece on its own.")(f)
-    return click.option("--stacking", type=click.Choice(["stacked", "cutouts"]),
+    return click.option("--stacking", type=click.Choice(list(STACKINGS)),
                          help="stacked: shapes over one another; cutouts: pieces that do not overlap "
                               "(for cutters and screen printing).  [default: stacked]")(f)
 

@@ -28,3 +28,7 @@ PAINT_KINDS = ("strokes", "shapes")
 
 # Styles of trace ([trace] style): filled regions, strokes, or both.
 STYLES = ("fills", "strokes", "mixed")
+
+# How the written shapes lie ([output] stacking): over one another, or as cut-outs that
+# do not overlap (vecfit/initial/tracer/cutouts.py).
+STACKINGS = ("stacked", "cutouts")
