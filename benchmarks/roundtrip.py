@@ -3,7 +3,7 @@ back at the designer's number of paths, and the traced file compared with the de
 
     python benchmarks/roundtrip.py [--sets noto-emoji,fxemoji,flags,logos,devicon,vscode-icons,
                                            fontawesome,tabler] [--limit 10] [--effort quick|normal|best]
-                                   [--no-refine] [--rows vecfit,vtracer] [--threads 2]
+                                   [--no-refine] [--rows vecfit,vtracer] [--threads 2] [--simplify DB]
                                    [--json out.json] [--verbose]
 
 The files: the shared real-world corpus (../shared/realworld, its manifest.tsv; sets by name
@@ -68,10 +68,12 @@ def png_rgb(png: bytes) -> np.ndarray:
     return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), np.float64) / 255
 
 
-def run_vecfit(png: bytes, paths: int, effort: str, refine: bool, threads: int) -> str:
+def run_vecfit(png: bytes, paths: int, effort: str, refine: bool, threads: int, simplify: float | None = None) -> str:
     import vecfit
 
     settings = {"trace": {"paths": max(1, paths)}, "optimize": {"threads": threads}}
+    if simplify is not None:
+        settings["optimize"]["simplify"] = simplify
     if not refine:
         settings["optimize"]["iterations"] = 0
     svg, _ = vecfit.trace(png, settings=settings, effort=effort if refine else None)
@@ -160,6 +162,8 @@ def main():
     ap.add_argument("--no-refine", action="store_true", help="vecfit's trace as it is, not refined")
     ap.add_argument("--rows", default=",".join(ROWS), help="vecfit, vtracer (vtracer where importable)")
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--simplify", type=float, default=None,
+                    help="optimize.simplify, the node pass's budget in dB (0: off; default: trace's)")
     ap.add_argument("--json", type=Path, help="write every file's numbers here")
     ap.add_argument("--verbose", action="store_true", help="a row per file")
     args = ap.parse_args()
@@ -194,7 +198,8 @@ def main():
                 for row in rows:
                     start = time.perf_counter()
                     try:
-                        written = (run_vecfit(png, designer["paths"], args.effort, not args.no_refine, args.threads)
+                        written = (run_vecfit(png, designer["paths"], args.effort, not args.no_refine, args.threads,
+                                              args.simplify)
                                    if row == "vecfit" else run_vtracer(png))
                         seconds = time.perf_counter() - start
                         record[row] = {**measure(written, target, folder, designer), "seconds": seconds}

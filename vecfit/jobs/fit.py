@@ -177,6 +177,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     # crossings the user drew stay; those the fit makes (and those a trace's fit gives a
     # sliver's two sides) are cut into simple loops
     drawn_crossed = set() if generated else crossed_subpaths(scene)
+    simplified = None
     if is_tensor(scene.view):
         import torch
         from vecfit.fitting.loop import Settings, Target, optimize
@@ -194,6 +195,12 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
                                                keep_alpha=keep_alpha)
             if not drop_background:  # auto:N's: one of the N
                 background = nearest_colour(background, used / 255.0)
+        if float(opt.get("simplify", 0)) > 0 and result.iterations > 0:  # fewer nodes (fitting/simplify.py)
+            from vecfit.fitting.simplify import simplify_fitted
+            render_rgb = lambda s, seed=0: to_rgb(to_numpy(_render_full(  # noqa: E731
+                s, sw, sh, {**opt, "seed": opt["seed"] + seed})), background)
+            simplified = simplify_fitted(scene, goal, settings, render_rgb, target_rgb, float(opt["simplify"]),
+                                         int(opt["simplify_iterations"]), hooks, keep_alpha)
     else:
         progress.start(0)
         result = _not_optimised(scene, opt)
@@ -246,6 +253,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
                     "per_iteration": result.seconds / max(result.iterations, 1),
                     "iterations": [round(t, 4) for t in result.iteration_seconds]},
         "shapes": len(scene.shapes),
+        "simplified": simplified,  # nodes dropped after the fit (fitting/simplify.py), or None
         "untangled_outlines": untangled,  # outlines the fit made cross themselves, cut into simple loops
         "file": design_stats(written),  # what a designer finds in the SVG written
         **({} if palette is None and layers is None else {"colours": colour_entry(written, palette, layers)}),
