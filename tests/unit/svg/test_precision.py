@@ -22,8 +22,8 @@ def test_decimals_for(pixels_per_unit, side, decimals):
     assert decimals_for(pixels_per_unit, side) == decimals
 
 
-@pytest.mark.parametrize("value,text", [(1.0, None), (0.9996, None), (0.9994, "0.999"), (0.5, "0.5"),
-                                        (0.12345, "0.123"), (0.0, "0"), (-0.2, "0"), (1.7, None)])
+@pytest.mark.parametrize("value,text", [(1.0, None), (0.9996, None), (0.9994, ".999"), (0.5, ".5"),
+                                        (0.12345, ".123"), (0.0, "0"), (-0.2, "0"), (1.7, None)])
 def test_opacity_written_with_three_decimals(value, text):
     assert opacity_text(value) == text
 
@@ -48,7 +48,7 @@ def test_written_decimals_follow_the_canvas(tmp_path):
     assert _decimals(d) == 2
     icon = _moved(tmp_path, 512, "0 0 24 24")  # a user unit is 21 px
     assert _decimals(re.search(r' d="([^"]*)"', icon).group(1)) == 4
-    assert 'fill-opacity="0.877"' in icon
+    assert 'fill-opacity=".877"' in icon
     small = _moved(tmp_path, 24, "0 0 24 24", pixels=(512, 512))  # optimised at 512 px
     assert _decimals(re.search(r' d="([^"]*)"', small).group(1)) == 4
     fixed = _moved(tmp_path, 512, "0 0 512 512", precision=5)
