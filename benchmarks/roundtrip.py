@@ -3,7 +3,7 @@ back at the designer's number of paths, and the traced file compared with the de
 
     python benchmarks/roundtrip.py [--sets noto-emoji,fxemoji,flags,logos,devicon,vscode-icons,
                                            fontawesome,tabler] [--limit 10] [--effort quick|normal|best]
-                                   [--no-refine] [--rows vecfit,vtracer] [--threads 2]
+                                   [--no-refine] [--rows vecfit,vtracer] [--threads 2] [--simplify DB]
                                    [--stacking cutouts [--gap-filler]]
                                    [--json out.json] [--verbose]
 
@@ -73,10 +73,12 @@ def png_rgb(png: bytes) -> np.ndarray:
     return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), np.float64) / 255
 
 
-def run_vecfit(png: bytes, paths: int, effort: str, refine: bool, threads: int, output: dict | None = None) -> str:
+def run_vecfit(png: bytes, paths: int, effort: str, refine: bool, threads: int, simplify: float | None = None) -> str:
     import vecfit
 
-    settings = {"trace": {"paths": max(1, paths)}, "optimize": {"threads": threads}, "output": output or {}}
+    settings = {"trace": {"paths": max(1, paths)}, "optimize": {"threads": threads}}
+    if simplify is not None:
+        settings["optimize"]["simplify"] = simplify
     if not refine:
         settings["optimize"]["iterations"] = 0
     svg, _ = vecfit.trace(png, settings=settings, effort=effort if refine else None)
@@ -171,6 +173,8 @@ def main():
     ap.add_argument("--no-refine", action="store_true", help="vecfit's trace as it is, not refined")
     ap.add_argument("--rows", default=",".join(ROWS), help="vecfit, vtracer (vtracer where importable)")
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--simplify", type=float, default=None,
+                    help="optimize.simplify, the node pass's budget in dB (0: off; default: trace's)")
     ap.add_argument("--stacking", choices=["stacked", "cutouts"], default="stacked",
                     help="vecfit's output: stacked shapes, or cut-outs (the stacked row is then added beside)")
     ap.add_argument("--gap-filler", action="store_true", help="cut-outs: with the gap filler")
@@ -213,7 +217,8 @@ def main():
                         if row == "cutouts":  # the stacked row's trace as cut-outs (what --stacking cutouts writes)
                             written = run_cutouts(stacked, target.shape[1], target.shape[0], args.gap_filler)
                         else:
-                            written = (run_vecfit(png, designer["paths"], args.effort, not args.no_refine, args.threads)
+                            written = (run_vecfit(png, designer["paths"], args.effort, not args.no_refine, args.threads,
+                                                  args.simplify)
                                        if row == "vecfit" else run_vtracer(png))
                             if row == "vecfit":
                                 stacked = written

@@ -42,6 +42,8 @@ class Settings:
     background: str  # auto (the target's corners) | none | a colour (io.colors.fitting_background)
     eval_samples: int  # N x N samples of the reported metrics and the comparison image
     palette: str  # the colours written ("" free; vecfit/jobs/palette.py reads it)
+    simplify: float  # after the fit, nodes dropped while the picture loses at most this many dB (0: never)
+    simplify_iterations: int  # the brief refinement after those joins (vecfit/fitting/simplify.py)
     lr: dict
 
     @classmethod
@@ -89,6 +91,10 @@ class Settings:
             raise VecfitError(f"max_size must be 0 (never downscale) or more, not {self.max_size}")
         if self.eval_samples < 1:
             raise VecfitError(f"eval_samples must be at least 1, not {self.eval_samples}")
+        if not (isinstance(self.simplify, (int, float)) and math.isfinite(self.simplify) and self.simplify >= 0):
+            raise VecfitError(f"simplify must be a number of dB >= 0, not {self.simplify}")
+        if self.simplify_iterations < 0:
+            raise VecfitError(f"simplify_iterations must be 0 or more, not {self.simplify_iterations}")
         if self.background.strip().lower() != "auto":
             fitting_background(self.background)
         devices.resolve(self.device)

@@ -195,6 +195,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         problem = cutout_problem(scene)
         if problem is not None:
             raise VecfitError(f"--stacking cutouts: {document.name}: {problem}")
+    simplified = None
     if is_tensor(scene.view):
         import torch
         from vecfit.fitting.loop import Settings, Target, optimize
@@ -212,6 +213,12 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
                                                keep_alpha=keep_alpha)
             if not drop_background:  # auto:N's: one of the N
                 background = nearest_colour(background, used / 255.0)
+        if float(opt.get("simplify", 0)) > 0 and result.iterations > 0:  # fewer nodes (fitting/simplify.py)
+            from vecfit.fitting.simplify import simplify_fitted
+            render_rgb = lambda s, seed=0: to_rgb(to_numpy(_render_full(  # noqa: E731
+                s, sw, sh, {**opt, "seed": opt["seed"] + seed})), background)
+            simplified = simplify_fitted(scene, goal, settings, render_rgb, target_rgb, float(opt["simplify"]),
+                                         int(opt["simplify_iterations"]), hooks, keep_alpha)
     else:
         progress.start(0)
         result = _not_optimised(scene, opt)
@@ -270,6 +277,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
                     "per_iteration": result.seconds / max(result.iterations, 1),
                     "iterations": [round(t, 4) for t in result.iteration_seconds]},
         "shapes": len(scene.shapes),
+        "simplified": simplified,  # nodes dropped after the fit (fitting/simplify.py), or None
         "untangled_outlines": untangled,  # outlines the fit made cross themselves, cut into simple loops
         **({} if cut is None else {"cutouts": cut}),  # --stacking cutouts: pieces, chains, and the file's score
         "file": design_stats(written),  # what a designer finds in the SVG written

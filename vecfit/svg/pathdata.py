@@ -328,47 +328,79 @@ def format_path_data(points, degrees, subpaths, decimals: int = 4, compact: bool
 
 
 def format_relative_path_data(points, degrees, subpaths, decimals: int = 2) -> str:
-    """Relative m/l/h/v/q/c/z path data, as designers' tools write it (Scene layout and Z
-    rule as ``format_path_data``): each subpath starts with an absolute ``M``, each segment
-    is written as offsets from its start, axis-aligned lines as ``h``/``v``, and a number
-    is not preceded by a space where its minus sign separates it. Offsets are short
-    (5.11 where the point is at 340.38): a refined photograph's path data is a quarter
-    smaller. The points are rounded to ``decimals`` first and every offset is the
-    difference of two rounded points, so the path lands exactly where the absolute one
-    would, with no drift along it."""
+    """Relative m/l/h/v/q/c/z path data, as designers' tools and optimisers write it (Scene
+    layout and Z rule as ``format_path_data``): the first subpath starts with an absolute
+    ``M``, each later one with an ``m`` from where the previous one closed or ended, each
+    segment is written as offsets from its start, axis-aligned lines as ``h``/``v``, and the
+    text is the shortest the SVG grammar reads back the same: no leading zero (``.5``,
+    ``-.5``), no separator where a minus sign or a second decimal point starts the next
+    number (``1.5.5`` is 1.5 then .5), and a command letter left out where the previous
+    segment had the same one. Offsets are short (5.11 where the point is at 340.38): a
+    refined photograph's path data is a quarter smaller than absolute. The points are
+    rounded to ``decimals`` first and every offset is the difference of two rounded
+    points, so the path lands exactly where the absolute one would, with no drift along
+    it."""
     a = np.asarray(points, np.float64)
     if not np.isfinite(a).all():
         fmt_many(a, decimals)  # raises, naming the value
     unit = 10 ** int(decimals)
     q = np.rint(a * unit).astype(np.int64).tolist()
+    texts: dict[int, str] = {}
 
     def number(v: int) -> str:
         # (a table of every fraction's text was 10^decimals strings made per path: at 6
         # decimals a 1,096-path file took minutes)
-        whole, frac = divmod(abs(v), unit)
-        text = f"{whole}.{frac:0{decimals}d}".rstrip("0") if frac else str(whole)
-        return "-" + text if v < 0 and text != "0" else text
+        text = texts.get(v)
+        if text is None:
+            whole, frac = divmod(abs(v), unit)
+            text = f"{whole}.{frac:0{decimals}d}".rstrip("0") if frac else str(whole)
+            if text.startswith("0."):
+                text = text[1:]
+            text = texts[v] = "-" + text if v < 0 and text != "0" else text
+        return text
 
-    def joined(values) -> str:
-        out = ""
+    out: list[str] = []
+    # what the text written so far ends with: a command letter (True), or a number with
+    # (".") or without ("") a decimal point
+    state = {"letter": True, "dot": False, "command": ""}
+
+    def put(command: str, values) -> None:
+        repeat = command == state["command"] and command not in "Mm"
+        if not repeat:
+            out.append(command)
+            state["letter"], state["command"] = True, command
         for v in values:
             t = number(v)
-            out += t if not out or t[0] == "-" else " " + t
-        return out
+            if not state["letter"] and not (t[0] == "-" or (t[0] == "." and state["dot"])):
+                out.append(" ")
+            out.append(t)
+            state["letter"], state["dot"] = False, "." in t
 
-    out = []
+    def close() -> None:
+        out.append("z")
+        state["letter"], state["command"] = True, "z"
+
+    here = None  # the current point after the previous subpath (its start, when closed)
     for start, segments, closed in _segment_ends(degrees, subpaths):
-        out.append("M" + joined(q[start]))
-        cx, cy = q[start]
+        sx, sy = q[start]
+        if here is None:
+            put("M", (sx, sy))
+        else:
+            put("m", (sx - here[0], sy - here[1]))
+        state["command"] = "m"  # a number after m's pair would be a line: never left implicit
+        cx, cy = sx, sy
         for d, ends in segments:
             offsets = [(q[i][0] - cx, q[i][1] - cy) for i in ends]
             cx, cy = q[ends[-1]]
             if d == 1 and offsets[0][1] == 0:
-                out.append("h" + joined([offsets[0][0]]))
+                put("h", (offsets[0][0],))
             elif d == 1 and offsets[0][0] == 0:
-                out.append("v" + joined([offsets[0][1]]))
+                put("v", (offsets[0][1],))
             else:
-                out.append(_LETTERS[d].lower() + joined([v for pair in offsets for v in pair]))
+                put(_LETTERS[d].lower(), [v for pair in offsets for v in pair])
         if closed:
-            out.append("z")
+            close()
+            here = (sx, sy)
+        else:
+            here = (cx, cy)
     return "".join(out)

@@ -60,7 +60,7 @@ def opacity_text(value) -> str | None:
     shows), None where it rounds to 1 (opaque: nothing to write)."""
     v = min(max(float(finite(value)), 0.0), 1.0)
     text = fmt(v, OPACITY_DECIMALS)
-    return None if text == "1" else text
+    return None if text == "1" else text[1:] if text.startswith("0.") else text  # .5, as path data
 
 
 # ---------------------------------------------------------------------- comparison

@@ -13,7 +13,7 @@ from vecfit.svg.pathdata import parse_path_data, to_arrays
 
 def test_a_square_of_cubics():
     square = np.array([[[0, 0], [1, 0], [2, 0], [3, 0]], [[3, 0], [3, 1], [3, 2], [0, 0]]], float)
-    assert path_data([square]) == "M0 0c1 0 2 0 3 0c0 1 0 2-3 0z"
+    assert path_data([square]) == "M0 0c1 0 2 0 3 0 0 1 0 2-3 0z"
 
 
 def test_empty_subpaths_are_left_out():

@@ -22,8 +22,8 @@ def test_decimals_for(pixels_per_unit, side, decimals):
     assert decimals_for(pixels_per_unit, side) == decimals
 
 
-@pytest.mark.parametrize("value,text", [(1.0, None), (0.9996, None), (0.9994, "0.999"), (0.5, "0.5"),
-                                        (0.12345, "0.123"), (0.0, "0"), (-0.2, "0"), (1.7, None)])
+@pytest.mark.parametrize("value,text", [(1.0, None), (0.9996, None), (0.9994, ".999"), (0.5, ".5"),
+                                        (0.12345, ".123"), (0.0, "0"), (-0.2, "0"), (1.7, None)])
 def test_opacity_written_with_three_decimals(value, text):
     assert opacity_text(value) == text
 
@@ -48,7 +48,7 @@ def test_written_decimals_follow_the_canvas(tmp_path):
     assert _decimals(d) == 2
     icon = _moved(tmp_path, 512, "0 0 24 24")  # a user unit is 21 px
     assert _decimals(re.search(r' d="([^"]*)"', icon).group(1)) == 4
-    assert 'fill-opacity="0.877"' in icon
+    assert 'fill-opacity=".877"' in icon
     small = _moved(tmp_path, 24, "0 0 24 24", pixels=(512, 512))  # optimised at 512 px
     assert _decimals(re.search(r' d="([^"]*)"', small).group(1)) == 4
     fixed = _moved(tmp_path, 512, "0 0 512 512", precision=5)
@@ -96,4 +96,23 @@ def test_relative_path_data_text():
 
     pts = np.array([[10.004, 10], [50, 10], [50.25, 40.126], [30, 41], [20.5, 35], [12, -3]])
     assert format_relative_path_data(pts, [1, 1, 3, 1], [(0, 4, True)], 2) == \
-        "M10 10h40l0.25 30.13c-20.25 0.87-29.75-5.13-38.25-43.13z"
+        "M10 10h40l.25 30.13c-20.25.87-29.75-5.13-38.25-43.13z"
+
+
+def test_relative_path_data_shortest_text():
+    """Repeated command letters left out, relative m after a closed subpath (from its
+    start), no separator before a minus or a second decimal point, and a space where a
+    digit follows a number; the text reads back as the points rounded."""
+    import numpy as np
+    from vecfit.svg.pathdata import format_path_data, format_relative_path_data, parse_path_data, to_arrays
+
+    pts = np.array([[10, 10], [11, 12], [13, 12.5], [14, 10], [15, 9.5], [16.5, 9], [20, 10],
+                    [30, 30], [30.5, 30], [31, 30.5],
+                    [5, 5], [6, 7]])
+    degrees = [3, 3, 1, 1, 1, 1, 1]
+    subpaths = [(0, 3, True), (3, 3, True), (6, 1, False)]
+    text = format_relative_path_data(pts, degrees, subpaths, 2)
+    assert text == "M10 10c1 2 3 2.5 4 0 1-.5 2.5-1 6 0zm20 20h.5l.5.5zm-25-25l1 2"
+    back = to_arrays(parse_path_data(text))
+    absolute = to_arrays(parse_path_data(format_path_data(pts, degrees, subpaths, 2)))
+    assert np.abs(back[0] - absolute[0]).max() < 1e-9 and back[2] == absolute[2]

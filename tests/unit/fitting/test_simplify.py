@@ -1,0 +1,118 @@
+"""Fewer nodes after the fit (vecfit/fitting/simplify.py): segments joined where the picture
+cannot tell, within the budget in dB, and never past it."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import torch
+
+import vecfit
+from vecfit.fitting.simplify import fit_pairs, reduce_nodes
+from vecfit.renderer.raster import render
+from vecfit.scene import Path, Scene, Shape, Solid
+from vecfit.scene.segments import layout_of, split_at
+from vecfit.svg.stats import design_stats
+
+
+def test_a_split_cubic_joins_back_into_itself():
+    c = np.array([[0.0, 0.0], [10.0, 30.0], [40.0, 30.0], [50.0, 0.0]])
+    a, b = split_at(c, 0.4)
+    joined, worst, mean, length, _ = fit_pairs(a[None], b[None])
+    assert worst[0] < 0.05 and mean[0] < 0.05  # (the split point searched on a grid)
+    assert np.abs(joined[0] - c).max() < 0.5
+    assert length[0] == pytest.approx(71.9, abs=0.5)  # the arc length, from the samples
+
+
+def test_a_corner_does_not_join_cheaply():
+    a = np.array([[0.0, 0.0], [10.0, 0.0], [20.0, 0.0], [30.0, 0.0]])
+    b = np.array([[30.0, 0.0], [30.0, 10.0], [30.0, 20.0], [30.0, 30.0]])
+    _, worst, _, _, _ = fit_pairs(a[None], b[None])
+    assert worst[0] > 3.0
+
+
+def disc_scene(pieces: int, extra_lines: bool = True) -> Scene:
+    """A disc of ``pieces`` cubics (over-segmented: 4 would do) and a square whose sides
+    are each two collinear lines."""
+    segs = []
+    k = 4 / 3 * math.tan(math.pi / (2 * pieces))
+    centre, r = np.array([22.0, 32.0]), 14.0
+    for i in range(pieces):
+        t0, t1 = 2 * math.pi * i / pieces, 2 * math.pi * (i + 1) / pieces
+        p0 = centre + r * np.array([math.cos(t0), math.sin(t0)])
+        p3 = centre + r * np.array([math.cos(t1), math.sin(t1)])
+        d0 = np.array([-math.sin(t0), math.cos(t0)])
+        d1 = np.array([-math.sin(t1), math.cos(t1)])
+        segs.append(np.stack([p0, p0 + k * r * d0, p3 - k * r * d1, p3]))
+    points, degrees = layout_of(segs, True)
+    disc = Shape(Path(points=torch.tensor(points, dtype=torch.float32), degrees=np.array(degrees),
+                      subpaths=[(0, len(degrees), True)]), fill=Solid(torch.tensor([0.8, 0.2, 0.1, 1.0])))
+    square = np.array([[40, 20], [50, 20], [60, 20], [60, 30], [60, 44], [50, 44], [40, 44], [40, 30]], float)
+    sq = Shape(Path(points=torch.tensor(square, dtype=torch.float32), degrees=np.array([1] * 8),
+                    subpaths=[(0, 8, True)]), fill=Solid(torch.tensor([0.1, 0.3, 0.8, 1.0])))
+    return Scene(64, 64, [disc, sq])
+
+
+def rgb(scene, samples=4):
+    return render(scene, 64, 64, samples=samples, seed=3, background=[1, 1, 1, 1]).numpy()[..., :3]
+
+
+def psnr(a, b):
+    return -10 * np.log10(float(((a - b) ** 2).mean()))
+
+
+def noisy(image):
+    """A target the scenes do not match exactly (a photograph's grain): the budget is a
+    share of an error that the renderer's own sampling noise does not dominate."""
+    return image + np.random.default_rng(5).normal(0, 0.03, image.shape)
+
+
+def test_reduce_nodes_keeps_the_picture_within_the_budget():
+    target = noisy(rgb(disc_scene(4), 8))
+    scene = disc_scene(16)
+    before = psnr(rgb(scene), target)
+
+    def measure(s):
+        return float(((rgb(s) - target) ** 2).mean())
+
+    stats = reduce_nodes(scene, measure, rgb(scene), (64, 64), budget_db=0.1, rounds=3)
+    disc, square = (s.geometry for s in scene.shapes)
+    assert stats["segments_before"] == 24
+    assert len(disc.degrees) <= 8 and stats["joined"] >= 8
+    # the square's collinear halves join into single lines; its corners stay
+    assert list(square.degrees) == [1, 1, 1, 1]
+    assert psnr(rgb(scene), target) >= before - 0.1
+    assert stats["mse_after"] <= stats["mse_before"] * 10 ** 0.01 + 1e-12
+
+
+def test_a_zero_budget_joins_only_what_costs_nothing():
+    target = noisy(rgb(disc_scene(16), 8))
+    scene = disc_scene(16)
+
+    def measure(s):
+        return float(((rgb(s) - target) ** 2).mean())
+
+    stats = reduce_nodes(scene, measure, rgb(scene), (64, 64), budget_db=0.0)
+    assert stats["mse_after"] <= stats["mse_before"] + 1e-12
+    assert list(scene.shapes[1].geometry.degrees) == [1, 1, 1, 1]  # collinear lines join at no cost
+
+
+def test_trace_drops_nodes_within_a_tenth_of_a_db():
+    """The job: a trace of a flat picture with the pass (the default) and without; the
+    pass's report, fewer segments in the file, and the loss within the budget (the
+    final figures are at the eval samples, a little noisier than the pass's own)."""
+    image = np.ones((64, 64, 3), np.float32)
+    yy, xx = np.mgrid[0:64, 0:64] + 0.5
+    image[(xx - 24) ** 2 + (yy - 30) ** 2 < 15 ** 2] = (0.8, 0.2, 0.1)
+    image[12:50, 44:58] = (0.1, 0.3, 0.8)
+    settings = {"trace": {"paths": 4}, "optimize": {"iterations": 40}}
+    off, report_off = vecfit.trace(image, settings={**settings, "optimize": {"iterations": 40, "simplify": 0}})
+    on, report_on = vecfit.trace(image, settings=settings)
+    assert report_off["simplified"] is None
+    s = report_on["simplified"]
+    assert s["segments_after"] <= s["segments_before"]
+    assert s["mse_refined"] <= s["mse_before"] * 10 ** 0.01 + 1e-12
+    assert design_stats(on)["segments"] <= design_stats(off)["segments"]
+    assert report_on["optimized"]["psnr"] >= report_off["optimized"]["psnr"] - 0.15
+    assert design_stats(on)["crossed_outlines"] == 0
