@@ -211,10 +211,13 @@ def main():
                 png = target_png(svg)
                 target = png_rgb(png)
                 record = {"name": name, "set": set_name, "designer": designer}
+                stacked = None  # vecfit's trace of this file, which the cutouts row cuts
                 for row in rows:
                     start = time.perf_counter()
                     try:
                         if row == "cutouts":  # the stacked row's trace as cut-outs (what --stacking cutouts writes)
+                            if stacked is None:
+                                raise RuntimeError("no stacked trace to cut")
                             written = run_cutouts(stacked, target.shape[1], target.shape[0], args.gap_filler)
                         else:
                             written = (run_vecfit(png, designer["paths"], args.effort, not args.no_refine, args.threads,
