@@ -94,6 +94,12 @@ class _Builder:
         if self.current is None or self.current.closed:
             # Z after Z (or before anything) closes an empty subpath at the start point.
             self.move(self.start)
+        last = self.current.points[-1]
+        if last != self.start and all(abs(a - b) <= 1e-12 * max(1.0, abs(b)) for a, b in zip(last, self.start)):
+            # relative offsets that add up to the start but for float rounding (88.998 and
+            # -5.6e-16 for 88.998, 0): the start, as the writer meant; else the Z's line of
+            # next to no length makes the outline seem to cross itself there
+            self.current.points[-1] = self.start
         self.current.degrees.append(1)  # explicit line back to the start, not stored twice
         self.current.closed = True
         self.point = self.start

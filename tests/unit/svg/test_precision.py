@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
 import pytest
 import torch
 
@@ -116,3 +117,18 @@ def test_relative_path_data_shortest_text():
     back = to_arrays(parse_path_data(text))
     absolute = to_arrays(parse_path_data(format_path_data(pts, degrees, subpaths, 2)))
     assert np.abs(back[0] - absolute[0]).max() < 1e-9 and back[2] == absolute[2]
+
+
+def test_relative_path_data_closes_exactly_at_its_start():
+    """Offsets that add up to the start but for float rounding (88.998 then -0.586 of y
+    after 0.586 and more) read back closed at the start itself, so the Z is no line of
+    its own and the outline does not seem to cross itself there."""
+    from vecfit.scene.crossings import subpath_crossings
+    from vecfit.svg.pathdata import parse_path_data, to_arrays
+
+    d = ("M88.998 0h-7.047l-.386 2.025c.555 1.24 1.446 2.157 2.715 3.175c.099-.094 .199-.185 .299-.273"
+         "c1.744-1.534 3.539-2.151 4.254-4.341c.06-.184 .121-.378 .165-.586z")
+    (subpath,) = parse_path_data(d)
+    assert subpath.points[-1] == subpath.points[0]
+    points, degrees = to_arrays([subpath])[:2]
+    assert subpath_crossings(np.asarray(points, np.float32).astype(np.float64), list(degrees), True) == []

@@ -5,7 +5,8 @@ piece under another. The stacked drawing (what trace and refine write: shapes ov
 backdrop, each reaching under those on top) is sampled on a grid finer than the pixels,
 and its pieces (vecfit/scene/partition.py: the samples with the same stack of shapes)
 are traced back along the lines between them. Each boundary between two pieces is one
-chain, fitted once with the tracer's Bézier fit and written forwards in one piece and
+chain: the stretch of the drawing's own outline that it runs along (cutout_curves.py), or
+else fitted with the tracer's Bézier fit; it is written forwards in one piece and
 backwards in the other, so the pieces meet edge to edge: no gap, no overlap.
 
 A piece is painted with what its stack drew there: the top shape's colour where it is
@@ -52,6 +53,7 @@ SMOOTHING = 0.35          # pixels: sigma of the smoothing of the sample grid's 
 CORNER_ANGLE = 135.0      # degrees, as the tracer
 CORNER_WINDOW = 1.5       # pixels either side over which a corner's angle is measured
 LINES = 0.1               # pixels: a cubic this close to its chord is a line
+STUB = 0.05              # pixels: a segment this short is dropped from a piece's outline
 GAP_WIDTH = 1.5           # pixels: the gap filler's stroke (it covers every pixel an edge
                           # crosses: a pixel's far corner lies at most 0.71 px from the edge)
 
@@ -239,7 +241,26 @@ def _reversed(points: np.ndarray, degrees: list[int]) -> tuple[np.ndarray, list[
 
 # ------------------------------------------------------------------- writing
 
-def _piece_layout(outlines, curves, user, decimals: int, tolerance: float, min_area: float):
+def _without_stubs(segs: list[np.ndarray], shortest: float) -> list[np.ndarray]:
+    """The closed loop without segments whose control points all lie within ``shortest``
+    of their start (what a cut next to a node leaves at a junction), the next segment
+    starting where the dropped one did: a stub folds the outline over itself after
+    rounding."""
+    kept = [c for c in segs if float(np.abs(c - c[0]).max()) > shortest]
+    if len(kept) < 2:
+        return [c for c in segs if float(np.abs(c - c[0]).max()) > 0]
+    out = [c.copy() for c in kept]
+    # each kept segment starts where the one before it (kept or not) ended: rejoin them
+    for k in range(len(out)):
+        previous = out[k - 1][-1]
+        delta = previous - out[k][0]
+        out[k][0] = previous
+        if len(out[k]) == 4:
+            out[k][1] += delta
+    return out
+
+
+def _piece_layout(outlines, curves, user, decimals: int, tolerance: float, stub: float, min_area: float):
     """Points, degrees and subpath spans (the root's user space) of a piece's closed
     outlines, each chained from its chains' curves and, should joining the chains have
     made it cross itself, cut at the crossing into simple loops (as untangle.py does, judged
@@ -256,7 +277,7 @@ def _piece_layout(outlines, curves, user, decimals: int, tolerance: float, min_a
             for degree in d:
                 segs.append(p[at:at + degree + 1])
                 at += degree
-        segs = [c for c in segs if float(np.abs(c - c[0]).max()) > 0]
+        segs = _without_stubs(segs, stub)
         if not segs:
             continue
         loops = simple_loops(segs, tolerance, decimals)
@@ -267,6 +288,8 @@ def _piece_layout(outlines, curves, user, decimals: int, tolerance: float, min_a
             spans.append((len(degrees), len(loop_degrees), True))
             points.append(loop_points)
             degrees += loop_degrees
+    if not points:  # nothing left of it but slivers
+        return None
     return np.concatenate(points), degrees, spans
 
 
@@ -350,14 +373,19 @@ def cut_out(svg: bytes, pixels: tuple[int, int], gap_filler: bool = False,
             out.add("path", {"d": format_relative_path_data(user(points), degrees, spans, decimals),
                              "fill": "none", "stroke": colour, "stroke-width": width,
                              "stroke-linejoin": "round", "stroke-linecap": "round"})
+    written = 0
     for piece in order:
-        points, degrees, spans = _piece_layout(parts.outlines[piece], fitted, user, decimals,
-                                               tolerance=0.01 * units_per_pixel, min_area=units_per_pixel ** 2)
+        layout = _piece_layout(parts.outlines[piece], fitted, user, decimals, tolerance=0.01 * units_per_pixel,
+                               stub=STUB * units_per_pixel, min_area=units_per_pixel ** 2)
+        if layout is None:
+            continue
+        points, degrees, spans = layout
+        written += 1
         colour, alpha = paints[piece]
         attributes = {"d": format_relative_path_data(points, degrees, spans, decimals),
                       "fill": hex_color(colour)}
         if alpha < 0.9995:
             attributes["fill-opacity"] = fmt(alpha, 3)
         out.add("path", attributes)
-    report = CutoutReport(pieces=len(order), chains=len(parts.chains), followed=followed, gap_filler=len(shared), scale=scale)
+    report = CutoutReport(pieces=written, chains=len(parts.chains), followed=followed, gap_filler=len(shared), scale=scale)
     return out.serialize(), report
