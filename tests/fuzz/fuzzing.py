@@ -551,8 +551,9 @@ PALETTES = ["#e63946,#f1faee,#1d3557", "auto:3", "auto:1", "auto:0", "auto:-2", 
 
 
 def colour_and_style_args(rng: random.Random, command: str) -> list[str]:
-    """This wave's options (issues 38, 39), valid and not: palettes (lists, files, auto:N,
-    auto:0, bad colours), colour layers, background removal, trace styles."""
+    """This wave's options (issues 37, 38, 39), valid and not: palettes (lists, files,
+    auto:N, auto:0, bad colours), colour layers, background removal, trace styles,
+    cut-outs and the gap filler."""
     args = []
     if rng.random() < 0.5:
         args += ["--palette", rng.choice(PALETTES)]
@@ -562,6 +563,10 @@ def colour_and_style_args(rng: random.Random, command: str) -> list[str]:
         args.append("--remove-background")
     if command == "trace" and rng.random() < 0.4:
         args += ["--style", rng.choice(["strokes", "mixed", "fills"])]
+    if rng.random() < 0.3:  # cut-outs (issue 37), with and without the gap filler, some refused
+        args += ["--stacking", rng.choice(["cutouts", "cutouts", "stacked"])]
+    if rng.random() < 0.2:
+        args.append("--gap-filler")
     return args
 
 
