@@ -288,6 +288,43 @@ def fit_outlines(outlines: list[np.ndarray], tolerance: float, corner_angle: flo
     return result
 
 
+def open_corners(points: np.ndarray, corner_angle: float, reach: int) -> list[int]:
+    """Indices where an open polyline turns sharper than corner_angle (degrees), judged
+    `reach` points either side, the sharpest within the reach."""
+    n = len(points)
+    if n < 2 * reach + 1:
+        return []
+    i = np.arange(reach, n - reach)
+    a, b = points[i - reach] - points[i], points[i + reach] - points[i]
+    cos = (a * b).sum(1) / np.maximum(np.hypot(*a.T) * np.hypot(*b.T), 1e-12)
+    angle = np.degrees(np.arccos(np.clip(cos, -1, 1)))
+    corners: list[int] = []
+    for k in np.argsort(angle, kind="stable").tolist():
+        if angle[k] >= corner_angle:
+            break
+        if all(abs(k - c) > reach for c in corners):
+            corners.append(k)
+    return sorted(c + reach for c in corners)
+
+
+def fit_pieces(pieces: list[np.ndarray], owner: list[int], count: int, sigma: float, window: int,
+               tolerance: float) -> list[np.ndarray]:
+    """Cubic segments [S, 4, 2] of ``count`` open polylines given as their pieces between
+    corners (``owner``: each piece's polyline, in order): each piece smoothed with its ends
+    held (sigma in points) and fitted with the end tangents of its own points (``window``
+    points along), as fit_outlines fits a closed outline's stretches."""
+    st = Stretches(np.concatenate(pieces), np.array([len(q) for q in pieces]))
+    s = st.smoothed(sigma)
+    tangents = st.tangents(s, window)
+    m = np.minimum(window, st.lengths - 1)
+    first, last = st.first, st.first + st.lengths - 1
+    t1, t2 = _unit(s[first + m] - s[first]), _unit(s[last - m] - s[last])
+    ctrl, stretch_of = _fit_all(st, s, tangents, t1, t2, tolerance)
+    line_of = np.asarray(owner)[stretch_of]
+    bounds = np.searchsorted(line_of, np.arange(count + 1))
+    return [ctrl[bounds[k]:bounds[k + 1]] for k in range(count)]
+
+
 def fit_closed(points: np.ndarray, tolerance: float, corner_angle: float,
                smoothing: float = 1.0, corner_window: float = 3.0) -> np.ndarray:
     """Cubic segments [S, 4, 2] of one closed outline (see fit_outlines)."""

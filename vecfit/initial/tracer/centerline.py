@@ -31,8 +31,8 @@ from vecfit.errors import VecfitWarning
 from vecfit.svg.numbers import fmt_many, hex_color
 from vecfit.svg.pathdata import format_relative_path_data
 
-from .bezier import TANGENT_REACH, Stretches, _fit_all, _unit, fit_outlines
-from .primitives import _continues, _line_like, as_primitive, straightened
+from .bezier import TANGENT_REACH, Stretches, _unit, fit_outlines, fit_pieces, open_corners
+from .primitives import _continues, as_primitive, open_outline, straightened
 from .quantize import OPAQUE, to_lab
 from .settings import TraceResult, TraceSettings
 from .skeleton import centerlines
@@ -177,25 +177,6 @@ def _resampled(points: np.ndarray, closed: bool, step: float = 1.0) -> np.ndarra
     return out[:-1] if closed and len(out) > 3 else out
 
 
-def _open_corners(points: np.ndarray, corner_angle: float, reach: int) -> list[int]:
-    """Indices where an open polyline (1 px steps) turns sharper than corner_angle, judged
-    `reach` points either side, the sharpest within the reach."""
-    n = len(points)
-    if n < 2 * reach + 1:
-        return []
-    i = np.arange(reach, n - reach)
-    a, b = points[i - reach] - points[i], points[i + reach] - points[i]
-    cos = (a * b).sum(1) / np.maximum(np.hypot(*a.T) * np.hypot(*b.T), 1e-12)
-    angle = np.degrees(np.arccos(np.clip(cos, -1, 1)))
-    corners: list[int] = []
-    for k in np.argsort(angle, kind="stable").tolist():
-        if angle[k] >= corner_angle:
-            break
-        if all(abs(k - c) > reach for c in corners):
-            corners.append(k)
-    return sorted(c + reach for c in corners)
-
-
 def _apex(p: np.ndarray, c: int, reach: int) -> np.ndarray:
     """Where the lines through the two sides of the corner at p[c] meet (each side's
     points `reach` to 3 `reach` away), if near p[c]; else p[c]."""
@@ -225,10 +206,10 @@ def fit_open(polylines: list[np.ndarray], tolerance: float, corner_angle: float,
     """Cubic segments [S, 4, 2] of each open polyline (points at 1 px steps): cut at its
     corners, each stretch smoothed with its ends held and fitted as bezier.fit_outlines
     fits a closed outline's stretches."""
-    pieces, lengths, owner = [], [], []
+    pieces, owner = [], []
     reach = int(round(CORNER_REACH))
     for k, p in enumerate(polylines):
-        bounds = [0, *_open_corners(Stretches(p, np.array([len(p)])).smoothed(smoothing / 2), corner_angle, reach),
+        bounds = [0, *open_corners(Stretches(p, np.array([len(p)])).smoothed(smoothing / 2), corner_angle, reach),
                   len(p) - 1]
         p = p.copy()
         for c in bounds[1:-1]:  # a corner at the meeting of its sides' lines (see _apex)
@@ -241,34 +222,8 @@ def fit_open(polylines: list[np.ndarray], tolerance: float, corner_angle: float,
             if (~cut).sum() >= 2:
                 inner = inner[~cut]
             pieces.append(p[inner])
-            lengths.append(len(pieces[-1]))
             owner.append(k)
-    st = Stretches(np.concatenate(pieces), np.array(lengths))
-    s = st.smoothed(smoothing)
-    window = max(1, int(round(TANGENT_REACH)))
-    tangents = st.tangents(s, window)
-    m = np.minimum(window, st.lengths - 1)
-    first, last = st.first, st.first + st.lengths - 1
-    t1, t2 = _unit(s[first + m] - s[first]), _unit(s[last - m] - s[last])
-    ctrl, stretch_of = _fit_all(st, s, tangents, t1, t2, tolerance)
-    line_of = np.asarray(owner)[stretch_of]
-    bounds = np.searchsorted(line_of, np.arange(len(polylines) + 1))
-    return [ctrl[bounds[k]:bounds[k + 1]] for k in range(len(polylines))]
-
-
-def open_outline(segs: np.ndarray, tolerance: float) -> tuple[np.ndarray, list[int]]:
-    """An open run of cubics [S, 4, 2] with its straight stretches as lines: (points,
-    degrees) in the Scene's layout (its start, then each segment's points after its start)."""
-    straight = _line_like(segs, tolerance) if tolerance > 0 else np.zeros(len(segs), bool)
-    runs: list[list] = []
-    for k in range(len(segs)):
-        if not straight[k]:
-            runs.append([3, segs[k, 0], segs[k, 1:]])
-        elif runs and runs[-1][0] == 1 and _continues(runs[-1][1], segs[k, 0], segs[k, 3], tolerance):
-            runs[-1][2] = segs[k, 3][None]
-        else:
-            runs.append([1, segs[k, 0], segs[k, 3][None]])
-    return np.concatenate([runs[0][1][None]] + [r[2] for r in runs]), [r[0] for r in runs]
+    return fit_pieces(pieces, owner, len(polylines), smoothing, max(1, int(round(TANGENT_REACH))), tolerance)
 
 
 def _sample(image: np.ndarray, xy: np.ndarray) -> np.ndarray:
@@ -371,7 +326,7 @@ def fitted_strokes(chains, radius: np.ndarray, ink: np.ndarray, color: str, s: T
     for c in closed:
         n = len(c.points)
         wrapped = np.concatenate([c.points[-reach:], c.points, c.points[:reach]])
-        corners = [k - reach for k in _open_corners(wrapped, s.corner_angle, reach) if reach <= k < n + reach]
+        corners = [k - reach for k in open_corners(wrapped, s.corner_angle, reach) if reach <= k < n + reach]
         if not corners:
             smooth.append(c)
             continue

@@ -85,6 +85,7 @@ class OutlineFinder:
         self.where = np.vstack(where)
         self.tree = cKDTree(self.points)
         self._trees: dict = {}
+        self._rows: dict = {}
 
     def nearest(self, p: np.ndarray):
         """(distance, loop, position) of the outline's point nearest each of ``p`` [n, 2]:
@@ -93,16 +94,24 @@ class OutlineFinder:
         w = self.where[i]
         return dist, w[:, 0].astype(np.int64), w[:, 1] + w[:, 2]
 
-    def nearest_on(self, loop: int, p: np.ndarray):
-        """(distance, position) of the point of loop ``loop`` nearest each of ``p``."""
+    def rows(self, loop: int) -> np.ndarray:
+        """The indices of loop ``loop``'s samples, in order along it."""
+        if loop not in self._rows:
+            self._rows[loop] = np.flatnonzero(self.where[:, 0] == loop)
+        return self._rows[loop]
+
+    def loop_tree(self, loop: int):
+        """A k-d tree of loop ``loop``'s samples (indexed as ``rows(loop)``)."""
         from scipy.spatial import cKDTree
 
         if loop not in self._trees:
-            rows = np.flatnonzero(self.where[:, 0] == loop)
-            self._trees[loop] = (cKDTree(self.points[rows]), rows)
-        tree, rows = self._trees[loop]
-        dist, i = tree.query(p)
-        w = self.where[rows[i]]
+            self._trees[loop] = cKDTree(self.points[self.rows(loop)])
+        return self._trees[loop]
+
+    def nearest_on(self, loop: int, p: np.ndarray):
+        """(distance, position) of the point of loop ``loop`` nearest each of ``p``."""
+        dist, i = self.loop_tree(loop).query(p)
+        w = self.where[self.rows(loop)[i]]
         return dist, w[:, 1] + w[:, 2]
 
     def exact(self, loop: int, position: float, p: np.ndarray) -> float:
@@ -229,9 +238,8 @@ def local_polyline(follow: Follow, near: np.ndarray, radius: float) -> np.ndarra
     """The followed loop's sample points within ``radius`` of ``near``, in order along it
     (the nearest run of them)."""
     f = follow.finder
-    rows = np.flatnonzero(f.where[:, 0] == follow.loop)
-    pts = f.points[rows]
-    close = np.flatnonzero(np.hypot(*(pts - near).T) <= radius)
+    pts = f.points[f.rows(follow.loop)]
+    close = np.array(sorted(f.loop_tree(follow.loop).query_ball_point(near, radius)), np.int64)
     if len(close) < 2:
         return pts[close]
     # the run round the nearest sample (the loop may pass near twice)

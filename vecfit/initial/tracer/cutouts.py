@@ -39,10 +39,9 @@ from vecfit.svg.numbers import fmt, hex_color
 from vecfit.svg.pathdata import format_relative_path_data
 from vecfit.svg.precision import root_decimals
 
-from .bezier import TANGENT_REACH, Stretches, _fit_all, _unit, fit_outlines
-from .centerline import _open_corners, open_outline
+from .bezier import TANGENT_REACH, Stretches, fit_outlines, fit_pieces, open_corners
 from .cutout_curves import OutlineFinder, closed_loops, crossing_near, layout, local_polyline, on_outline
-from .primitives import straightened
+from .primitives import open_outline, straightened
 
 MAX_SAMPLES = 16_000_000  # the sampling grid's size at most (a 2,000-px canvas at 2x2)
 SCALE = 4                 # samples a pixel side where the canvas allows
@@ -110,20 +109,11 @@ def _fit_open(polylines: list[np.ndarray], step: float) -> list[np.ndarray]:
     pieces, owner = [], []
     for k, p in enumerate(polylines):
         light = Stretches(p, np.array([len(p)])).smoothed(sigma / 2)
-        bounds = [0, *_open_corners(light, CORNER_ANGLE, reach), len(p) - 1]
+        bounds = [0, *open_corners(light, CORNER_ANGLE, reach), len(p) - 1]
         for a, b in zip(bounds[:-1], bounds[1:]):
             pieces.append(p[a:b + 1])
             owner.append(k)
-    st = Stretches(np.concatenate(pieces), np.array([len(q) for q in pieces]))
-    s = st.smoothed(sigma)
-    tangents = st.tangents(s, window)
-    m = np.minimum(window, st.lengths - 1)
-    first, last = st.first, st.first + st.lengths - 1
-    t1, t2 = _unit(s[first + m] - s[first]), _unit(s[last - m] - s[last])
-    ctrl, stretch_of = _fit_all(st, s, tangents, t1, t2, TOLERANCE)
-    line_of = np.asarray(owner)[stretch_of]
-    bounds = np.searchsorted(line_of, np.arange(len(polylines) + 1))
-    return [ctrl[bounds[k]:bounds[k + 1]] for k in range(len(polylines))]
+    return fit_pieces(pieces, owner, len(polylines), sigma, window, TOLERANCE)
 
 
 def _boundary_shape(chain, stacks) -> int | None:

@@ -64,11 +64,11 @@ def _line_like(segs: np.ndarray, tolerance: float) -> np.ndarray:
     return ok
 
 
-def straightened(segs: np.ndarray, tolerance: float) -> Outline:
-    """A closed outline of cubics [S, 4, 2] with its straight runs as lines (see the module
-    docstring), closed as the tracer closes it: a ``Z`` line of zero length at the end."""
-    straight = _line_like(segs, tolerance)
-    runs: list[list] = []  # [degree, start, the points after the start]
+def _runs(segs: np.ndarray, tolerance: float) -> list[list]:
+    """Cubics [S, 4, 2] as runs [degree, start, the points after the start]: cubics within
+    ``tolerance`` of their chord become lines, and lines that continue each other one."""
+    straight = _line_like(segs, tolerance) if tolerance > 0 else np.zeros(len(segs), bool)
+    runs: list[list] = []
     for k in range(len(segs)):
         if not straight[k]:
             runs.append([3, segs[k, 0], segs[k, 1:]])
@@ -76,12 +76,26 @@ def straightened(segs: np.ndarray, tolerance: float) -> Outline:
             runs[-1][2] = segs[k, 3][None]  # the line goes on
         else:
             runs.append([1, segs[k, 0], segs[k, 3][None]])
+    return runs
+
+
+def straightened(segs: np.ndarray, tolerance: float) -> Outline:
+    """A closed outline of cubics [S, 4, 2] with its straight runs as lines (see the module
+    docstring), closed as the tracer closes it: a ``Z`` line of zero length at the end."""
+    runs = _runs(segs, tolerance)
     # a line that ends the outline may go on into the one that starts it
     if (len(runs) > 2 and runs[0][0] == 1 and runs[-1][0] == 1
             and _continues(runs[-1][1], runs[0][1], runs[0][2][-1], tolerance)):
         runs[0][1] = runs.pop()[1]
     points = [runs[0][1][None]] + [r[2] for r in runs]
     return Outline(np.concatenate(points), [r[0] for r in runs] + [1])
+
+
+def open_outline(segs: np.ndarray, tolerance: float) -> tuple[np.ndarray, list[int]]:
+    """An open run of cubics [S, 4, 2] with its straight stretches as lines: (points,
+    degrees) in the Scene's layout (its start, then each segment's points after its start)."""
+    runs = _runs(segs, tolerance)
+    return np.concatenate([runs[0][1][None]] + [r[2] for r in runs]), [r[0] for r in runs]
 
 
 def _continues(a: np.ndarray, b: np.ndarray, c: np.ndarray, tolerance: float) -> bool:
