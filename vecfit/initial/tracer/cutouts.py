@@ -231,17 +231,29 @@ def _reversed(points: np.ndarray, degrees: list[int]) -> tuple[np.ndarray, list[
 
 # ------------------------------------------------------------------- writing
 
-def _without_stubs(segs: list[np.ndarray], shortest: float) -> list[np.ndarray]:
-    """The closed loop without segments whose control points all lie within ``shortest``
-    of their start (what a cut next to a node leaves at a junction), the next segment
-    starting where the dropped one did: a stub folds the outline over itself after
-    rounding."""
+def _segments(points: np.ndarray, degrees: list[int]) -> list[np.ndarray]:
+    """An open curve's segments ([d + 1, 2] control points each) from its layout."""
+    out, at = [], 0
+    for d in degrees:
+        out.append(points[at:at + d + 1])
+        at += d
+    return out
+
+
+def _without_stubs(segs: list[np.ndarray], shortest: float, closed: bool = True) -> list[np.ndarray]:
+    """The loop (or open run) without segments whose control points all lie within
+    ``shortest`` of their start (what a cut next to a node leaves at a junction), each
+    segment after a dropped one starting where the one before ended: a stub folds an
+    outline over itself after rounding. An open run of stubs only is dropped whole."""
     kept = [c for c in segs if float(np.abs(c - c[0]).max()) > shortest]
-    if len(kept) < 2:
+    if not closed:
+        if not kept:
+            return []
+    elif len(kept) < 2:
         return [c for c in segs if float(np.abs(c - c[0]).max()) > 0]
     out = [c.copy() for c in kept]
     # each kept segment starts where the one before it (kept or not) ended: rejoin them
-    for k in range(len(out)):
+    for k in range(0 if closed else 1, len(out)):
         previous = out[k - 1][-1]
         delta = previous - out[k][0]
         out[k][0] = previous
@@ -262,11 +274,7 @@ def _piece_layout(outlines, curves, user, decimals: int, tolerance: float, stub:
             p, d = curves[k]
             if backwards:
                 p, d = _reversed(p, d)
-            p = user(p)
-            at = 0
-            for degree in d:
-                segs.append(p[at:at + degree + 1])
-                at += degree
+            segs += _segments(user(p), d)
         segs = _without_stubs(segs, stub)
         if not segs:
             continue
@@ -284,7 +292,7 @@ def _piece_layout(outlines, curves, user, decimals: int, tolerance: float, stub:
 
 
 def _open_layout(runs):
-    """Points, degrees and spans of open runs ((points, degrees) each)."""
+    """Points, degrees and spans of open runs ((points, degrees) each, in pixels)."""
     points, degrees, spans = [], [], []
     for p, d in runs:
         spans.append((len(degrees), len(d), False))
@@ -355,8 +363,10 @@ def cut_out(svg: bytes, pixels: tuple[int, int], gap_filler: bool = False,
         for k, chain in enumerate(parts.chains):
             if chain.left in rank and chain.right in rank:
                 under = min(chain.left, chain.right, key=rank.get)
-                by_colour.setdefault(hex_color(paints[under][0]), []).append(fitted[k])
-                shared.append(k)
+                segs = _without_stubs(_segments(*fitted[k]), STUB, closed=False)
+                if segs:  # (a chain of next to no length, where three pieces meet at a point: none)
+                    by_colour.setdefault(hex_color(paints[under][0]), []).append(layout_of(segs, False))
+                    shared.append(k)
         width = fmt(GAP_WIDTH * units_per_pixel, max(decimals, 2))
         for colour, runs in by_colour.items():
             points, degrees, spans = _open_layout(runs)
