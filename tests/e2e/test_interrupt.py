@@ -38,6 +38,18 @@ def finish(proc, timeout=60):
     return proc.returncode, out, err
 
 
+def wait_for_torch_loading(proc, timeout=60):
+    """Waits until the process has begun loading torch's C++ library: the middle of
+    torch's import, which goes on for a second or more after that."""
+    maps = Path(f"/proc/{proc.pid}/maps")
+    if not maps.exists():  # (not Linux: a fixed wait instead)
+        time.sleep(0.5)
+        return
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and proc.poll() is None and "libtorch" not in maps.read_text():
+        time.sleep(0.005)
+
+
 def digest(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
@@ -48,13 +60,18 @@ def no_leftovers(folder: Path):
 
 
 def test_ctrl_c_while_torch_is_imported(tmp_path):
-    svg = tmp_path / "a.svg"
-    svg.write_text(f'<svg {NS} width="10" height="10"><rect width="5" height="5"/></svg>')
-    proc = start("render", svg, "-o", tmp_path / "a.png", cwd=tmp_path)
-    time.sleep(0.4)  # the command has started; torch takes a second or more to import
+    # (paint imports torch at once; render of a plain file needs no torch at all, and
+    # once finished in the 0.4 s this test used to wait, so its Ctrl-C hit an exiting
+    # process)
+    target = tmp_path / "target.png"
+    target.write_bytes(PHOTO.read_bytes())
+    out = tmp_path / "out.svg"
+    proc = start("paint", target, "-o", out, "--iterations", "100000", "--threads", "1", cwd=tmp_path)
+    wait_for_torch_loading(proc)
     proc.send_signal(signal.SIGINT)
     code, _, err = finish(proc)
-    assert code == 130 and "Traceback" not in err and "interrupted" in err
+    assert code == 130 and "Traceback" not in err and "interrupted" in err, (code, err)
+    assert not out.exists()
     no_leftovers(tmp_path)
 
 
