@@ -48,7 +48,10 @@ def translucent_pixels(alpha: np.ndarray) -> np.ndarray:
         return partial
     kernel = np.ones((2 * RIM + 1, 2 * RIM + 1), np.uint8)
     near_solid = cv2.dilate((a >= SOLID).astype(np.uint8), kernel) > 0
-    near_clear = cv2.dilate((a <= CLEAR).astype(np.uint8), kernel) > 0
+    # Beyond the canvas is clear: a shape the canvas's edge cuts through has a rim of
+    # partial pixels along that edge (a logo's letters cut at the bottom row).
+    clear = np.pad(a <= CLEAR, RIM, constant_values=True).astype(np.uint8)
+    near_clear = cv2.dilate(clear, kernel)[RIM:-RIM, RIM:-RIM] > 0
     return partial & ~(near_solid & near_clear)
 
 

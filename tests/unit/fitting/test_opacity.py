@@ -38,6 +38,17 @@ def test_an_anti_aliased_rim_is_not_translucency():
     assert has_translucent_areas(shadow)
 
 
+def test_a_shape_ending_in_the_canvas_edge_pixels_is_not_translucency():
+    # A bar ending half-way into the last row and the first column, as logos-030's
+    # letters do at 256 px: those partial pixels border the clear beyond the canvas.
+    bar = np.zeros((40, 48), np.float32)
+    bar[10:39, 1:30] = 1.0
+    bar[39, 1:30] = bar[10:39, 0] = 0.5
+    bar[39, 0] = 0.25
+    assert not has_translucent_areas(bar)
+    assert has_translucent_areas(0.5 * bar)
+
+
 def test_flat_art_and_photographs_told_apart():
     flat = rgba(disc(), background=(1, 1, 1))
     assert flat_share(flat[..., :3]) > 0.85
