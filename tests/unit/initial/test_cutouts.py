@@ -117,3 +117,30 @@ def test_the_file_keeps_its_size_and_view_box():
     out, _ = cut_out(svg.encode(), (W, H))
     assert f'width="{W / 4}mm"' in out.decode() and f'viewBox="0 0 {W} {H}"' in out.decode()
     assert np.isfinite(f64(scene(out).shapes[0].geometry.points)).all()
+
+
+def test_a_flat_cubic_past_its_moved_end_becomes_a_line():
+    # noto-emoji-040: a chain's end moved back along a straight stretch left its control
+    # point 0.16 px past the end, a spike that made the piece's outline cross itself
+    from vecfit.initial.tracer.cutouts import _collinear_as_lines
+    points = np.array([[130.0, 53.0], [140.19, 52.97], [140.81, 52.97], [141.08, 52.97], [140.92, 52.97],
+                       [144.0, 48.9], [156.8, 39.0], [165.0, 34.2]])
+    out, degrees = _collinear_as_lines(points, [1, 3, 3], 0.1)
+    assert degrees == [1, 1, 3]
+    assert np.array_equal(out, points[[0, 1, 4, 5, 6, 7]])
+    bulging = points.copy()
+    bulging[2, 1] += 0.5  # a real curve stays one
+    assert _collinear_as_lines(bulging, [1, 3, 3], 0.1)[1] == [1, 3, 3]
+
+
+def test_a_piece_with_no_area_is_not_written():
+    # a piece whose two chains were laid on the same stretch of an outline: a loop that
+    # goes out and back on itself, which the crossing test finds crossed
+    from vecfit.initial.tracer.cutouts import _piece_layout
+    chain = (np.array([[135.76, 495.7], [136.81, 495.77], [137.86, 495.77], [138.91, 495.85]]), [3])
+    layout = _piece_layout([[(0, False), (0, True)]], [chain], lambda p: p, decimals=2, tolerance=0.01,
+                           stub=0.05, min_area=1.0)
+    assert layout is None
+    small = (np.array([[0.0, 0.0], [0.6, 0.0], [0.6, 0.6], [0.0, 0.6], [0.0, 0.0]]), [1, 1, 1, 1])
+    kept = _piece_layout([[(0, False)]], [small], lambda p: p, decimals=2, tolerance=0.01, stub=0.05, min_area=1.0)
+    assert kept is not None and kept[1] == [1, 1, 1, 1]  # a lone small piece is kept: its neighbours leave it a hole

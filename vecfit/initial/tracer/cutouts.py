@@ -210,7 +210,29 @@ def _junctions(chains, curves, follows: dict, step: float) -> None:
             if piece and np.hypot(*(piece[0][0] - a)) < JUNCTION_REACH and \
                     np.hypot(*(piece[-1][-1] - b)) < JUNCTION_REACH:
                 curves[k] = layout(piece)
-        curves[k] = _moved_ends(*curves[k], a, b)
+        curves[k] = _collinear_as_lines(*_moved_ends(*curves[k], a, b), LINES)
+
+
+def _collinear_as_lines(points: np.ndarray, degrees: list[int], tolerance: float):
+    """The open curve with each cubic whose control points lie within ``tolerance`` of
+    its chord's line written as a line. Moving a chain's end back along a straight stretch
+    can leave a control point past the new end: a flat cubic that runs beyond its end and
+    doubles back, a spike the crossing test rightly finds (noto-emoji-040's cut-outs)."""
+    out, kept, at = [points[:1]], [], 0
+    for d in degrees:
+        seg = points[at:at + d + 1]
+        at += d
+        if d == 3:
+            chord = seg[-1] - seg[0]
+            length = float(np.hypot(*chord))
+            if length > 1e-9:
+                rel = seg[1:3] - seg[0]
+                across = np.abs(rel[:, 0] * chord[1] - rel[:, 1] * chord[0]) / length
+                if float(across.max()) <= tolerance:
+                    seg, d = seg[[0, -1]], 1
+        out.append(seg[1:])
+        kept.append(d)
+    return np.concatenate(out), kept
 
 
 def _moved_ends(points: np.ndarray, degrees: list[int], a: np.ndarray, b: np.ndarray):
@@ -280,7 +302,10 @@ def _piece_layout(outlines, curves, user, decimals: int, tolerance: float, stub:
             continue
         loops = simple_loops(segs, tolerance, decimals)
         for loop in loops:
-            if len(loops) > 1 and abs(loop_area(loop)) < min_area:
+            area = abs(loop_area(loop))
+            # (a lone loop is the piece: kept however small, unless it has no area at all,
+            # as where its two chains were laid on the same stretch of an outline)
+            if area < (min_area if len(loops) > 1 else stub * stub):
                 continue
             loop_points, loop_degrees = layout_of(loop, True)
             spans.append((len(degrees), len(loop_degrees), True))
