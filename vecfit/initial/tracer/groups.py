@@ -14,13 +14,19 @@ which shape reaches under which, and the pieces of a group fill the same pixels 
 
 The background region of an opaque image (the tracer's full-canvas rect) keeps a group
 of its own: pieces of its colour elsewhere (an eye's highlight) must be drawn above what
-surrounds them, not under everything.
+surrounds them, not under everything. Pieces of its colour on the canvas's edge are the
+page too (the corners a logo's ring cuts off) and join it: as a group of their own they
+took a colour from the budget, and at a budget of one path they were merged with the
+logo into one grey shape (logos-052, 10.7 dB).
 """
 from __future__ import annotations
 
 import numpy as np
 
+from .quantize import to_lab
 from .regions import Regions, painted_regions
+
+PAGE_COLOUR = 2.0  # CIELAB units: a piece on the canvas's edge this close to the page's colour is page
 
 
 def ward_groups(area: np.ndarray, color: np.ndarray, budget: int) -> np.ndarray:
@@ -90,12 +96,47 @@ def grouped(regions: Regions, rgb: np.ndarray, budget: int, background: int | No
     n = regions.count
     if n == 0:
         return regions
-    others = np.array([i for i in range(n) if i != background], np.int64)
+    page = _page_pieces(regions, background)
+    others = np.array([i for i in range(n) if i != background and not page[i]], np.int64)
     group = np.empty(n, np.int64)
-    group[others] = ward_groups(regions.area[others], regions.color[others], max(int(budget), 1))
+    if len(others):
+        group[others] = ward_groups(regions.area[others], regions.color[others], max(int(budget), 1))
+        group[others] = _same_colours_joined(group[others], regions.area[others], regions.color[others])
     count = int(group[others].max()) + 1 if len(others) else 0
     if background is not None:
         group[background] = count
+        group[page] = count
         count += 1
     labels = np.where(regions.labels >= 0, group[np.maximum(regions.labels, 0)], -1).astype(np.int32)
     return painted_regions(labels, count, rgb)
+
+
+def _page_pieces(regions: Regions, background: int | None) -> np.ndarray:
+    """[count] bool: the regions besides the background that touch the canvas's edge in
+    the background's colour (within PAGE_COLOUR)."""
+    page = np.zeros(regions.count, bool)
+    if background is None:
+        return page
+    labels = regions.labels
+    edge = np.unique(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]))
+    edge = edge[(edge >= 0) & (edge != background)]
+    if len(edge):
+        lab = to_lab(np.asarray(regions.color, np.float64).reshape(-1, 3))
+        page[edge] = np.linalg.norm(lab[edge] - lab[background], axis=1) < PAGE_COLOUR
+    return page
+
+
+def _same_colours_joined(group: np.ndarray, area: np.ndarray, color: np.ndarray) -> np.ndarray:
+    """Ward's groups renumbered 0.. with groups of one colour (means within PAGE_COLOUR)
+    joined: a budget above the number of colours must not split a colour over two paths
+    (a flag's white cross as two paths of L-shaped pieces)."""
+    ids, group = np.unique(group, return_inverse=True)
+    weight = np.bincount(group, area, minlength=len(ids))
+    mean = np.stack([np.bincount(group, area * color[:, c], minlength=len(ids)) for c in range(3)], 1)
+    lab = to_lab(mean / np.maximum(weight, 1e-12)[:, None])
+    into = np.arange(len(ids))
+    for g in range(len(ids)):
+        close = np.flatnonzero(np.linalg.norm(lab[:g] - lab[g], axis=1) < PAGE_COLOUR)
+        if len(close):
+            into[g] = into[close[0]]
+    return np.unique(into, return_inverse=True)[1][group]

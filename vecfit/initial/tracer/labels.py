@@ -11,6 +11,18 @@ import cv2
 import numpy as np
 
 
+def covering_boxes(a: list, b: list) -> list:
+    """Per label, the box covering its boxes in ``a`` and ``b`` (None where both are)."""
+    out = []
+    for x, y in zip(a, b):
+        if x is None or y is None:
+            out.append(x if y is None else y)
+        else:
+            out.append((slice(min(x[0].start, y[0].start), max(x[0].stop, y[0].stop)),
+                        slice(min(x[1].start, y[1].start), max(x[1].stop, y[1].stop))))
+    return out
+
+
 def bounding_boxes(labels: np.ndarray, count: int) -> list:
     """(rows, cols) slices of the box around each label 0..count-1 of ``labels`` (an int
     array [H, W]; negative values belong to none), None for a label with no pixel:

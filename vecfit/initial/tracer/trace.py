@@ -19,13 +19,14 @@ from vecfit.svg.numbers import hex_color
 
 from .bezier import fit_outlines
 from .groups import grouped
-from .labels import bounding_boxes
+from .labels import bounding_boxes, covering_boxes
 from .outlines import drawing_order, grown_masks, shape_outlines
 from .quantize import OPAQUE, nearest_centre, palette_classes, prefilter, quantize_colors, to_lab
 from .regions import build_regions, majority_class, palette_colors
 from .settings import TraceResult, TraceSettings, check_settings
 from .subpixel import refine_outlines
 from .primitives import as_primitive, straightened
+from .tucked import tucked_hosts
 
 # Compound paths keep every region (specks and slivers merge away regardless): the
 # budget counts colours. (Capping the regions at 2-8 a path changed no file's segments by
@@ -38,6 +39,12 @@ ALL_REGIONS = 1 << 30
 # rectangle's sides 0.5 px or more from its nearest ellipse (an emoji's eye, 20 x 37 px).
 ELLIPSE_TOLERANCE = 0.35
 from .svgtext import add_path, add_primitive, add_rect, new_document, outline_path_data, path_data
+
+
+def _same_colour(a, b) -> bool:
+    """Whether two fills look the same (under one CIELAB unit apart)."""
+    lab = to_lab(np.asarray([a, b], np.float64).reshape(2, 3))
+    return float(np.linalg.norm(lab[0] - lab[1])) < 1.0
 
 
 def check_image(image) -> np.ndarray:
@@ -108,6 +115,7 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     # does not count (a designer's page is the background of the drawing); flat art keeps
     # every region and the budget counts colours (compound paths: groups.py)
     compound = s.compound and is_flat_art(rgb)
+    host = None  # flat art's pieces tucked under another region (tucked.py)
     budget = ALL_REGIONS if compound else int(s.paths) + int(bool(opaque.all()))
     regions = build_regions(classes, rgb, budget, s.min_area, s.merge_thin)
     report("order", 0.35)
@@ -116,8 +124,10 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     if compound and regions.count:
         backdrop = int(order[0]) if opaque.all() else None
         regions = grouped(regions, rgb, int(s.paths), backdrop)
-        boxes = bounding_boxes(regions.labels, regions.count)
-        order = drawing_order(regions.labels, regions.count, boxes)
+        host = tucked_hosts(regions.labels, regions.count)
+        boxes = covering_boxes(bounding_boxes(regions.labels, regions.count),
+                               bounding_boxes(host, regions.count))
+        order = drawing_order(regions.labels, regions.count, boxes, host)
         if backdrop is not None:  # the backdrop's group (the last) is drawn first, as the rect
             order = np.concatenate([[regions.count - 1], order[order != regions.count - 1]])
     rank = np.empty(regions.count, np.int64)
@@ -130,7 +140,8 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     shapes, outlines, holes = [], [], []  # shapes: (region, its outlines' slice of `outlines`)
     drawn = [i for i in order.tolist() if i != background]
     drawn_rank = np.append(rank, -1)[regions.labels]  # each pixel's region's rank; -1: none
-    masks = dict(zip(drawn, grown_masks(regions.labels, rank, drawn_rank, drawn, boxes, int(s.overlap))))
+    masks = dict(zip(drawn, grown_masks(regions.labels, rank, drawn_rank, drawn, boxes, int(s.overlap),
+                                               host)))
     for j, i in enumerate(order):
         if i == background:
             continue
@@ -138,7 +149,7 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
         # the shape must not paint over pixels no region draws (transparent, or an isolated
         # speck that was dropped) nor, mostly, those of the regions drawn before it
         ranks = drawn_rank[y0:y0 + mask.shape[0], x0:x0 + mask.shape[1]]
-        found, is_hole = shape_outlines(mask, ranks, j, (x0, y0), s.min_area)
+        found, is_hole = shape_outlines(mask, ranks, j, (x0, y0), s.min_area, sharp=compound)
         shapes.append((i, slice(len(outlines), len(outlines) + len(found))))
         outlines.extend(found)
         holes.extend(is_hole)
@@ -162,10 +173,11 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     if background is not None:
         fills.add(hex_color(paint[background]))
         add_rect(document, w, h, hex_color(paint[background]))
-    for i, sl in shapes:
+    for n, (i, sl) in enumerate(shapes):
         subpaths = [sp for sp in fitted[sl] if len(sp)]
-        if not subpaths:
-            continue
+        if not subpaths or (compound and n == 0 and background is not None
+                            and _same_colour(paint[i], paint[background])):
+            continue  # (the first shape over the backdrop, in its colour: it would paint nothing)
         fill = hex_color(paint[i])
         fills.add(fill)
         cut = any(holes[sl])
