@@ -62,8 +62,9 @@ def resolve(command: str, *, preset: str | None = None, config_file=None,
 
 def validate(settings: dict) -> None:
     """Checks the values, not just the keys and types: a bad background, loss, rate, trace
-    or paint setting is refused here, before any work starts (VecfitError). [optimize] is
-    checked by its type, Settings."""
+    or paint setting is refused here, before any work starts (VecfitError), and only here:
+    the jobs take what ``resolve`` returns as checked. [optimize] is checked by its type,
+    Settings."""
     Settings.from_config(settings["optimize"])
     from vecfit.jobs.palette import parse_palette  # an unreadable or empty palette: refused before any work
     parse_palette(settings["optimize"]["palette"])
@@ -92,6 +93,13 @@ def validate(settings: dict) -> None:
     if "retarget" in settings:
         from vecfit.editing.settings import RetargetSettings
         settings_of(RetargetSettings, settings["retarget"]).check()
+
+
+def loop_settings(config: dict) -> Settings:
+    """The [optimize] table of a config that ``resolve`` made (and checked) as the loop's
+    Settings, its device resolved here: once a run, where the job runs (batch may hand
+    jobs to other processes and machines)."""
+    return Settings.of_checked(config["optimize"])
 
 
 def output_precision(settings: dict) -> int | None:
