@@ -17,7 +17,7 @@ import dataclasses
 from vecfit.errors import VecfitError
 from vecfit.fitting.settings import Settings  # torch-free: trace --no-refine checks it too
 from vecfit.io.configs import configs_dir, merge, packaged, read_toml  # noqa: F401 (configs_dir: for callers)
-from vecfit.names import EFFORTS, STACKINGS
+from vecfit.names import EFFORTS, GROUP_BY, STACKINGS
 
 DEFAULT_EFFORT = "normal"
 
@@ -68,10 +68,10 @@ def validate(settings: dict) -> None:
     Settings.from_config(settings["optimize"])
     from vecfit.jobs.palette import parse_palette  # an unreadable or empty palette: refused before any work
     parse_palette(settings["optimize"]["palette"])
-    if settings["output"]["group_by"] not in ("none", "colour", "color"):
+    if settings["output"]["group_by"] not in GROUP_BY:
         raise VecfitError(f"output.group_by must be none or colour, not {settings['output']['group_by']!r}")
     if settings["output"]["stacking"] not in STACKINGS:
-        raise VecfitError(f"output.stacking must be stacked or cutouts, not {settings['output']['stacking']!r}")
+        raise VecfitError(f"output.stacking must be {' or '.join(STACKINGS)}, not {settings['output']['stacking']!r}")
     if settings["output"]["stacking"] == "cutouts" and settings.get("trace", {}).get("style", "fills") != "fills":
         raise VecfitError("cut-outs are filled pieces: --stacking cutouts needs --style fills")
     if settings["output"]["gap_filler"] and settings["output"]["stacking"] != "cutouts":
