@@ -69,6 +69,12 @@ def test_the_configs_refuse_a_name_outside_the_lists():
         resolve("refine", effort="fast")
 
 
+def test_the_loop_implements_exactly_the_losses():
+    from vecfit.fitting import losses
+    assert tuple(losses.FUNCTIONS) == names.LOSSES
+    assert set(losses.WEIGHTED) < set(names.LOSSES)
+
+
 def test_the_package_and_the_jobs_agree():
     from vecfit.batch import plan
     from vecfit.jobs.protocol import JOB_MODULES
