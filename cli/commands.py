@@ -13,7 +13,7 @@ from pathlib import Path
 import click
 
 from vecfit.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE
-from vecfit.names import EFFORTS, FILTERS, FORMATS, JOBS, LOSSES, MODES, PAINT_KINDS, STACKINGS, STYLES
+from vecfit.names import EFFORTS, FILTERS, FORMATS, GROUP_BY, JOBS, LOSSES, MODES, PAINT_KINDS, STACKINGS, STYLES
 
 DEVICE_OPTION = dict(metavar="auto|cpu|cuda[:N]",
                      help="Where pixels are shaded: auto (a GPU when vecfit was built with CUDA and "
@@ -273,7 +273,7 @@ def optimize_options(f):
 
 def colour_options(f):
     """--palette and --group-by: trace, refine, paint (vecfit/jobs/palette.py, vecfit/svg/layers.py)."""
-    f = click.option("--group-by", "group_by", type=click.Choice(["none", "colour", "color"]),
+    f = click.option("--group-by", "group_by", type=click.Choice(GROUP_BY),
                      help="colour: one <g> (an Inkscape layer) per colour, in stacking order.")(f)
     return click.option("--palette", metavar="COLOURS|FILE|auto:N",
                         help="Every paint one of these colours, exactly: '#e63946,#f1faee', a file "

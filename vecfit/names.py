@@ -29,6 +29,10 @@ PAINT_KINDS = ("strokes", "shapes")
 # Styles of trace ([trace] style): filled regions, strokes, or both.
 STYLES = ("fills", "strokes", "mixed")
 
+# How the written shapes are grouped ([output] group_by): as they are, or one <g> a colour
+# (vecfit/svg/layers.py; both spellings).
+GROUP_BY = ("none", "colour", "color")
+
 # How the written shapes lie ([output] stacking): over one another, or as cut-outs that
 # do not overlap (vecfit/initial/tracer/cutouts.py).
 STACKINGS = ("stacked", "cutouts")

@@ -20,7 +20,7 @@ CHOICES = {
     ("paint", "kind"): names.PAINT_KINDS,
     **{(command, option): values for command in ("refine", "trace", "paint")
        for option, values in (("mode", names.MODES), ("loss", names.LOSSES), ("effort", names.EFFORTS),
-                              ("output_format", names.FORMATS))},
+                              ("output_format", names.FORMATS), ("group_by", names.GROUP_BY))},
 }
 
 
@@ -36,11 +36,11 @@ def test_the_command_lines_choices_are_the_names(command, option):
 
 
 def test_every_choice_of_the_command_line_is_a_list_of_names():
-    """No command offers a Choice written out by hand (but --group-by's spellings)."""
+    """No command offers a Choice written out by hand."""
     lists = {v for k, v in vars(names).items() if k.isupper()}
     for name, command in main.commands.items():
         for param in command.params:
-            if isinstance(param.type, click.Choice) and param.name != "group_by":
+            if isinstance(param.type, click.Choice):
                 assert tuple(param.type.choices) in lists, (name, param.name)
 
 
@@ -67,6 +67,12 @@ def test_the_configs_refuse_a_name_outside_the_lists():
         Settings.from_config({**defaults("refine", "optimize"), "loss": "l3"})
     with pytest.raises(VecfitError, match="unknown effort 'fast' \\(known: quick, normal, best\\)"):
         resolve("refine", effort="fast")
+
+
+def test_the_loop_implements_exactly_the_losses():
+    from vecfit.fitting import losses
+    assert tuple(losses.FUNCTIONS) == names.LOSSES
+    assert set(losses.WEIGHTED) < set(names.LOSSES)
 
 
 def test_the_package_and_the_jobs_agree():

@@ -22,7 +22,6 @@ import torch
 from vecfit.errors import NonFiniteScene, VecfitError
 from vecfit.io.compositing import composite_torch
 from vecfit.io.images import downscaled, downscaled_weight
-from vecfit.renderer import device as devices
 from vecfit.renderer.persistent import PersistentPack
 from vecfit.renderer.raster import render
 from vecfit.renderer.stopwatch import lap, phase
@@ -154,8 +153,8 @@ def optimize(scene: Scene, target: Target, settings: Settings,
     ``keep_alpha``: colour tensors whose alpha must not change (e.g. a backdrop that
     has to keep the canvas covered), beside those ``settings.alpha`` keeps (opacity.py). ``penalty``: a term added to every iteration's loss,
     computed from the Scene's tensors (its gradient reaches them with the image's), e.g.
-    `vecfit edit`'s cost of moving what the edit did not touch."""
-    settings.check()
+    `vecfit edit`'s cost of moving what the edit did not touch. ``settings`` are taken as
+    made (Settings.from_config and defaults check them and resolve the device)."""
     if target.weight is not None:
         losses.weighted(settings.loss)  # refuses a loss that takes no weight, before any work
     return _Fit(scene, target, settings, hooks, keep_alpha, penalty).run(progress)
@@ -171,7 +170,6 @@ class _Fit:
         self.loss_fn = losses.get(settings.loss)
         height, width = target.image.shape[:2]
         self.fine_from, self.levels = _levels(target, settings, len(scene.shapes))
-        self.device = devices.device_name(devices.resolve(settings.device))  # "auto" settled once
         self.density = outline_density(scene, width, height)
         lr = dict(settings.lr)
         if "points" in lr:
@@ -220,7 +218,7 @@ class _Fit:
                            seed=settings.seed + iteration, background=self.target.background,
                            threads=settings.threads, boundary_samples=settings.boundary_samples,
                            interior_samples=settings.interior_samples, boundary_budget=settings.boundary_budget,
-                           device=self.device,
+                           device=settings.device,
                            packed=self.packed(w, h))
             self.image = image.detach()
             loss = at.loss(self.loss_fn, settings.loss, at.rendered(image), goal)

@@ -92,18 +92,23 @@ def weighted_pyramid(a: torch.Tensor, b: torch.Tensor, weight: torch.Tensor, lev
     return total
 
 
+# The losses by name: names.LOSSES, which the configs and the command line offer
+# (tests/unit/test_names.py holds the two together), and those that take a per-pixel weight.
+FUNCTIONS = {"l2": l2, "l1": l1, "ssim": ssim_loss, "pyramid": pyramid}
+WEIGHTED = {"l2": weighted_l2, "l1": weighted_l1, "pyramid": weighted_pyramid}
+
+
 def weighted(name: str):
     """The loss ``name`` with a per-pixel weight: l2, l1 and pyramid (a weight has no
     plain meaning for SSIM's windows)."""
-    table = {"l2": weighted_l2, "l1": weighted_l1, "pyramid": weighted_pyramid}
-    if name not in table:
+    if name not in WEIGHTED:
         get(name)  # an unknown name is refused as such
-        raise VecfitError(f"loss {name!r} takes no per-pixel weight; use l2, l1 or pyramid")
-    return table[name]
+        *most, last = WEIGHTED
+        raise VecfitError(f"loss {name!r} takes no per-pixel weight; use {', '.join(most)} or {last}")
+    return WEIGHTED[name]
 
 
 def get(name: str):
-    table = {"l2": l2, "l1": l1, "ssim": ssim_loss, "pyramid": pyramid}
-    if name not in table:
+    if name not in FUNCTIONS:
         raise VecfitError(f"loss must be one of {', '.join(LOSSES)}, not {name!r}")
-    return table[name]
+    return FUNCTIONS[name]

@@ -21,3 +21,21 @@ class Result:
     coarse_iterations: int = 0  # the first ones, fitted at half the size
     outline_density: Optional[float] = None  # control polygon px per image px at the start (rates.py)
     point_rate: Optional[float] = None  # the point rate used, px a step (after the density rule)
+
+
+def joined(runs: list[Result]) -> Result:
+    """Runs of the loop made one after another on one Scene (retarget's rounds) as one:
+    their curves, counts and times added up; the parameters and rates the last one used
+    (every run optimises the same tensors)."""
+    last = runs[-1] if runs else Result()
+    return Result(losses=[v for r in runs for v in r.losses],
+                  best_loss=last.best_loss,
+                  iterations=sum(r.iterations for r in runs),
+                  seconds=sum(r.seconds for r in runs),
+                  interrupted=any(r.interrupted for r in runs),
+                  skipped_steps=sum(r.skipped_steps for r in runs),
+                  parameters=dict(last.parameters),
+                  iteration_seconds=[t for r in runs for t in r.iteration_seconds],
+                  coarse_iterations=sum(r.coarse_iterations for r in runs),
+                  outline_density=last.outline_density,
+                  point_rate=last.point_rate)

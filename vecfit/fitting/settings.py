@@ -29,7 +29,7 @@ class Settings:
     interior_samples: int  # of the N x N samples per pixel, those the backward revisits (0: all)
     seed: int
     threads: int
-    device: str
+    device: str  # resolved (Settings.of_checked): cpu or cuda:N
     lr_decay: float
     lr_warmup: int
     alpha: str  # ALPHA_MODES: auto (only where the target or the colour is translucent) | free | fixed
@@ -54,17 +54,29 @@ class Settings:
 
     @classmethod
     def from_config(cls, table: dict, source: str = "configs/refine.toml") -> "Settings":
-        """From the whole [optimize] table: every key is a field here, and a key that is not
-        (or a field left out) is an error naming ``source`` (the file) and the key."""
+        """From the whole [optimize] table, checked: every key is a field here, and a key
+        that is not (or a field left out) is an error naming ``source`` (the file) and the
+        key; a value out of range is refused. The one check of these settings:
+        vecfit.jobs.config.resolve makes it for every command, before any work."""
+        s = cls.of_checked(table, source)
+        s.check()
+        return s
+
+    @classmethod
+    def of_checked(cls, table: dict, source: str = "configs/refine.toml") -> "Settings":
+        """From an [optimize] table whose values were checked (by vecfit.jobs.config.resolve:
+        a job's settings), its values not checked again. The device is resolved here,
+        "auto" settled to "cpu" or "cuda:N": the loop, the renders a job scores and its
+        report all take this one name."""
         known = {f.name for f in fields(cls)}
         unknown, missing = sorted(set(table) - known), sorted(known - set(table) - {"lr"})
         if unknown or missing:
             problem = (f"unknown setting 'optimize.{unknown[0]}' (known here: {', '.join(sorted(known))})"
                        if unknown else f"missing setting 'optimize.{missing[0]}'")
             raise VecfitError(f"{source}: {problem}")
-        s = cls(**{k: v for k, v in table.items() if k != "lr"}, lr=dict(table.get("lr", {})))
-        s.check()
-        return s
+        device = devices.device_name(devices.resolve(table["device"]))
+        return cls(**{k: v for k, v in table.items() if k not in ("lr", "device")}, device=device,
+                   lr=dict(table.get("lr", {})))
 
     def check(self) -> None:
         if self.iterations < 0:
@@ -97,7 +109,6 @@ class Settings:
             raise VecfitError(f"simplify_iterations must be 0 or more, not {self.simplify_iterations}")
         if self.background.strip().lower() != "auto":
             fitting_background(self.background)
-        devices.resolve(self.device)
         for kind, value in self.lr.items():
             if kind not in PARAMETER_KINDS:
                 raise VecfitError(f"unknown parameter kind {kind!r} (known: {', '.join(PARAMETER_KINDS)})")

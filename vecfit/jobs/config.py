@@ -17,7 +17,7 @@ import dataclasses
 from vecfit.errors import VecfitError
 from vecfit.fitting.settings import Settings  # torch-free: trace --no-refine checks it too
 from vecfit.io.configs import configs_dir, merge, packaged, read_toml  # noqa: F401 (configs_dir: for callers)
-from vecfit.names import EFFORTS, STACKINGS
+from vecfit.names import EFFORTS, GROUP_BY, STACKINGS
 
 DEFAULT_EFFORT = "normal"
 
@@ -62,15 +62,16 @@ def resolve(command: str, *, preset: str | None = None, config_file=None,
 
 def validate(settings: dict) -> None:
     """Checks the values, not just the keys and types: a bad background, loss, rate, trace
-    or paint setting is refused here, before any work starts (VecfitError). [optimize] is
-    checked by its type, Settings."""
+    or paint setting is refused here, before any work starts (VecfitError), and only here:
+    the jobs take what ``resolve`` returns as checked. [optimize] is checked by its type,
+    Settings."""
     Settings.from_config(settings["optimize"])
     from vecfit.jobs.palette import parse_palette  # an unreadable or empty palette: refused before any work
     parse_palette(settings["optimize"]["palette"])
-    if settings["output"]["group_by"] not in ("none", "colour", "color"):
+    if settings["output"]["group_by"] not in GROUP_BY:
         raise VecfitError(f"output.group_by must be none or colour, not {settings['output']['group_by']!r}")
     if settings["output"]["stacking"] not in STACKINGS:
-        raise VecfitError(f"output.stacking must be stacked or cutouts, not {settings['output']['stacking']!r}")
+        raise VecfitError(f"output.stacking must be {' or '.join(STACKINGS)}, not {settings['output']['stacking']!r}")
     if settings["output"]["stacking"] == "cutouts" and settings.get("trace", {}).get("style", "fills") != "fills":
         raise VecfitError("cut-outs are filled pieces: --stacking cutouts needs --style fills")
     if settings["output"]["gap_filler"] and settings["output"]["stacking"] != "cutouts":
@@ -92,6 +93,13 @@ def validate(settings: dict) -> None:
     if "retarget" in settings:
         from vecfit.editing.settings import RetargetSettings
         settings_of(RetargetSettings, settings["retarget"]).check()
+
+
+def loop_settings(config: dict) -> Settings:
+    """The [optimize] table of a config that ``resolve`` made (and checked) as the loop's
+    Settings, its device resolved here: once a run, where the job runs (batch may hand
+    jobs to other processes and machines)."""
+    return Settings.of_checked(config["optimize"])
 
 
 def output_precision(settings: dict) -> int | None:

@@ -10,26 +10,24 @@ import time
 import numpy as np
 import torch
 
-from vecfit import __version__
 from vecfit.editing.mask import changed_region, grown, load_mask
 from vecfit.editing.settings import EditSettings
 from vecfit.errors import VecfitError
 from vecfit.fitting.anchor import acting_on, anchors
-from vecfit.fitting.loop import Settings, Target, optimize
+from vecfit.fitting.loop import Target, optimize
 from vecfit.fitting.metrics import compare, seen, to_rgb
 from vecfit.fitting.rates import learning_rate_scales
 from vecfit.io.images import downscaled, downscaled_weight
-from vecfit.io.report import error_map, panels_image, save_panels, save_report
-from vecfit.renderer import device as devices
+from vecfit.io.report import error_map, panels_image, save_panels
 from vecfit.scene import Scene
 from vecfit.scene.crossings import crossed_subpaths
-from vecfit.svg.numbers import hex_color
-from vecfit.svg.stats import design_stats
 from vecfit.svg.write import svg_bytes
 
-from .config import output_precision, settings_of
-from .fit import _render_full, background_for, cut_crossed_outlines, load_scene_to_fit, load_target
+from .config import loop_settings, output_precision, settings_of
+from .fit import background_for, cut_crossed_outlines, load_scene_to_fit, load_target
 from .protocol import Inputs, Outputs, listener
+from .report import job_report
+from .scoring import refuse_non_finite, render_for_scoring
 
 MOVED_PX = 0.1        # an element counts as changed when a length moved this many pixels
 RECOLOURED = 1.5 / 255  # ... or a colour channel more than a step of #rrggbb
@@ -101,16 +99,14 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     scene, document = load_scene_to_fit(inputs.svg)
     fit_canvas(scene, target, svg_path, edited_path)
     edit = settings_of(EditSettings, config["edit"])
-    edit.check()
-    opt = {**config["optimize"], "device": devices.device_name(devices.resolve(config["optimize"]["device"]))}
-    settings = Settings.from_config(opt)
+    settings = loop_settings(config)  # its device resolved once: the loop, the renders, the report
     kinds = [k for k, v in scene.parameters().items() if v and settings.lr.get(k, 0) > 0]
     if not kinds:
         raise VecfitError(f"{svg_path}: nothing to optimise (no parameter kind has a learning rate above 0)")
-    background = background_for(target, opt["background"])
+    background = background_for(target, settings.background)
     h, w = target.shape[:2]
 
-    original_image = _render_full(scene, w, h, opt).numpy()
+    original_image = render_for_scoring(scene, w, h, settings)
     if mask is not None:
         region = load_mask(mask, (w, h))
     else:
@@ -128,14 +124,14 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     # unlike the original on 92% of the error's pixels. Where nothing was edited, nothing
     # should move.
     aimed = np.where(region[..., None], target, original_image).astype(np.float32)
-    small = downscaled(aimed, opt["max_size"])
+    small = downscaled(aimed, settings.max_size)
     sh, sw = small.shape[:2]
     weight = downscaled_weight(np.where(region, edit.changed_weight, 1.0).astype(np.float32), (sh, sw))
     region_small = downscaled_weight(region.astype(np.float32), (sh, sw)) > 0
     reach = max(0, round(edit.reach * sh / h))
     free = acting_on(scene, grown(region_small, reach), kinds, samples=settings.samples,
                      seed=settings.seed, threads=settings.threads, background=background,
-                     device=opt["device"])
+                     device=settings.device)
     penalty = anchors(scene, free, kinds, edit.anchor, edit.anchor_free, edit.anchor_free_colors, sw, sh,
                       3 if background is not None else 4)
     before = {id(t): t.detach().clone() for k in kinds for t in scene.parameters()[k]}
@@ -144,13 +140,12 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     drawn_crossed = crossed_subpaths(scene)  # the user's crossings stay; the fit's are cut
     progress.start(settings.iterations)
     result = optimize(scene, goal, settings, progress=progress, penalty=penalty)
-    final_image = original_image if result.iterations == 0 else _render_full(scene, w, h, opt).numpy()
+    final_image = original_image if result.iterations == 0 else render_for_scoring(scene, w, h, settings)
 
     target_rgb = to_rgb(target, background)
     original_rgb, final_rgb = to_rgb(original_image, background), to_rgb(final_image, background)
     initial, final = compare(original_rgb, target_rgb), compare(final_rgb, target_rgb)
-    if not all(math.isfinite(final[k]) or (k == "psnr" and final["mse"] == 0) for k in final):
-        raise VecfitError(f"the optimised image has non-finite values ({final}); nothing written")
+    refuse_non_finite(final)
     changed = changed_elements(scene, before, w, h)
     # after the picture and the changes are measured: cutting a crossed outline into
     # simple loops draws the same (less slivers under a square pixel)
@@ -163,47 +158,22 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     if outputs.comparison is not None:
         save_panels(outputs.comparison, panels_image(
             [original_rgb, target_rgb, final_rgb, error_map(final_rgb, target_rgb)]))
-    seconds = time.perf_counter() - started
-    report = {
-        "vecfit": __version__,
-        "command": "edit",
-        "target": str(edited_path),
-        "orientation": orientation,  # the edited image's EXIF orientation, applied
-        "init": str(svg_path),
-        "mask": None if mask is None else str(mask),
-        **outputs.names(),
-        "size": [w, h],
-        "optimized_size": [sw, sh],
-        "background": None if background is None else hex_color(background),
-        "changed_region": {"pixels": int(region.sum()), "fraction": float(region.mean()),
-                           "from": "mask" if mask is not None else "renders"},
-        "initial": initial,
-        "optimized": final,
-        "psnr_gain_db": final["psnr"] - initial["psnr"],
-        "psnr_inside": {"before": region_psnr(original_rgb, target_rgb, region),
-                        "after": region_psnr(final_rgb, target_rgb, region)},
-        "psnr_outside": {"before": region_psnr(original_rgb, target_rgb, ~region),
-                         "after": region_psnr(final_rgb, target_rgb, ~region)},
-        "elements": {"total": len(scene.shapes), "changed": changed,
-                     "unchanged": len(scene.shapes) - len(changed)},
-        "parameters_free": penalty.free,        # act on the changed region
-        "parameters_anchored": penalty.anchored,  # held by the penalty
-        "iterations": result.iterations,
-        "coarse_iterations": result.coarse_iterations,
-        "interrupted": result.interrupted,
-        "skipped_steps": result.skipped_steps,
-        "seconds": {"total": seconds, "optimize": result.seconds,
-                    "per_iteration": result.seconds / max(result.iterations, 1)},
-        "shapes": len(scene.shapes),
-        "file": design_stats(written),  # what a designer finds in the SVG written
-        "parameters": {**result.parameters, "total": sum(result.parameters.values())},
-        "loss": settings.loss,
-        "loss_curve": result.losses,
-        "seed": opt["seed"],
-        "device": opt["device"],
-        "effort": config.get("effort", "normal"),  # quick | normal | best (configs/: [efforts])
-        "config": config,
-    }
-    if outputs.report is not None:
-        save_report(outputs.report, report)
-    return report
+    return outputs.keep_report(job_report(
+        config, settings, outputs, result, started=started,
+        inputs={"command": "edit", "target": str(edited_path),
+                "orientation": orientation,  # the edited image's EXIF orientation, applied
+                "init": str(svg_path), "mask": None if mask is None else str(mask)},
+        canvas={"size": [w, h], "optimized_size": [sw, sh]}, background=background,
+        initial=initial, optimized=final, shapes=len(scene.shapes), written=written,
+        measured={
+            "changed_region": {"pixels": int(region.sum()), "fraction": float(region.mean()),
+                               "from": "mask" if mask is not None else "renders"},
+            "psnr_inside": {"before": region_psnr(original_rgb, target_rgb, region),
+                            "after": region_psnr(final_rgb, target_rgb, region)},
+            "psnr_outside": {"before": region_psnr(original_rgb, target_rgb, ~region),
+                             "after": region_psnr(final_rgb, target_rgb, ~region)},
+            "elements": {"total": len(scene.shapes), "changed": changed,
+                         "unchanged": len(scene.shapes) - len(changed)},
+            "parameters_free": penalty.free,        # act on the changed region
+            "parameters_anchored": penalty.anchored,  # held by the penalty
+        }))

@@ -3,36 +3,33 @@ SVG, report and comparison picture written next to each other. `vecfit refine` s
 from the user's SVG, `vecfit trace` and `vecfit paint` from SVGs of their own making."""
 from __future__ import annotations
 
-import math
 import time
 import warnings
 from pathlib import Path
 
 import numpy as np
 
-from vecfit import __version__
 from vecfit.errors import VecfitError
 from vecfit.fitting.metrics import compare, to_rgb
 from vecfit.fitting.result import Result
+from vecfit.fitting.settings import Settings
 from vecfit.io.colors import fitting_background
 from vecfit.io.images import downscaled, read_image
-from vecfit.io.report import save_comparison, save_report
-from vecfit.renderer import device as devices
-from vecfit.renderer.forward import render_numpy
+from vecfit.io.report import save_comparison
 from vecfit.scene import Scene
-from vecfit.scene.arrays import is_tensor, to_numpy
+from vecfit.scene.arrays import is_tensor
 from vecfit.scene.crossings import crossed_subpaths
 from vecfit.scene.untangle import untangle
-from vecfit.svg.numbers import hex_color
 from vecfit.svg.document import SvgDocument
 from vecfit.svg.read import read_svg, scene_of
 from vecfit.svg.precision import shape_decimals
-from vecfit.svg.stats import design_stats
 from vecfit.svg.write import svg_bytes
 
-from .config import output_precision
+from .config import loop_settings, output_precision
 from .palette import colour_entry, nearest_colour, parse_palette
 from .protocol import Outputs, listener
+from .report import job_report
+from .scoring import refuse_non_finite, render_for_scoring, rendered_rgb, score_written
 
 OPAQUE = 0.999  # a target whose every alpha is at least this is treated as opaque
 ASPECT_TOLERANCE = 0.01
@@ -105,38 +102,13 @@ def generated_scene(document: SvgDocument) -> Scene:
 
 # --------------------------------------------------------------------------- run
 
-def _render_full(scene, w, h, config):
-    """The scene at w x h pixels, without background (straight RGBA): a tensor, or a NumPy
-    array for a Scene of NumPy arrays."""
-    if not is_tensor(scene.view):  # a Scene of NumPy arrays (nothing to optimise): no torch
-        return render_numpy(scene, w, h, samples=config["eval_samples"], seed=config["seed"],
-                            threads=config["threads"], device=config["device"])
-    import torch
-    from vecfit.renderer.raster import render
-    with torch.no_grad():
-        return render(scene, w, h, samples=config["eval_samples"], seed=config["seed"],
-                      threads=config["threads"], device=config["device"])
-
-
-def _scored(svg: bytes, size: tuple[int, int], target_rgb: np.ndarray, background, opt: dict) -> dict:
-    """The written SVG (cut-outs: not what was optimised) read back, rendered at ``size``
-    and compared with the target: {"psnr", "mse", "ssim"}."""
-    from vecfit.export import scene_of_svg
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        scene, _ = scene_of_svg(svg)
-    rgb = to_rgb(to_numpy(_render_full(scene, size[0], size[1], opt)), background)
-    return {k: v for k, v in compare(rgb, target_rgb).items() if k in ("psnr", "mse", "ssim")}
-
-
-def _not_optimised(scene: Scene, opt: dict) -> Result:
+def _not_optimised(scene: Scene, settings: Settings) -> Result:
     """The counts the loop would report for 0 iterations (vecfit.fitting.rates.parameter_kinds:
     the kinds with a positive rate and tensors), and its refusal of a scene without any."""
-    if opt["iterations"] != 0:
+    if settings.iterations != 0:
         raise VecfitError("a Scene of NumPy arrays cannot be optimised (read it with tensors)")
     counts = {name: sum(int(np.size(t)) for t in tensors) for name, tensors in scene.parameters().items()
-              if float(opt["lr"].get(name, 0.0)) > 0 and tensors}
+              if float(settings.lr.get(name, 0.0)) > 0 and tensors}
     if not counts:
         raise VecfitError("nothing to optimise: the scene has no parameters with a learning rate above 0")
     return Result(parameters=counts)
@@ -167,15 +139,14 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     # The report marks a finished run: an old one must not sit beside new outputs if this
     # run dies before it writes its own.
     outputs.forget_report()
-    # "auto" settled once, for the loop, the full-size renders and the report alike
-    opt = {**config["optimize"], "device": devices.device_name(devices.resolve(config["optimize"]["device"]))}
+    settings = loop_settings(config)  # its device resolved once: the loop, the renders, the report
     drop_background = removed_background is not None
-    background = removed_background if drop_background else background_for(target, opt["background"])
-    palette = parse_palette(opt.get("palette"))
+    background = removed_background if drop_background else background_for(target, settings.background)
+    palette = parse_palette(settings.palette)
     if palette is not None and palette.auto is None and not drop_background:  # a background written in is a paint too
         background = nearest_colour(background, palette.rgb)
     h, w = target.shape[:2]
-    small = downscaled(target, opt["max_size"])
+    small = downscaled(target, settings.max_size)
     sh, sw = small.shape[:2]
     # Measured at the optimised size: a 12-megapixel photo's full-size renders, SSIM and
     # comparison took a minute and 3 GB around a loop of seconds (--max-size 0: full size).
@@ -183,8 +154,8 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
 
     # Rendered bare and composited here (the same arithmetic as the core's background):
     # the alpha then also says whether the shapes cover the canvas.
-    initial_image = _render_full(scene, sw, sh, opt)
-    initial_rgb = to_rgb(to_numpy(initial_image), background)
+    initial_image = render_for_scoring(scene, sw, sh, settings)
+    initial_rgb = to_rgb(initial_image, background)
     initial = compare(initial_rgb, target_rgb)
     # crossings the user drew stay; those the fit makes (and those a trace's fit gives a
     # sliver's two sides) are cut into simple loops
@@ -198,9 +169,8 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     simplified = None
     if is_tensor(scene.view):
         import torch
-        from vecfit.fitting.loop import Settings, Target, optimize
+        from vecfit.fitting.loop import Target, optimize
         from vecfit.fitting.opacity import make_opaque
-        settings = Settings.from_config(opt)
         goal = Target(torch.from_numpy(small), background)
         if generated and settings.alpha == "auto" and not goal.wants_translucency:
             make_opaque(scene)
@@ -213,24 +183,22 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
                                                keep_alpha=keep_alpha)
             if not drop_background:  # auto:N's: one of the N
                 background = nearest_colour(background, used / 255.0)
-        if float(opt.get("simplify", 0)) > 0 and result.iterations > 0:  # fewer nodes (fitting/simplify.py)
+        if settings.simplify > 0 and result.iterations > 0:  # fewer nodes (fitting/simplify.py)
             from vecfit.fitting.simplify import simplify_fitted
-            render_rgb = lambda s, seed=0: to_rgb(to_numpy(_render_full(  # noqa: E731
-                s, sw, sh, {**opt, "seed": opt["seed"] + seed})), background)
-            simplified = simplify_fitted(scene, goal, settings, render_rgb, target_rgb, float(opt["simplify"]),
-                                         int(opt["simplify_iterations"]), hooks, keep_alpha)
+            render_rgb = lambda s, seed=0: rendered_rgb(s, sw, sh, settings, background, seed)  # noqa: E731
+            simplified = simplify_fitted(scene, goal, settings, render_rgb, target_rgb, float(settings.simplify),
+                                         int(settings.simplify_iterations), hooks, keep_alpha)
     else:
         progress.start(0)
-        result = _not_optimised(scene, opt)
+        result = _not_optimised(scene, settings)
     untangled = cut_crossed_outlines(scene, drawn_crossed, config, (w, h))
     if result.iterations == 0:  # nothing moved: the same picture and figures
         final_image, final_rgb, final = initial_image, initial_rgb, dict(initial)
     else:
-        final_image = _render_full(scene, sw, sh, opt)
-        final_rgb = to_rgb(to_numpy(final_image), background)
+        final_image = render_for_scoring(scene, sw, sh, settings)
+        final_rgb = to_rgb(final_image, background)
         final = compare(final_rgb, target_rgb)
-    if not all(math.isfinite(final[k]) or (k == "psnr" and final["mse"] == 0) for k in final):
-        raise VecfitError(f"the optimised image has non-finite values ({final}); nothing written")
+    refuse_non_finite(final)
 
     # The SVG must look like what was optimised: where the shapes leave the canvas
     # uncovered, the background is written in as a first rect.
@@ -243,7 +211,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         from vecfit.initial.tracer.cutouts import cut_out
         written, cut = cut_out(written, (w, h), gap_filler=bool(config["output"].get("gap_filler")),
                                precision=output_precision(config), name=str(document.name))
-        cut = {**cut.as_dict(), **_scored(written, (sw, sh), target_rgb, background, opt)}
+        cut = {**cut.as_dict(), **score_written(written, (sw, sh), target_rgb, background, settings)}
     layers = None
     if config["output"].get("group_by", "none") != "none":
         from vecfit.svg.layers import group_by_colour
@@ -253,43 +221,14 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     outputs.keep_svg(written)
     if outputs.comparison is not None:
         save_comparison(outputs.comparison, target_rgb, initial_rgb, final_rgb)
-    seconds = time.perf_counter() - started
-    report = {
-        "vecfit": __version__,
-        **{k: v() if callable(v) else v for k, v in (inputs or {}).items()},
-        **outputs.names(),
-        "size": [w, h],
-        "optimized_size": [sw, sh],  # the metrics and the comparison picture are at this size
-        "background": None if background is None else hex_color(background),
-        "initial": initial,
-        "optimized": final,
-        "psnr_gain_db": final["psnr"] - initial["psnr"],
-        "mse_ratio": initial["mse"] / final["mse"] if final["mse"] > 0 else None,
-        "iterations": result.iterations,
-        "coarse_iterations": result.coarse_iterations,  # their losses are at half the size
-        "interrupted": result.interrupted,
-        "skipped_steps": result.skipped_steps,
-        # the point rate after the density rule (configs/refine.toml: dense_outline), and
-        # the density it followed
-        "point_rate": result.point_rate,
-        "outline_density": result.outline_density,
-        "seconds": {"total": seconds, "optimize": result.seconds,
-                    "per_iteration": result.seconds / max(result.iterations, 1),
-                    "iterations": [round(t, 4) for t in result.iteration_seconds]},
-        "shapes": len(scene.shapes),
+    outcome = {
         "simplified": simplified,  # nodes dropped after the fit (fitting/simplify.py), or None
         "untangled_outlines": untangled,  # outlines the fit made cross themselves, cut into simple loops
         **({} if cut is None else {"cutouts": cut}),  # --stacking cutouts: pieces, chains, and the file's score
-        "file": design_stats(written),  # what a designer finds in the SVG written
         **({} if palette is None and layers is None else {"colours": colour_entry(written, palette, layers)}),
-        "parameters": {**result.parameters, "total": sum(result.parameters.values())},
-        "loss": opt["loss"],
-        "loss_curve": result.losses,
-        "seed": opt["seed"],
-        "device": opt["device"],  # what "auto" came to
-        "effort": config.get("effort", "normal"),  # quick | normal | best (configs/: [efforts])
-        "config": config,
     }
-    if outputs.report is not None:
-        save_report(outputs.report, report)
-    return report
+    return outputs.keep_report(job_report(
+        config, settings, outputs, result, started=started, inputs=inputs or {},
+        canvas={"size": [w, h], "optimized_size": [sw, sh]},  # the metrics and the comparison picture are at this size
+        background=background, initial=initial, optimized=final, shapes=len(scene.shapes), written=written,
+        outcome=outcome))

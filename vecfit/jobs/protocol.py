@@ -93,6 +93,14 @@ class Outputs:
         if self.report is not None:
             self.report.unlink(missing_ok=True)
 
+    def keep_report(self, report: dict) -> dict:
+        """The job's report, written where asked (last: a report means a finished run);
+        returned for the job to return."""
+        if self.report is not None:
+            from vecfit.io.report import save_report
+            save_report(self.report, report)
+        return report
+
     def keep_svg(self, payload: bytes) -> None:
         """The job's SVG (UTF-8 bytes): kept as ``text``, and written where asked, as SVG
         or converted to ``format``."""

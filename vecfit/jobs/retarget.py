@@ -11,7 +11,7 @@ the previous left), not on each round's fitted render: the targets stay crisp, a
 round's fit cannot steer later seams into content it blurred."""
 from __future__ import annotations
 
-import math
+import dataclasses
 import re
 import time
 
@@ -19,26 +19,23 @@ import cv2
 import numpy as np
 import torch
 
-from vecfit import __version__
 from vecfit.editing.points import carve_points
 from vecfit.editing.seams import carve, foreground, remove_seam
 from vecfit.editing.settings import RetargetSettings
 from vecfit.errors import VecfitError
-from vecfit.fitting.loop import Settings, Target, optimize
+from vecfit.fitting.loop import Target, optimize
 from vecfit.fitting.metrics import compare, seen, to_rgb
-from vecfit.io.report import save_panels, save_report, side_by_side
-from vecfit.renderer import device as devices
-from vecfit.renderer.raster import render
+from vecfit.fitting.result import joined
+from vecfit.io.report import save_panels, side_by_side
 from vecfit.scene.crossings import crossed_subpaths
-from vecfit.svg.numbers import hex_color
-from vecfit.svg.stats import design_stats
 from vecfit.svg.write import svg_bytes
 
-from .config import output_precision, settings_of
-from .fit import background_for, cut_crossed_outlines, load_scene_to_fit
+from .config import loop_settings, output_precision, settings_of
+from .fit import MIN_SIDE, background_for, cut_crossed_outlines, load_scene_to_fit
 from .protocol import Inputs, Outputs, listener
+from .report import job_report
+from .scoring import refuse_non_finite, render_for_scoring
 
-MIN_SIDE = 11
 _SIZE = re.compile(r"\s*(\d+(?:\.\d*)?|\.\d+)\s*(%|px)?\s*$")
 
 
@@ -76,7 +73,6 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     outputs.check_against(inputs)
     outputs.forget_report()
     retarget = settings_of(RetargetSettings, config["retarget"])
-    retarget.check()
     width = str(retarget.width).strip() or None
     height = str(retarget.height).strip() or None
     if width is None and height is None:
@@ -94,8 +90,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
         raise VecfitError(f"{new_w:g}x{new_h:g} is too small (at least {MIN_SIDE}x{MIN_SIDE} pixels)")
     if round(new_w) == round(w0) and round(new_h) == round(h0):
         raise VecfitError(f"{svg_path} is already {w0:g}x{h0:g}: nothing to retarget")
-    opt = {**config["optimize"], "device": devices.device_name(devices.resolve(config["optimize"]["device"]))}
-    settings = Settings.from_config(opt)
+    settings = loop_settings(config)  # its device resolved once: the loop, the renders, the report
     if not any(v and settings.lr.get(k, 0) > 0 for k, v in scene.parameters().items()):
         raise VecfitError(f"{svg_path}: nothing to optimise (no parameter kind has a learning rate above 0)")
 
@@ -105,13 +100,8 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     ww, wh = max(1, round(w0 * s)), max(1, round(h0 * s))
     s_x, s_y = ww / w0, wh / h0
 
-    def draw(w, h, samples):
-        with torch.no_grad():
-            return render(scene, w, h, samples=samples, seed=opt["seed"], threads=opt["threads"],
-                          device=opt["device"]).numpy()
-
-    original = draw(ww, wh, opt["eval_samples"])
-    background = background_for(original, opt["background"])
+    original = render_for_scoring(scene, ww, wh, settings)
+    background = background_for(original, settings.background)
     goal_w, goal_h = min(ww, max(1, round(new_w * s_x))), min(wh, max(1, round(new_h * s_y)))
     # Vertical seams first (width), then horizontal ones (height, on the transposed image).
     empty = seen(np.zeros((1, 1, 4), np.float32), background)[0, 0]  # the bare canvas
@@ -130,12 +120,12 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
                                          "final_iterations": retarget.final_iterations}}
     progress.start(len(plan) * retarget.iterations_per_step + retarget.final_iterations)
 
-    loop = Settings(**{**settings.__dict__, "iterations": retarget.iterations_per_step})
+    loop = dataclasses.replace(settings, iterations=retarget.iterations_per_step)
     drawn_crossed = crossed_subpaths(scene)  # the user's crossings stay; the fit's are cut
     cur_w, cur_h = ww, wh
     image = original
     used = {0: 0, 1: 0}
-    losses, interrupted, skipped, iterations = [], False, 0, 0
+    runs = []  # the loop's runs: a round's each, then the final fit
     for axis, count in plan:
         seams = (seams_w if axis == 0 else seams_h)[used[axis]:used[axis] + count]
         used[axis] += count
@@ -146,33 +136,24 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
         else:
             cur_h -= count
         scene.width, scene.height = cur_w / s_x, cur_h / s_y
-        result = optimize(scene, Target(torch.from_numpy(np.ascontiguousarray(image)), background), loop,
-                          progress=progress)
-        losses += result.losses
-        iterations += result.iterations
-        skipped += result.skipped_steps
-        if result.interrupted:
-            interrupted = True
+        runs.append(optimize(scene, Target(torch.from_numpy(np.ascontiguousarray(image)), background), loop,
+                             progress=progress))
+        if runs[-1].interrupted:
             break
-    if not interrupted and retarget.final_iterations > 0:
-        final_loop = Settings(**{**settings.__dict__, "iterations": retarget.final_iterations})
-        result = optimize(scene, Target(torch.from_numpy(np.ascontiguousarray(image)), background),
-                          final_loop, progress=progress)
-        losses += result.losses
-        iterations += result.iterations
-        skipped += result.skipped_steps
-        interrupted = result.interrupted
+    if not (runs and runs[-1].interrupted) and retarget.final_iterations > 0:
+        final_loop = dataclasses.replace(settings, iterations=retarget.final_iterations)
+        runs.append(optimize(scene, Target(torch.from_numpy(np.ascontiguousarray(image)), background),
+                             final_loop, progress=progress))
+    result = joined(runs)
 
     # The canvas: the new size exactly, unless Ctrl-C stopped at a round's size.
-    done = not interrupted
-    out_w, out_h = (new_w, new_h) if done else (cur_w / s_x, cur_h / s_y)
+    out_w, out_h = (cur_w / s_x, cur_h / s_y) if result.interrupted else (new_w, new_h)
     scene.width, scene.height = out_w, out_h
     cut_crossed_outlines(scene, drawn_crossed, config)
-    final = draw(cur_w, cur_h, opt["eval_samples"])
+    final = render_for_scoring(scene, cur_w, cur_h, settings)
     final_rgb, goal_rgb = to_rgb(final, background), to_rgb(image, background)
     fit = compare(final_rgb, goal_rgb)
-    if not all(math.isfinite(fit[k]) or (k == "psnr" and fit["mse"] == 0) for k in fit):
-        raise VecfitError(f"the retargeted image has non-finite values ({fit}); nothing written")
+    refuse_non_finite(fit, "retargeted")
     written = svg_bytes(scene, document, canvas=(out_w, out_h), precision=output_precision(config))
     outputs.keep_svg(written)
     original_rgb = to_rgb(original, background)
@@ -180,37 +161,15 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     if outputs.comparison is not None:
         save_panels(outputs.comparison, side_by_side([original_rgb, scaled_rgb, final_rgb]))
     plain = compare(scaled_rgb.astype(np.float64), goal_rgb) if scaled_rgb.shape == goal_rgb.shape else None
-    seconds = time.perf_counter() - started
-    report = {
-        "vecfit": __version__,
-        "command": "retarget",
-        "init": str(svg_path),
-        **outputs.names(),
-        "size_before": [w0, h0],
-        "size": [out_w, out_h],
-        "working_size": {"before": [ww, wh], "after": [cur_w, cur_h]},
-        "seams": {"vertical": used[0], "horizontal": used[1]},
-        "rounds": len(plan),
-        "background": None if background is None else hex_color(background),
+    return outputs.keep_report(job_report(
+        config, settings, outputs, result, started=started, inputs={"command": "retarget", "init": str(svg_path)},
+        canvas={"size_before": [w0, h0], "size": [out_w, out_h],
+                "working_size": {"before": [ww, wh], "after": [cur_w, cur_h]},
+                "seams": {"vertical": used[0], "horizontal": used[1]}, "rounds": len(plan)},
+        background=background,
         # against the seam-carved render of the input (what was fitted): plain scaling of
         # the input's render, and the retargeted SVG's render
-        "initial": plain,
-        "optimized": fit,
-        "shapes": len(scene.shapes),
-        "file": design_stats(written),  # what a designer finds in the SVG written
-        "iterations": iterations,
-        "interrupted": interrupted,
-        "skipped_steps": skipped,
-        "seconds": {"total": seconds, "per_iteration": seconds / max(iterations, 1)},
-        "loss_curve": losses,
-        "seed": opt["seed"],
-        "device": opt["device"],
-        "effort": config.get("effort", "normal"),  # quick | normal | best (configs/: [efforts])
-        "config": config,
-    }
-    if outputs.report is not None:
-        save_report(outputs.report, report)
-    return report
+        initial=plain, optimized=fit, shapes=len(scene.shapes), written=written))
 
 
 def _apply(image: np.ndarray, seams: list, axis: int) -> np.ndarray:
