@@ -3,9 +3,10 @@ of that region's shape, which runs on under it.
 
 A designer draws Iceland's flag as a white cross with a red cross over it; traced region
 by region, the white is four L-shaped pieces round the red, stacked on top of it or cut
-around it: twice the nodes, and shapes nobody would draw. Here a piece (a 4-connected
-component of one region) whose outline lies mostly against one other region, at least
-TUCK_SHARE of its length (the canvas's edge and transparency count against it), is
+around it: twice the nodes, and shapes nobody would draw. Here a piece (an 8-connected
+component of one region, as its outline joins it) whose outline lies mostly against one
+other region, at least TUCK_SHARE of its length (the canvas's edge and transparency
+count against it), is
 "tucked" under that region: the region's shape covers the piece too, so the region is
 drawn first (its area counts the piece: see outlines.drawing_order) and the piece over it.
 A shape enclosed by another was already drawn this way (its holes are filled); this also
@@ -16,7 +17,7 @@ emoji's outline round its face) stay as they are: neither shares enough.
 from __future__ import annotations
 
 import numpy as np
-from skimage.measure import label as connected
+from .regions import components
 
 TUCK_SHARE = 0.6
 
@@ -30,8 +31,9 @@ def tucked_hosts(labels: np.ndarray, count: int) -> np.ndarray:
     host = np.full(labels.shape, -1, np.int64)
     if count < 2 or labels.size == 0:
         return host
-    pieces = connected(labels + 1, background=0, connectivity=1)  # 0: transparent
-    n = int(pieces.max()) + 1
+    found, n = components(labels)
+    pieces = found.astype(np.int64) + 1  # 0: transparent
+    n += 1
     owner = np.full(n, -1, np.int64)
     owner[pieces.ravel()] = labels.ravel()
 
