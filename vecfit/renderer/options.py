@@ -8,9 +8,7 @@ from dataclasses import dataclass
 
 from vecfit import _core
 from vecfit.errors import VecfitError
-
-MODES = ("mc", "analytic")
-FILTERS = ("box", "tent", "gaussian", "parabolic", "hann")
+from vecfit.names import FILTERS, MODES
 
 
 @dataclass(frozen=True)
