@@ -259,6 +259,25 @@ def dash_count(path: Path, pattern: tuple[float, ...], width: float = 0.0) -> fl
     return _estimate(_Segments(path), path, pattern, width)
 
 
+class DashBudget:
+    """The dashes one scene may have, limits.MAX_DASHES, counted shape after shape as
+    dash_count counts them: the one count that the SVG reader (which leaves a pattern out
+    and notes it) and the packer (which draws it solid, with a warning, for a Scene made
+    otherwise) both take from."""
+
+    def __init__(self):
+        self.left = float(limits.MAX_DASHES)
+
+    def take(self, path: Path, pattern: tuple[float, ...], width: float = 0.0) -> bool:
+        """Whether the pattern's dashes along ``path`` (a stroke ``width`` wide) fit in
+        what is left; if they do, they are taken from it."""
+        count = dash_count(path, pattern, width)
+        if not count <= self.left:  # (a non-finite count never fits)
+            return False
+        self.left -= count
+        return True
+
+
 def _estimate(segs: _Segments, path: Path, pattern: tuple[float, ...], width: float) -> float:
     total = float(np.nansum(segs.length))
     period = math.fsum(pattern)
