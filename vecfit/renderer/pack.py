@@ -474,14 +474,13 @@ def dashed_stroke(shape: Shape, budget: DashBudget | None = None) -> Path | None
     g = outline_path(as_torch(geometry) if plain else geometry)  # (dashes are cut in torch)
     if g is None or not g.subpaths:
         return None
-    budget = DashBudget() if budget is None else budget
-    if not budget.take(g, pattern, dash_width(shape)):
+    dashes = dash_path(g, pattern, float(shape.dash_offset), budget=budget, width=dash_width(shape))
+    if dashes is None:  # (the pattern and offset are valid: no room left in the budget)
         warnings.warn(f"{shape.source if shape.source is not None else 'a shape'}: stroke-dasharray makes more "
                       f"than {_limits.MAX_DASHES} dashes in the scene (the limit); stroked solid", VecfitWarning,
                       stacklevel=2)
         return None
-    dashes = dash_path(g, pattern, float(shape.dash_offset), max_dashes=math.inf)  # (counted by the budget)
-    if plain and dashes is not None:  # back to the Scene's kind
+    if plain:  # back to the Scene's kind
         dashes = dataclasses.replace(dashes, points=to_numpy(dashes.points),
                                      widths=None if dashes.widths is None else to_numpy(dashes.widths))
     return dashes
