@@ -102,6 +102,7 @@ class Placement:
     solid_alphas: object = None                    # their alphas (fixed opacities multiplied out)
     gradients: list = field(default_factory=list)  # (paint, paint_params row, first stop, alpha)
     bbox_geometry: list = field(default_factory=list)  # the geometry bounding-box gradients depend on
+    dashed: list = field(default_factory=list)     # shapes whose stroke is drawn from its dashes
     strokes: list = field(default_factory=list)    # (draw_params row, shape index)
 
 
@@ -288,6 +289,7 @@ class Packer:
                         continue
             if dashes is not None and has_stroke:
                 stroke_index = paths.add(dashes, i, len(out.shapes), len(out.subpaths), with_widths=True)
+                self.placed.dashed.append(i)
                 out.shapes.append([SHAPE_PATH, len(out.subpaths), len(dashes.subpaths), -1])
                 out.subpaths.extend([None] * len(dashes.subpaths))
                 geometry = dashes

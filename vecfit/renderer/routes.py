@@ -154,6 +154,10 @@ def routes_of(scene: Scene, packed: Packed) -> Routes:
             out.colors("paint_params", row * PAINT_ROW + 6, color, alpha.reshape(1))
     for geometry in placed.bbox_geometry:
         out.used_otherwise(*_geometry_tensors(geometry))
+    for i in placed.dashed:  # the dashes are cut where the outline's arc lengths say
+        g = scene.shapes[i].geometry
+        out.used_otherwise(*_geometry_tensors(g), *([g.widths] if isinstance(g, Path) and g.widths is not None
+                                                    else []))
     for paint, row, first_stop, alpha in placed.gradients:
         first = row * PAINT_ROW
         if isinstance(paint, LinearGradient):

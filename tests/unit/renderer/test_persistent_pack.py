@@ -347,3 +347,18 @@ def test_loop_same_seed_same_result(tmp_path):
     for losses, values in runs[2:]:
         assert losses == pytest.approx(runs[0][0], rel=1e-4)
         assert torch.allclose(values, runs[0][1], atol=1e-3)
+
+
+def test_the_routes_of_a_dashed_stroke_mark_its_geometry(tmp_path):
+    """The persistent pack declines dashes before it reads routes; the routes say so too:
+    the dashes' points and widths are not affine in the outline's (they are cut where its
+    arc lengths say), so the outline's tensors are marked, and its dash path gets no route."""
+    from vecfit.renderer.pack import pack_scene
+    from vecfit.renderer.routes import routes_of
+    scene = _scene(tmp_path, MIXED.replace('stroke-linecap="round"', 'stroke-linecap="round" stroke-dasharray="9 4"'))
+    path = scene.shapes[-1].geometry
+    path.widths = torch.linspace(1.0, 6.0, len(path.points))
+    routes = routes_of(scene, pack_scene(scene, 64, 48))
+    assert {id(path.points), id(path.widths)} <= routes.nonlinear
+    assert not any(r.tensor is path.points or r.tensor is path.widths for r in routes.routes)
+    assert id(scene.shapes[1].geometry.points) not in routes.nonlinear  # (an undashed path's are routed)
