@@ -14,6 +14,7 @@ import click
 
 from vecfit.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE
 from vecfit.names import EFFORTS, FILTERS, FORMATS, GROUP_BY, JOBS, LOSSES, MODES, PAINT_KINDS, STACKINGS, STYLES
+from vecfit.renderer.options import RenderOptions
 
 DEVICE_OPTION = dict(metavar="auto|cpu|cuda[:N]",
                      help="Where pixels are shaded: auto (a GPU when vecfit was built with CUDA and "
@@ -109,18 +110,18 @@ def main():
 @click.option("--out-dir", type=click.Path(file_okay=False), help="Folder for outputs, NAME.svg -> NAME.png.")
 @click.option("--width", type=click.IntRange(min=1), help="Width in pixels (default: the SVG's).")
 @click.option("--height", type=click.IntRange(min=1), help="Height in pixels (default: the SVG's).")
-@click.option("--samples", type=click.IntRange(1, 64), default=2, show_default=True,
+@click.option("--samples", type=click.IntRange(1, 64), default=RenderOptions.samples, show_default=True,
               help="N: N x N samples per pixel.")
-@click.option("--mode", type=click.Choice(MODES), default="mc", show_default=True,
+@click.option("--mode", type=click.Choice(MODES), default=RenderOptions.mode, show_default=True,
               help="Anti-aliasing: Monte Carlo samples or the analytical prefilter.")
-@click.option("--filter", "filter_", type=click.Choice(FILTERS), default="box",
+@click.option("--filter", "filter_", type=click.Choice(FILTERS), default=RenderOptions.filter,
               show_default=True, help="Pixel filter.")
-@click.option("--filter-radius", type=click.FloatRange(min=0.5), default=0.5, show_default=True,
-              help="Pixel filter radius in pixels (tent, gaussian).")
+@click.option("--filter-radius", type=click.FloatRange(min=0.5), default=RenderOptions.filter_radius,
+              show_default=True, help="Pixel filter radius in pixels (tent, gaussian).")
 @click.option("--background", default="none", show_default=True,
               help="none, white, black or #rrggbb[aa].")
-@click.option("--seed", type=int, default=0, show_default=True, help="Random seed of the samples.")
-@click.option("--threads", type=click.IntRange(min=0), default=0, help="Threads (0: all cores).")
+@click.option("--seed", type=int, default=RenderOptions.seed, show_default=True, help="Random seed of the samples.")
+@click.option("--threads", type=click.IntRange(min=0), default=RenderOptions.threads, help="Threads (0: all cores).")
 @click.option("--device", default="auto", show_default=True, **DEVICE_OPTION)
 def render(inputs, output, out_dir, width, height, samples, mode, filter_, filter_radius,
            background, seed, threads, device):

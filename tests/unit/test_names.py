@@ -56,8 +56,15 @@ def test_the_core_takes_exactly_the_modes_and_filters():
 
 
 def test_the_renderers_options_check_the_same_names():
-    from vecfit.renderer import options
-    assert tuple(options.MODES) == names.MODES and tuple(options.FILTERS) == names.FILTERS
+    from vecfit.renderer.options import RenderOptions
+    for mode in names.MODES:
+        assert RenderOptions(1, 1, mode=mode).mode == mode
+    for filt in names.FILTERS:
+        assert RenderOptions(1, 1, filter=filt).filter == filt
+    with pytest.raises(VecfitError, match="mode must be one of mc, analytic"):
+        RenderOptions(1, 1, mode="exact")
+    with pytest.raises(VecfitError, match="filter must be one of box, tent"):
+        RenderOptions(1, 1, filter="lanczos")
 
 
 def test_the_configs_refuse_a_name_outside_the_lists():

@@ -104,9 +104,13 @@ def renders_without_torch(scene: Scene) -> bool:
                    or isinstance(s.stroke, (LinearGradient, RadialGradient)) for s in scene.shapes)
 
 
-def render_numpy(scene: Scene, width: int | None = None, height: int | None = None, *, samples: int = 2,
-                 mode: str = "mc", filter: str = "box", filter_radius: float = 0.5, seed: int = 0,
-                 background=None, threads: int | None = None, device: str = "cpu") -> np.ndarray:
+_D = RenderOptions  # (its defaults)
+
+
+def render_numpy(scene: Scene, width: int | None = None, height: int | None = None, *,
+                 samples: int = _D.samples, mode: str = _D.mode, filter: str = _D.filter,
+                 filter_radius: float = _D.filter_radius, seed: int = _D.seed, background=_D.background,
+                 threads: int | None = _D.threads, device: str = "cpu") -> np.ndarray:
     """``scene`` (of NumPy arrays, or tensors) rendered as vecfit.renderer.raster.render
     renders it with the same settings, without a gradient: an [H, W, 4] float32 array of
     straight RGBA. Clip paths, masks and filters need the layered renderer (torch): a

@@ -65,10 +65,14 @@ class _RenderBatch(torch.autograd.Function):
         return (None, None, None, None, *[g.reshape(shape) for g, shape in zip(out, ctx.shapes)])
 
 
-def render_batch(scenes: Sequence[Scene], width: int, height: int, *, samples: int = 2, mode: str = "mc",
-                 filter: str = "box", filter_radius: float = 0.5, seed: int | Sequence[int] = 0,
-                 background=None, threads: int | None = None, boundary_samples: float = 2.0,
-                 interior_samples: int = 0, device: str = "cpu") -> torch.Tensor:
+_D = RenderOptions  # (its defaults)
+
+
+def render_batch(scenes: Sequence[Scene], width: int, height: int, *, samples: int = _D.samples,
+                 mode: str = _D.mode, filter: str = _D.filter, filter_radius: float = _D.filter_radius,
+                 seed: int | Sequence[int] = _D.seed, background=_D.background, threads: int | None = _D.threads,
+                 boundary_samples: float = _D.boundary_samples, interior_samples: int = _D.interior_samples,
+                 device: str = "cpu") -> torch.Tensor:
     """Render ``scenes`` at width x height into a [B, H, W, 4] tensor of straight RGBA,
     differentiable with respect to every tensor of every scene, as ``render`` (same
     options; ``seed`` is one seed for all or one per scene). threads: how many scenes at
@@ -86,7 +90,8 @@ def render_batch(scenes: Sequence[Scene], width: int, height: int, *, samples: i
                           f"(at most {MAX_PIXELS // 1_000_000} million pixels in all)")
     options = RenderOptions(width, height, samples=int(samples), mode=mode, filter=filter,
                             filter_radius=float(filter_radius), threads=int(threads or 0),
-                            background=background_rgba(background), interior_samples=int(interior_samples))
+                            background=background_rgba(background), interior_samples=int(interior_samples),
+                            boundary_samples=float(boundary_samples))
     if devices.resolve(device) >= 0:
         return torch.stack([render(s, width, height, samples=samples, mode=mode, filter=filter,
                                    filter_radius=filter_radius, seed=sd, background=background,
@@ -98,5 +103,5 @@ def render_batch(scenes: Sequence[Scene], width: int, height: int, *, samples: i
         structure, f = packed_for_core(scene, width, height)
         structures.append(structure)
         floats.extend(f)
-    return _RenderBatch.apply(options.core(), seeds, float(boundary_samples), structures,
+    return _RenderBatch.apply(options.core(), seeds, options.boundary_samples, structures,
                               *floats)  # (no graph without grads)

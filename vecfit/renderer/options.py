@@ -1,16 +1,18 @@
 """RenderOptions: how the core renders, as one typed value (the core's struct of the same
 name, csrc/forward/forward.h), checked here with messages for the user and passed to the
-core's entry points whole instead of as a row of positional arguments."""
+core's entry points whole instead of as a row of positional arguments.
+
+Its defaults are the render defaults of Python: vecfit.render, render_numpy, render_batch
+and the render command read them here. A fit renders with the same but for FITTING. (Plain
+Python, the core imported only to build its struct: the command line reads the defaults
+at start-up.)"""
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 
-from vecfit import _core
 from vecfit.errors import VecfitError
-
-MODES = ("mc", "analytic")
-FILTERS = ("box", "tent", "gaussian", "parabolic", "hann")
+from vecfit.names import FILTERS, MODES
 
 
 @dataclass(frozen=True)
@@ -22,7 +24,9 @@ class RenderOptions:
     every draw tested at every sample (a check of the tiles, for tests); premultiplied:
     the image as premultiplied RGBA (the layers of renderer/layers.py); boundary_budget:
     the Monte Carlo backward's boundary samples per pixel of the image at most (0: no
-    bound), allotted by the pixel adjoints."""
+    bound), allotted by the pixel adjoints; boundary_samples: the Monte Carlo backward's
+    boundary samples per pixel of boundary length (the core's boundary_density, which its
+    backward entry points take beside the struct)."""
     width: int
     height: int
     samples: int = 2
@@ -36,6 +40,7 @@ class RenderOptions:
     brute_force: bool = False
     premultiplied: bool = False
     boundary_budget: float = 0.0
+    boundary_samples: float = 2.0
 
     def __post_init__(self):
         check_options(self.samples, self.mode, self.filter, self.filter_radius)
@@ -46,6 +51,8 @@ class RenderOptions:
 
     def core(self) -> "_core.RenderOptions":
         """The core's struct."""
+        from vecfit import _core
+
         bg = self.background
         return _core.RenderOptions(
             width=int(self.width), height=int(self.height), samples=int(self.samples), mode=self.mode,
@@ -53,6 +60,16 @@ class RenderOptions:
             threads=int(self.threads or 0), background=None if bg is None else [float(v) for v in bg],
             interior_samples=int(self.interior_samples), brute_force=bool(self.brute_force),
             premultiplied=bool(self.premultiplied), boundary_budget=float(self.boundary_budget))
+
+
+# Where a fit (configs/refine.toml's [optimize], the loop's Settings) renders otherwise than
+# vecfit.render, on purpose: its Monte Carlo backward revisits one of each pixel's N x N
+# samples for the colours' term (an iteration's noise averages out over the next ones, at
+# a fraction of the cost), and bounds the boundary samples at 2 per pixel of the image, put
+# where the error is (dense traces had iterations dominated by their boundaries). A single
+# render's gradients keep every sample and no bound. tests/unit/renderer/test_options.py
+# holds refine.toml to RenderOptions' defaults but for these.
+FITTING = {"interior_samples": 1, "boundary_budget": 2.0}
 
 
 def check_options(samples, mode: str, filter: str, filter_radius: float) -> None:

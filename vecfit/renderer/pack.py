@@ -8,6 +8,9 @@ arrays by the same code, without torch: the operations come from vecfit.scene.op
 
 The layout of every table (enums, row widths) is the core's own (layout.py, from
 csrc/scene/scene.h).
+
+Packed.placement says where each scene value landed in the arrays (plain records, kept on
+every pack); vecfit.renderer.routes reads them, for the fitting loop's persistent pack.
 """
 from __future__ import annotations
 
@@ -21,7 +24,7 @@ import numpy as np
 from vecfit import limits as _limits
 from vecfit.errors import VecfitError, VecfitWarning
 from vecfit.scene import Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect, Scene, Shape, Solid
-from vecfit.scene.dashes import dash_path, dash_pattern, outline_path
+from vecfit.scene.dashes import DashBudget, dash_path, dash_pattern, outline_path
 from vecfit.scene.geometry import affine_apply, local_bbox, rect_as_path, value
 from vecfit.scene.arrays import as_torch, is_tensor, to_numpy
 from vecfit.scene.ops import ops_for
@@ -52,6 +55,7 @@ class Packed:
     n_points: int = 0
     n_stops: int = 0
     ops: object = None  # vecfit.scene.ops: the float arrays' kind
+    placement: "Placement" = None  # where the scene's values landed (for routes.py)
 
     def arrays(self) -> dict:
         """Contiguous arrays for the core: float32 torch tensors (or NumPy arrays) and
@@ -85,21 +89,42 @@ class Packed:
         }
 
 
-class Packer:
-    """``provenance`` (optional, vecfit.renderer.persistent.Provenance): told where each scene
-    tensor's values land in the float arrays, so that a fitting loop can refresh them
-    without packing again."""
+@dataclass
+class Placement:
+    """Where the scene's values landed in the packed arrays (what vecfit.renderer.routes
+    reads; the rows are those of Packed.arrays)."""
+    matrices: object = None     # every shape's matrix to pixels [n, 3, 3]
+    scale: object = None        # every shape's uniform scale [n]
+    shapes: list = field(default_factory=list)     # (shape index, stroke drawn) of each shape packed
+    paths: list = field(default_factory=list)      # (first point row, local points, shape index, Rect or None, widths or None)
+    ellipses: list = field(default_factory=list)   # (ellipses row, shape index, Circle or Ellipse)
+    solids: list = field(default_factory=list)     # the solid colours, in paint_params rows 0...
+    solid_alphas: object = None                    # their alphas (fixed opacities multiplied out)
+    gradients: list = field(default_factory=list)  # (paint, paint_params row, first stop, alpha)
+    bbox_geometry: list = field(default_factory=list)  # the geometry bounding-box gradients depend on
+    dashed: list = field(default_factory=list)     # shapes whose stroke is drawn from its dashes
+    strokes: list = field(default_factory=list)    # (draw_params row, shape index)
 
-    def __init__(self, scene: Scene, width: int, height: int, provenance=None):
+
+class Packer:
+    """``keep_empty``: an ellipse whose radius is 0 or less keeps its draw, with axes 0 (the
+    core draws nothing there), so that the structure does not change as a radius crosses
+    0 (the persistent pack, vecfit.renderer.persistent)."""
+
+    def __init__(self, scene: Scene, width: int, height: int, keep_empty: bool = False):
         self.scene = scene
-        self.provenance = provenance
+        self.keep_empty = keep_empty
         self.ops = ops_for(scene.view)
-        self.out = Packed(ops=self.ops)
+        self.placed = Placement()
+        self.out = Packed(ops=self.ops, placement=self.placed)
         self.canvas = canvas_matrix(scene, width, height)
         self.group_matrix: list = []
         self.group_layer: list[int] = []
         self._group_draw_counts = self._count_group_draws()
-        self._dash_count = 0  # dashes of the dashed strokes packed so far (limits.MAX_DASHES)
+        self._dashes = DashBudget()  # the scene's dashes (limits.MAX_DASHES)
+        self._n_solid = 0
+        self._n_gradients = 0
+        self._keep_draws: list[bool] | None = None  # per draw: False where its gradient paints nothing
 
     # --------------------------------------------------------------- structure
 
@@ -151,8 +176,7 @@ class Packer:
         out, ops = self.out, self.ops
         g = m
         if paint.units == "objectBoundingBox":
-            if self.provenance:
-                self.provenance.used_otherwise(*_geometry_tensors(geometry))
+            self.placed.bbox_geometry.append(geometry)
             box = local_bbox(geometry)
             if box is None:
                 return None
@@ -168,36 +192,27 @@ class Packer:
             return None
         to_paint = ops.inv(g)[:2].reshape(6)
         # its row: after the solids and the gradients before it (see _finish_paints)
-        first = (self._n_solid + getattr(self, "_n_gradients", 0)) * COLUMNS["paint_params"]
+        row = self._n_solid + self._n_gradients
         if isinstance(paint, LinearGradient):
             params = ops.cat([to_paint, ops.f32(paint.start), ops.f32(paint.end), ops.zeros(1)])
             kind = PAINT_LINEAR
-            if self.provenance:
-                self.provenance.copy("paint_params", first + 6, paint.start)
-                self.provenance.copy("paint_params", first + 8, paint.end)
         elif isinstance(paint, RadialGradient):
             # SVG 2 semantics, as resvg and browsers draw it: a focal point outside the
             # circle makes a cone, and the area outside the cone is not painted.
             c, f, r = ops.f32(paint.center), ops.f32(paint.focal), ops.f32(paint.radius).reshape(1)
             params = ops.cat([to_paint, c, r, f])
             kind = PAINT_RADIAL
-            if self.provenance:
-                self.provenance.copy("paint_params", first + 6, paint.center)
-                self.provenance.copy("paint_params", first + 8, paint.radius)
-                self.provenance.copy("paint_params", first + 9, paint.focal)
         else:
             raise VecfitError(f"unknown paint {type(paint).__name__}")
         colors = ops.f32(paint.colors)
         colors = ops.cat([colors[:, :3], colors[:, 3:4] * alpha], dim=1)
-        if self.provenance:
-            self.provenance.copy("stop_offsets", out.n_stops, paint.offsets)
-            self.provenance.colors("stop_colors", out.n_stops * 4, paint.colors, ops.full((len(paint.offsets),), value(alpha)))
+        self.placed.gradients.append((paint, row, out.n_stops, alpha))
         out.paints.append([kind, out.n_stops, len(paint.offsets)])
         out.paint_params.append(params)
         out.stop_offsets.append(ops.f32(paint.offsets))
         out.stop_colors.append(colors)
         out.n_stops += len(paint.offsets)
-        self._n_gradients = getattr(self, "_n_gradients", 0) + 1
+        self._n_gradients += 1
         return self._n_gradients - 1
 
     # ------------------------------------------------------------------- draws
@@ -207,9 +222,11 @@ class Packer:
         out, ops = self.out, self.ops
         shapes = self.scene.shapes
         matrices = stacked_shape_matrices(self.scene, self.canvas, self.group_matrix)
+        self.placed.matrices = matrices
         # Similarity (no metric needed for strokes) and uniform scale of every shape.
         lin = matrices[:, :2, :2]
         scale = ops.sqrt(ops.abs(lin[:, 0, 0] * lin[:, 1, 1] - lin[:, 0, 1] * lin[:, 1, 0]))
+        self.placed.scale = scale
         lin_np = ops.numpy(lin)
         big = np.maximum(np.maximum(np.abs(lin_np[:, 0, 0]), np.abs(lin_np[:, 1, 1])), 1e-30)
         similar = ((np.abs(lin_np[:, 0, 1]) <= 1e-9 * big) & (np.abs(lin_np[:, 1, 0]) <= 1e-9 * big)
@@ -237,10 +254,7 @@ class Packer:
             has_stroke = (shape.stroke is not None and _stroke_width_positive(shape)
                           and scale_np[i] > 0)
             # A dashed stroke is drawn from its dashes, a path of its own (None: solid).
-            dashes = dashed_stroke(shape, _limits.MAX_DASHES - self._dash_count) if has_stroke else None
-            if dashes is not None:
-                pattern = dash_pattern(shape.dash_array)
-                self._dash_count += len(dashes.subpaths) * max(1.0, dash_width(shape) / sum(pattern))
+            dashes = dashed_stroke(shape, self._dashes) if has_stroke else None
             if dashes is not None and not dashes.subpaths:
                 has_stroke = False  # no dash at all (a zero-length path)
             if not (has_fill or has_stroke):
@@ -253,13 +267,10 @@ class Packer:
             else:
                 factors.append(shape.opacity)
             geometry = shape.geometry
-            if self.provenance:
-                self._record_presence(shape, has_stroke, scale_np[i] > 0)
+            self.placed.shapes.append((i, has_stroke))
             rect = None
             if isinstance(geometry, Rect):
                 rect = geometry
-                if self.provenance:
-                    self.provenance.rect(rect)
                 geometry = rect_as_path(geometry)
                 if geometry is None:
                     continue
@@ -273,11 +284,12 @@ class Packer:
                     out.shapes.append([SHAPE_PATH, len(out.subpaths), len(geometry.subpaths), -1])
                     out.subpaths.extend([None] * len(geometry.subpaths))  # filled by the batch
                 else:
-                    index = self._add_ellipse(geometry, matrices[i])
+                    index = self._add_ellipse(geometry, matrices[i], i)
                     if index is None:
                         continue
             if dashes is not None and has_stroke:
                 stroke_index = paths.add(dashes, i, len(out.shapes), len(out.subpaths), with_widths=True)
+                self.placed.dashed.append(i)
                 out.shapes.append([SHAPE_PATH, len(out.subpaths), len(dashes.subpaths), -1])
                 out.subpaths.extend([None] * len(dashes.subpaths))
                 geometry = dashes
@@ -293,36 +305,22 @@ class Packer:
                 out.draws.append([stroke_index, DRAW_STROKE, 0, paint, layer,
                                   CAPS[shape.linecap], JOINS[shape.linejoin], per_point])
 
-        paths.finish(out, ops, matrices, scale, self.provenance)
+        paths.finish(out, ops, matrices, scale, self.placed)
         self._finish_paints(solid_colors, solid_alphas, gradient_rows)
         self._finish_draw_params(stroke_rows, matrices, scale, similar)
         return out
 
-    def _record_presence(self, shape: Shape, has_stroke: bool, scaled: bool) -> None:
-        """Tells the provenance which of the shape's draws exist because of a value that the
-        loop may change (a stroke's width above 0)."""
-        g = shape.geometry
-        if shape.stroke is not None and scaled:
-            widths = g.widths if isinstance(g, Path) and g.widths is not None else shape.stroke_width
-            self.provenance.present_if_positive(widths, has_stroke)
-        # (an ellipse's radii gate its axes instead: see _add_ellipse)
-
-    def _add_ellipse(self, geometry, m) -> int | None:
+    def _add_ellipse(self, geometry, m, shape_index: int) -> int | None:
         r = self.ops.expand(geometry.radius.reshape(1), 2) if isinstance(geometry, Circle) else geometry.radii
         present = value(r.min()) > 0
-        if not present and not self.provenance:
+        if not present and not self.keep_empty:
             return None
         ops = self.ops
         c = affine_apply(m, ops.f32(geometry.center.reshape(1, 2)))[0]
         axes = m[:2, :2] @ ops.diag(ops.f32(r))
-        if self.provenance:
-            # Kept with axes 0 while a radius is <= 0 (the core draws nothing there), so
-            # that a fitting loop's pack keeps its structure as radii cross 0: the axes'
-            # routes are gated by the radii (Provenance.ellipse).
-            if not present:
-                axes = axes * 0.0
-            self.provenance.ellipse(len(self.out.ellipses), geometry.center, geometry.radius if isinstance(geometry, Circle)
-                               else geometry.radii, m.detach().numpy())
+        if not present:
+            axes = axes * 0.0  # (keep_empty: drawn as nothing)
+        self.placed.ellipses.append((len(self.out.ellipses), shape_index, geometry))
         self.out.ellipses.append(ops.cat([c, axes.reshape(4)]))
         self.out.shapes.append([SHAPE_ELLIPSE, 0, 0, len(self.out.ellipses) - 1])
         return len(self.out.shapes) - 1
@@ -340,9 +338,7 @@ class Packer:
             columns = [_stack(ops, [f[k] if k < len(f) else one for f in solid_alphas]) for k in range(depth)]
             alphas = ops.prod(ops.stack(columns), 0).reshape(n_solid)
             colors = ops.cat([colors[:, :3], colors[:, 3:4] * alphas[:, None]], dim=1)
-            if self.provenance:
-                for row, (color, a) in enumerate(zip(solid_colors, alphas.detach())):  # (torch only)
-                    self.provenance.colors("paint_params", row * COLUMNS["paint_params"] + 6, color, a.reshape(1))
+            self.placed.solids, self.placed.solid_alphas = solid_colors, alphas
             ident = ops.expand(ops.eye(2, 3).reshape(1, 6), n_solid, 6)
             out.paint_params.append(ops.cat([ident, colors, ops.zeros((n_solid, 1))], dim=1))
             out.paints.extend([[PAINT_SOLID, 0, 0]] * n_solid)
@@ -381,13 +377,9 @@ class Packer:
             limits = ops.f32([float(self.scene.shapes[i].miter_limit) for i in idx])
             stroke_params = ops.cat([(widths * s)[:, None], limits[:, None], metric], dim=1)
             params = ops.put_rows(params, rows, stroke_params)
-        keep = getattr(self, "_keep_draws", [True] * n)
-        if self.provenance and stroke_rows:
-            row_after = np.cumsum(keep) - 1  # rows once the draws that paint nothing are dropped
-            for (row, i), s_i in zip(stroke_rows, ops.numpy(s)):
-                if keep[row]:
-                    self.provenance.scaled("draw_params", int(row_after[row]) * COLUMNS["draw_params"],
-                                      self.scene.shapes[i].stroke_width, float(s_i))
+        keep = self._keep_draws if self._keep_draws is not None else [True] * n
+        row_after = np.cumsum(keep) - 1  # rows once the draws that paint nothing are dropped
+        self.placed.strokes = [(int(row_after[row]), i) for row, i in stroke_rows if keep[row]]
         if not all(keep):
             params = params[ops.from_numpy(np.asarray(keep))]
             out.draws = [row for row, k in zip(out.draws, keep) if k]
@@ -421,20 +413,13 @@ class _PathBatch:
         self.subpath_slot.append(subpath_slot)
         return core_shape
 
-    def finish(self, out: Packed, ops, matrices, scale, provenance=None) -> None:
+    def finish(self, out: Packed, ops, matrices, scale, placed: Placement) -> None:
         if not self.points:
             return
         counts = [len(p) for p in self.points]
-        if provenance:
-            row, m_np, s_np = out.n_points, matrices.detach().numpy(), scale.detach().numpy()
-            for points, widths, owner, n, rect in zip(self.points, self.widths, self.owner, counts, self.rects):
-                if rect is not None:
-                    provenance.rect_corners("points", row, rect, m_np[owner])
-                else:
-                    provenance.points("points", row, points, m_np[owner])
-                if widths is not None:
-                    provenance.scaled("point_widths", row, widths, float(s_np[owner]))
-                row += n
+        rows = out.n_points + np.concatenate([[0], np.cumsum(counts)[:-1]])
+        placed.paths = [(int(row), points, owner, rect, widths) for row, points, owner, rect, widths
+                        in zip(rows, self.points, self.owner, self.rects, self.widths)]
         local = ops.f32(ops.cat(self.points))
         # (numpy: torch's repeat_interleave wakes its thread pool, 0.6 ms a call on 2 busy cores)
         owner = ops.from_numpy(np.repeat(np.asarray(self.owner, dtype=np.int64), counts))
@@ -476,10 +461,11 @@ class _PathBatch:
         out.segments.append(np.concatenate([deg[:, None], idx], axis=1))
 
 
-def dashed_stroke(shape: Shape, max_dashes: float | None = None) -> Path | None:
+def dashed_stroke(shape: Shape, budget: DashBudget | None = None) -> Path | None:
     """The dashes the shape's stroke is drawn from (vecfit.scene.dashes), or None where it
-    is drawn solid: no dash pattern or one SVG draws solid, or a dash_count over
-    ``max_dashes`` (limits.MAX_DASHES by default; with a warning naming the element)."""
+    is drawn solid: no dash pattern or one SVG draws solid, or dashes the scene's
+    ``budget`` (limits.MAX_DASHES; a new one by default) has no room for, with a warning
+    naming the element."""
     if shape.dash_array is None:
         return None
     pattern = dash_pattern(shape.dash_array)
@@ -490,14 +476,15 @@ def dashed_stroke(shape: Shape, max_dashes: float | None = None) -> Path | None:
     g = outline_path(as_torch(geometry) if plain else geometry)  # (dashes are cut in torch)
     if g is None or not g.subpaths:
         return None
-    dashes = dash_path(g, pattern, float(shape.dash_offset), max_dashes=max_dashes, width=dash_width(shape))
-    if plain and dashes is not None:  # back to the Scene's kind
-        dashes = dataclasses.replace(dashes, points=to_numpy(dashes.points),
-                                     widths=None if dashes.widths is None else to_numpy(dashes.widths))
-    if dashes is None:
+    dashes = dash_path(g, pattern, float(shape.dash_offset), budget=budget, width=dash_width(shape))
+    if dashes is None:  # (the pattern and offset are valid: no room left in the budget)
         warnings.warn(f"{shape.source if shape.source is not None else 'a shape'}: stroke-dasharray makes more "
                       f"than {_limits.MAX_DASHES} dashes in the scene (the limit); stroked solid", VecfitWarning,
                       stacklevel=2)
+        return None
+    if plain:  # back to the Scene's kind
+        dashes = dataclasses.replace(dashes, points=to_numpy(dashes.points),
+                                     widths=None if dashes.widths is None else to_numpy(dashes.widths))
     return dashes
 
 
@@ -507,14 +494,6 @@ def dash_width(shape: Shape) -> float:
     if isinstance(g, Path) and g.widths is not None and _count(g.widths):
         return value(g.widths.max())
     return value(shape.stroke_width)
-
-
-def _geometry_tensors(geometry) -> list:
-    if isinstance(geometry, Path):
-        return [geometry.points]
-    if isinstance(geometry, Rect):
-        return [geometry.p_min, geometry.p_max, geometry.corner_radii]
-    return [geometry.center, geometry.radius if isinstance(geometry, Circle) else geometry.radii]
 
 
 def _stroke_width_positive(shape: Shape) -> bool:
@@ -538,5 +517,7 @@ def _stack(ops, arrays: list):
         return ops.stack([ops.f32(t).reshape(arrays[0].shape) for t in arrays])
 
 
-def pack_scene(scene: Scene, width: int, height: int) -> Packed:
-    return Packer(scene, width, height).pack()
+def pack_scene(scene: Scene, width: int, height: int, keep_empty: bool = False) -> Packed:
+    """The scene's arrays for the core at width x height, with where its values landed
+    (Packed.placement). ``keep_empty``: see Packer."""
+    return Packer(scene, width, height, keep_empty).pack()

@@ -45,17 +45,23 @@ class _Render(torch.autograd.Function):
         return (None, None, None, None, None, *out)
 
 
+_D = RenderOptions  # (its defaults)
+
+
 def render(scene: Scene, width: int | None = None, height: int | None = None, *,
-           samples: int = 2, mode: str = "mc", filter: str = "box", filter_radius: float = 0.5,
-           seed: int = 0, background=None, threads: int | None = None, boundary_samples: float = 2.0,
-           interior_samples: int = 0, boundary_budget: float = 0.0, device: str = "cpu",
-           packed: tuple | None = None, _brute_force: bool = False, _gpu_lists: bool = False, _premultiplied: bool = False) -> torch.Tensor:
+           samples: int = _D.samples, mode: str = _D.mode, filter: str = _D.filter,
+           filter_radius: float = _D.filter_radius, seed: int = _D.seed, background=_D.background,
+           threads: int | None = _D.threads, boundary_samples: float = _D.boundary_samples,
+           interior_samples: int = _D.interior_samples, boundary_budget: float = _D.boundary_budget,
+           device: str = "cpu", packed: tuple | None = None, _brute_force: bool = False, _gpu_lists: bool = False,
+           _premultiplied: bool = False) -> torch.Tensor:
     """Render ``scene`` into an [H, W, 4] float tensor of straight RGBA.
 
     samples: N means N x N stratified samples per pixel (jittered in "mc" mode, at the
     strata centres in "analytic" mode). filter: the pixel filter, with its radius in
     pixels (box always covers exactly the pixel). background: None (transparent) or an
-    RGBA / RGB sequence in [0, 1]. threads: None or 0 for all cores.
+    RGBA / RGB sequence in [0, 1]. threads: None or 0 for all cores. (The defaults are
+    RenderOptions'.)
 
     The result is differentiable with respect to every tensor of the scene. In "mc" mode
     the backward pass samples the boundaries (``boundary_samples`` points per pixel of
@@ -93,7 +99,7 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
                             filter_radius=float(filter_radius), seed=int(seed), threads=int(threads or 0),
                             background=background_rgba(background), interior_samples=int(interior_samples),
                             brute_force=bool(_brute_force), premultiplied=bool(_premultiplied),
-                            boundary_budget=float(boundary_budget))
+                            boundary_budget=float(boundary_budget), boundary_samples=float(boundary_samples))
     if packed is None:
         structure, floats = packed_for_core(scene, width, height)
     else:
@@ -101,7 +107,7 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
         check_finite(floats)
     core, where = options.core(), devices.resolve(device)
     if torch.is_grad_enabled() and any(t.requires_grad for t in floats) and not _brute_force:
-        return _Render.apply(core, where, float(boundary_samples), bool(_gpu_lists), structure, *floats)
+        return _Render.apply(core, where, options.boundary_samples, bool(_gpu_lists), structure, *floats)
     return torch.from_numpy(_core_render(core, where, structure, floats)[1])
 
 

@@ -259,6 +259,27 @@ def dash_count(path: Path, pattern: tuple[float, ...], width: float = 0.0) -> fl
     return _estimate(_Segments(path), path, pattern, width)
 
 
+class DashBudget:
+    """The dashes one scene may have, limits.MAX_DASHES, counted shape after shape as
+    dash_count counts them: the one count that the SVG reader (which leaves a pattern out
+    and notes it) and the packer (which draws it solid, with a warning, for a Scene made
+    otherwise) both take from."""
+
+    def __init__(self):
+        self.left = float(limits.MAX_DASHES)
+
+    def take(self, path: Path, pattern: tuple[float, ...], width: float = 0.0) -> bool:
+        """Whether the pattern's dashes along ``path`` (a stroke ``width`` wide) fit in
+        what is left; if they do, they are taken from it."""
+        return self.spend(dash_count(path, pattern, width))
+
+    def spend(self, count: float) -> bool:
+        if not count <= self.left:  # (a non-finite count never fits)
+            return False
+        self.left -= count
+        return True
+
+
 def _estimate(segs: _Segments, path: Path, pattern: tuple[float, ...], width: float) -> float:
     total = float(np.nansum(segs.length))
     period = math.fsum(pattern)
@@ -295,21 +316,20 @@ def _intervals(length: float, closed: bool, pattern: tuple[float, ...], first_in
     return a, b, dash
 
 
-def dash_path(path: Path, pattern, offset: float = 0.0, max_dashes: float | None = None,
+def dash_path(path: Path, pattern, offset: float = 0.0, budget: DashBudget | None = None,
               width: float = 0.0) -> Path | None:
     """The dashes of ``path`` for ``pattern`` (a dash_pattern) and ``offset``, both in the
     path's own units, as open subpaths; None where the stroke is drawn solid: an invalid
-    pattern or offset, or a dash_count (for a stroke ``width`` wide) over ``max_dashes``
-    (limits.MAX_DASHES by default)."""
+    pattern or offset, or a dash_count (for a stroke ``width`` wide) that the scene's
+    ``budget`` (a new one by default: limits.MAX_DASHES) has no room for."""
     import torch
 
     pattern = dash_pattern(pattern)
     offset = float(offset)
     if pattern is None or not math.isfinite(offset):
         return None
-    max_dashes = limits.MAX_DASHES if max_dashes is None else max_dashes
     segs = _Segments(path)
-    if _estimate(segs, path, pattern, width) > max_dashes:
+    if not (DashBudget() if budget is None else budget).spend(_estimate(segs, path, pattern, width)):
         return None
     first_index, first_len = _phase(pattern, offset)
 

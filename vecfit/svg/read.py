@@ -22,7 +22,7 @@ import numpy as np
 from vecfit import limits
 from vecfit.errors import SvgError
 from vecfit.scene import BLEND_MODES, ClipPath, Filter, Group, Mask, Path, Rect, Scene, Shape, arrays
-from vecfit.scene.dashes import dash_count, dash_pattern, outline_path
+from vecfit.scene.dashes import DashBudget, dash_pattern, outline_path
 
 from .effects import func_iri, parse_filter, region, units_of
 from .paints import BLACK, Paints, parse_opacity, parse_paint, solid
@@ -110,7 +110,7 @@ class Reader:
         self.ids = document.ids
         self._elements = 0  # elements walked so far, <use> instances included
         self._segments = 0
-        self._dash_count = 0  # dashes of the dashed strokes so far (about)
+        self._dash_budget = DashBudget()  # the scene's dashes (limits.MAX_DASHES)
         elements = sum(1 for e in self.root.iter() if isinstance(e.tag, str))
         if elements > MAX_ELEMENTS:  # entity expansion can make millions from a small file
             self._too_many_elements()
@@ -460,7 +460,7 @@ class Reader:
     def _dashes(self, style, geometry, width, name) -> tuple[tuple[float, ...] | None, float]:
         """stroke-dasharray (lengths, percentages of the diagonal; an invalid list or one SVG
         draws solid: None) and stroke-dashoffset, in user units. A pattern that would take
-        the scene past limits.MAX_DASHES dashes is noted and drawn solid."""
+        the scene past limits.MAX_DASHES dashes (DashBudget) is noted and drawn solid."""
         items = re.split(r"\s*,\s*|\s+", (style.get("stroke-dasharray") or "none").strip())
         diagonal, values = self._diagonal(), []
         for item in items:
@@ -473,11 +473,9 @@ class Reader:
         # (rects and ellipses become paths in torch: a NumPy reading imports it here)
         outline = outline_path(arrays.as_torch(geometry) if arrays.making_numpy() and not isinstance(geometry, Path)
                                else geometry)
-        count = dash_count(outline, pattern, width) if outline is not None else 0.0
-        if self._dash_count + count > limits.MAX_DASHES:
+        if outline is not None and not self._dash_budget.take(outline, pattern, width):
             self.skips.add("stroke-dasharray", name)
             return None, 0.0
-        self._dash_count += count
         return pattern, offset if offset is not None and math.isfinite(offset) else 0.0
 
     def _note_shape_effects(self, tag, style, name, stroked):

@@ -120,3 +120,27 @@ def test_dashed_points_get_gradients():
     image[..., 3].sum().backward()
     assert points.grad.abs().sum() > 0 and widths.grad.abs().sum() > 0
     assert torch.isfinite(points.grad).all() and torch.isfinite(widths.grad).all()
+
+
+def test_the_reader_and_the_packer_count_dashes_alike(tmp_path, monkeypatch):
+    """One count (scene.dashes.DashBudget) for the reader and the packer: of two strokes
+    that each fit the limit but not together, the reader keeps the first and notes the
+    second; the packer then draws the scene it read without a warning, and a Scene made
+    with both patterns gets the first dashed and the second solid, with a warning."""
+    monkeypatch.setattr(limits, "MAX_DASHES", 43)  # (one dash short of both: 20 drawn + 2 each)
+    svg = tmp_path / "d.svg"
+    svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="100" height="40">'
+                   '<path id="a" d="M 10 10 H 90" stroke="black" stroke-width="2" stroke-dasharray="2 2"/>'
+                   '<path id="b" d="M 10 30 H 90" stroke="black" stroke-width="2" stroke-dasharray="2 2"/></svg>')
+    with pytest.warns(VecfitWarning, match="stroke-dasharray"):
+        scene = vecfit.load_svg(svg)  # 22 dashes each (20 + the pattern's 2)
+    assert scene.shapes[0].dash_array == (2.0, 2.0) and scene.shapes[1].dash_array is None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        image = vecfit.render(scene, samples=4)[..., 3]
+    scene.shapes[1].dash_array = (2.0, 2.0)
+    scene.shapes[1].source = "b"
+    with pytest.warns(VecfitWarning, match="b: stroke-dasharray makes more than 43 dashes"):
+        again = vecfit.render(scene, samples=4)[..., 3]
+    assert torch.equal(image, again)
+    assert 0.3 < float(image[10].sum()) / float(image[30].sum()) < 0.7  # a dashed row, a solid one

@@ -1,7 +1,13 @@
 """The fitting loop's persistent pack (vecfit/renderer/persistent.py): the same image and
 the same gradients as packing the Scene on every call, where it applies, and no pack
-(None) where it does not."""
+(None, with the reason logged) where it does not. The pack does not check itself when it
+is built: its agreement with packing anew (the floats, and their gradients for a random
+adjoint, where a missed or wrong route shows) is asserted here, on every kind of value a
+route serves and on the shared scenes."""
 from __future__ import annotations
+
+import logging
+import warnings
 
 import pytest
 import torch
@@ -9,6 +15,7 @@ import torch
 from vecfit.fitting import loop
 from vecfit.fitting.loop import Settings, Target, optimize
 from vecfit.fitting.rates import parameter_kinds
+from vecfit.renderer.forward import FLOAT_INPUTS, packed_for_core
 from vecfit.renderer.persistent import PersistentPack
 from vecfit.renderer.raster import render
 from vecfit.svg.read import load_svg
@@ -74,12 +81,130 @@ def _assert_same(scene, kinds, w, h):
         assert torch.allclose(grads2[name], g, rtol=1e-5, atol=1e-6 * float(g.abs().max())), name
 
 
+def _assert_agrees(scene, kinds, w, h, pack=None):
+    """The persistent pack's floats are those of packing the scene anew, and so are their
+    gradients w.r.t. every kind for a random adjoint of the floats (what the build used
+    to check on every build of a fit). Returns how many kinds had a gradient."""
+    pack = pack or PersistentPack.build(scene, w, h, kinds)
+    assert pack is not None
+    leaves = [k.flat.detach().clone().requires_grad_() for k in kinds]
+    _, mine = pack.arrays(leaves)
+    for k in kinds:
+        k.zero_grad()
+    _, packed = packed_for_core(scene, w, h)  # through the Scene's tensors (views of the kinds)
+    for name, a, b in zip(FLOAT_INPUTS, mine, packed):
+        assert a.shape == b.shape, name
+        assert torch.allclose(a.detach(), b.detach(), rtol=1e-5, atol=1e-5), name
+    generator = torch.Generator().manual_seed(0)
+    adjoints = [torch.randn(f.shape, generator=generator) for f in packed]
+    sum((a * g).sum() for a, g in zip(mine, adjoints)).backward()
+    sum((f * g).sum() for f, g in zip(packed, adjoints) if f.requires_grad).backward()
+    checked = 0
+    for k, leaf in zip(kinds, leaves):
+        reference = k.gradient()  # the Scene's tensors' own
+        fast = leaf.grad if leaf.grad is not None else torch.zeros_like(reference)
+        scale = float(reference.abs().max()) if reference.numel() else 0.0
+        assert torch.allclose(fast, reference, rtol=1e-4, atol=1e-4 * max(1.0, scale)), k.name
+        checked += scale > 0
+    return checked
+
+
 def test_mixed_scene_same_image_and_gradients(tmp_path):
     scene = _scene(tmp_path)
     kinds = parameter_kinds(scene, RATES, 64, 48)
     assert {k.name for k in kinds} == set(RATES)
     _assert_same(scene, kinds, 64, 48)
     _assert_same(scene, kinds, 37, 29)  # another size: other matrices
+
+
+@pytest.mark.parametrize("size", [(64, 48), (37, 29)])
+def test_mixed_scene_floats_and_their_gradients_agree(tmp_path, size):
+    scene = _scene(tmp_path)
+    kinds = parameter_kinds(scene, RATES, *size)
+    assert _assert_agrees(scene, kinds, *size) == len(RATES)  # every kind reaches a float
+
+
+def test_a_wrong_route_shows(tmp_path):
+    """The agreement check sees a route that is off (here: one point's coefficient)."""
+    scene = _scene(tmp_path)
+    kinds = parameter_kinds(scene, {"points": 1.0}, 64, 48)
+    pack = PersistentPack.build(scene, 64, 48, kinds)
+    _assert_agrees(scene, kinds, 64, 48, pack)
+    pack._coefficient[3] *= 1.5
+    with pytest.raises(AssertionError):
+        _assert_agrees(scene, kinds, 64, 48, pack)
+
+
+AGREEMENT_CASES = {
+    "square rect": ('<path d="M0 0 H128 V96 H0 Z" fill="#eee"/>',
+                    '<rect x="3" y="4" width="100" height="80" fill="#eee" stroke="#f00"/>'),
+    "bounding-box gradient, colours": ('id="lin" gradientUnits="userSpaceOnUse"', 'id="lin"'),
+    "rounded rect, colours": ('<path d="M0 0 H128 V96 H0 Z" fill="#eee"/>',
+                              '<rect width="128" height="96" rx="9" fill="#eee"/>'),
+    "nested opacity layers": ('<path d="M20 20 L50 25 L40 60 Z" fill="#c84" fill-opacity="0.8"/>',
+                              '<g opacity="0.5"><path d="M20 20 L50 25 L40 60 Z" fill="#c84"/>'
+                              '<path d="M30 20 L60 25 L50 60 Z" fill="#4c8" stroke="#00f"/></g>'),
+    "circle of radius 0": ('r="20" fill="url(#rad)"', 'r="0" fill="url(#rad)"'),
+}
+
+
+@pytest.mark.parametrize("case", sorted(AGREEMENT_CASES))
+def test_floats_and_gradients_agree(tmp_path, case):
+    old, new = AGREEMENT_CASES[case]
+    assert old in MIXED
+    scene = _scene(tmp_path, MIXED.replace(old, new))
+    # (", colours": the geometry enters non-linearly there; the paints and widths do not)
+    rates = {k: v for k, v in RATES.items() if k not in ("points", "radii")} if "colours" in case else RATES
+    _assert_agrees(scene, parameter_kinds(scene, rates, 64, 48), 64, 48)
+
+
+def _shared_scenes():
+    """The shared scenes, the large ones (seconds each) marked slow."""
+    folder = SHARED / "data" / "scenes"
+    paths = sorted(folder.glob("*.svg")) if folder.is_dir() else []
+    return [pytest.param(p.name, marks=[pytest.mark.slow] if p.stat().st_size > 200_000 else []) for p in paths]
+
+
+@pytest.mark.parametrize("name", _shared_scenes())
+def test_shared_scenes_agree_or_say_why_not(name, caplog):
+    """Each shared scene with the default rates: the pack agrees, or there is none and the
+    log says why (clip paths, masks, filters or dashes: what the scene has)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # (what the reader leaves out is not the point here)
+        scene = load_svg(SHARED / "data" / "scenes" / name)
+    w, h = output_size_at_most(scene, 96)
+    kinds = parameter_kinds(scene, loop.Settings.defaults().lr, w, h)
+    with caplog.at_level(logging.INFO, logger="vecfit.renderer.persistent"):
+        pack = PersistentPack.build(scene, w, h, kinds)
+    if pack is None:
+        (record,) = caplog.records
+        reason = record.getMessage()
+        if scene.has_effects():
+            assert "clip paths, masks or filters" in reason
+        else:
+            assert "dashed strokes" in reason and any(s.dash_array is not None for s in scene.shapes)
+        return
+    assert not caplog.records
+    assert _assert_agrees(scene, kinds, w, h) > 0
+
+
+def output_size_at_most(scene, side: int) -> tuple[int, int]:
+    s = side / max(float(scene.width), float(scene.height))
+    return max(1, round(float(scene.width) * s)), max(1, round(float(scene.height) * s))
+
+
+def test_declines_say_why(tmp_path, caplog):
+    scene = _scene(tmp_path)
+    with caplog.at_level(logging.INFO, logger="vecfit.renderer.persistent"):
+        assert PersistentPack.build(scene, 64, 48, parameter_kinds(scene, {"transforms": 0.01}, 64, 48)) is None
+        assert PersistentPack.build(scene, 64, 48, parameter_kinds(scene, {"points": 1.0}, 64, 48)) is not None
+        clipped = _scene(tmp_path, MIXED.replace(
+            "<defs>", '<defs><clipPath id="c"><rect width="60" height="60"/></clipPath>').replace(
+            '<circle cx="90"', '<circle clip-path="url(#c)" cx="90"'))
+        assert PersistentPack.build(clipped, 64, 48, parameter_kinds(clipped, {"points": 1.0}, 64, 48)) is None
+    assert [r.getMessage() for r in caplog.records] == [
+        "the scene is packed on every iteration: transforms optimised",
+        "the scene is packed on every iteration: clip paths, masks or filters (drawn in layers, several packs a render)"]
 
 
 def test_square_rect(tmp_path):
@@ -222,3 +347,18 @@ def test_loop_same_seed_same_result(tmp_path):
     for losses, values in runs[2:]:
         assert losses == pytest.approx(runs[0][0], rel=1e-4)
         assert torch.allclose(values, runs[0][1], atol=1e-3)
+
+
+def test_the_routes_of_a_dashed_stroke_mark_its_geometry(tmp_path):
+    """The persistent pack declines dashes before it reads routes; the routes say so too:
+    the dashes' points and widths are not affine in the outline's (they are cut where its
+    arc lengths say), so the outline's tensors are marked, and its dash path gets no route."""
+    from vecfit.renderer.pack import pack_scene
+    from vecfit.renderer.routes import routes_of
+    scene = _scene(tmp_path, MIXED.replace('stroke-linecap="round"', 'stroke-linecap="round" stroke-dasharray="9 4"'))
+    path = scene.shapes[-1].geometry
+    path.widths = torch.linspace(1.0, 6.0, len(path.points))
+    routes = routes_of(scene, pack_scene(scene, 64, 48))
+    assert {id(path.points), id(path.widths)} <= routes.nonlinear
+    assert not any(r.tensor is path.points or r.tensor is path.widths for r in routes.routes)
+    assert id(scene.shapes[1].geometry.points) not in routes.nonlinear  # (an undashed path's are routed)
