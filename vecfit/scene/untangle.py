@@ -101,9 +101,13 @@ def simple_loops(segs: list[np.ndarray], tolerance: float, decimals: int | None 
             if loop:
                 done.append(loop)
             continue
-        c = found[0]
-        pieces = cut_at(loop, c.seg_a, c.t_a, c.seg_b, c.t_b, c.point)
-        if any(_same(piece, loop) for piece in pieces):  # rounding undid the cut: no progress
+        # the first crossing whose cut makes progress: rounding can undo a cut, and a
+        # crossing at the loop's own start (where it closes) cuts off nothing
+        for c in found:
+            pieces = cut_at(loop, c.seg_a, c.t_a, c.seg_b, c.t_b, c.point)
+            if not any(_same(piece, loop) for piece in pieces):
+                break
+        else:
             done.append(loop)
             continue
         todo.extend(pieces)

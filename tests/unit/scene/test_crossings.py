@@ -42,6 +42,15 @@ def test_figure_eight_crosses_once_at_its_middle():
     assert crossings_of(*polygon((0, 0), (2, 2), (2, 0), (0, 2))) == [Crossing(0, 0.5, 2, 0.5, (1.0, 1.0))]
 
 
+def test_segments_of_no_length_are_passed_over():
+    # a figure eight with a repeated point (a zero-length line) before its crossing
+    # segment: the crossing is the same
+    assert crossings_of(*polygon((0, 0), (0, 0), (2, 2), (2, 0), (0, 2))) == [Crossing(1, 0.5, 3, 0.5, (1.0, 1.0))]
+    # a square closed by a line from its start to itself (as cutting an outline at its
+    # start leaves it): the segments either side of that line meet, they do not cross
+    assert crossings_of(*polygon((0, 0), (1, 0), (1, 1), (0, 1), (0, 0))) == []
+
+
 def test_pentagram_crosses_five_times():
     angles = math.pi / 2 + np.arange(5) * 4 * math.pi / 5
     found = crossings_of(*polygon(*np.c_[np.cos(angles), np.sin(angles)]))

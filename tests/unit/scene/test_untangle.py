@@ -100,3 +100,20 @@ def test_a_loop_within_a_few_rounding_steps_is_left_whole_not_cut_for_ever():
     from vecfit.scene.untangle import simple_loops
     assert len(simple_loops(eight(0.03), 1e-4, 2)) == 1
     assert len(simple_loops(eight(30.0), 1e-4, 2)) == 2
+
+
+def test_a_loop_crossed_at_its_own_start_is_cut_at_its_other_crossings():
+    # a refined kitty trace's outline (Illustrator's, refined at the defaults): a cubic
+    # that loops through its neighbours, and a crossing reported where the loop closes,
+    # whose cut cuts off nothing; untangling left it whole, crossed
+    from vecfit.scene.untangle import simple_loops
+    points = np.array([[265.74, 335.54], [268.73, 337.92], [266.83, 332.94], [275.36, 343.39],
+                       [267.05, 334.44], [269.48, 338.13], [268.81, 335.32], [266.74, 338.66],
+                       [266.46, 338.07], [266.84, 337.35], [267.64, 336.58], [266.89, 336.31],
+                       [266.24, 335.97], [265.74, 335.54]])
+    degrees = [3, 3, 1, 3, 3, 1]
+    assert subpath_crossings(points, degrees, True, 0.01)
+    loops = simple_loops(segments_of(points, degrees, True), 0.01, 2)
+    assert len(loops) > 1
+    for loop in loops:
+        assert subpath_crossings(*layout_of(loop, True), True, 0.01) == []
