@@ -116,7 +116,8 @@ def test_centerlines_join_straight_through_a_crossing():
 def test_fills_is_todays_trace_byte_for_byte():
     # the SHA-256 of main's trace of this picture (before --style existed; path text in its
     # shortest form since the node pass: the same points; concave corners through the
-    # pixel corner and pieces tucked under their surrounding colour since session 17)
+    # pixel corner, pieces tucked under their surrounding colour and grown under what
+    # covers them since session 17)
     img = np.ones((96, 128, 3), np.float32)
     cv2.circle(img, (40, 50), 25, (0.8, 0.2, 0.1), -1, cv2.LINE_AA)
     cv2.line(img, (10, 10), (120, 80), (0.1, 0.1, 0.6), 5, cv2.LINE_AA)
@@ -124,7 +125,7 @@ def test_fills_is_todays_trace_byte_for_byte():
     for settings in (None, TraceSettings.defaults(style="fills")):
         svg = trace_image(img, settings).svg
         assert hashlib.sha256(svg.encode()).hexdigest() == \
-            "9991f9a0f79dd48e08121697b1249426672b8189cbe83860f6e7ed908a52843d"
+            "8d36757f2ee51cf6531412b9eb820e4014c4011f09bb8fe0aafdd4a8c8c36564"
 
 
 def test_thick_shapes_fall_back_to_fills_with_a_warning():

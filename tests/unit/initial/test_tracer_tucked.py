@@ -74,3 +74,23 @@ def test_the_page_cut_in_two_stays_page(tmp_path):
     assert re.findall(r'<(?:path|rect) (?!id)[^>]*fill="(#[0-9a-f]{6})"', result.svg) == ["#000000"]
     out = render(result, W, H, tmp_path)
     assert psnr(image[..., :3], out[..., :3]) >= 30
+
+
+def test_a_stripe_runs_on_under_the_emblem_over_it(tmp_path):
+    # Myanmar's flag (flags-000): stripes with a star over them; each stripe is a
+    # rectangle under the star, not a rectangle with the star's notch cut in it
+    # (tucked.hull_filled). Here a disc over a green and a red stripe.
+    layers = [(coverage(lambda x, y: (x > -1) & (y > 50.3) & (y < 100.3), W, H), (0.2, 0.7, 0.2)),
+              (coverage(lambda x, y: (x > -1) & (y > 100.3), W, H), (0.9, 0.15, 0.2)),
+              (coverage(lambda x, y: np.hypot(x - 100, y - 80) < 35, W, H), (1.0, 1.0, 1.0))]
+    image = paint(layers, W, H, background=(1.0, 0.8, 0.0))
+    result = trace_image(image, TraceSettings.defaults(paths=3))
+    written = result.svg.split("\n")[3:-2]
+    assert written[0].startswith("<rect")  # the red stripe, whole under the disc
+    # the green one runs on under the disc in one piece (its hidden edge not quite
+    # straight: the sub-pixel placement reads no blend under the disc)
+    green = re.search(r' d="([^"]*)"', written[1]).group(1)
+    assert green.lower().count("m") == 1 and len(re.findall(r"[a-zA-Z]", green)) <= 9
+    assert written[2].startswith("<circle") or written[2].startswith("<ellipse")  # the disc, on top
+    out = render(result, W, H, tmp_path)
+    assert psnr(image[..., :3], out[..., :3]) >= 30

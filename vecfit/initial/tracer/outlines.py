@@ -12,6 +12,7 @@ import cv2
 import numpy as np
 
 from .labels import fill_holes
+from .tucked import hull_filled
 
 
 def crack_outlines(mask: np.ndarray, origin=(0, 0), sharp: bool = True) -> list[np.ndarray]:
@@ -138,17 +139,18 @@ def drawing_order(labels: np.ndarray, count: int, boxes, host: np.ndarray | None
 
 
 def grown_masks(labels: np.ndarray, rank: np.ndarray, ranks: np.ndarray, regions, boxes, overlap: int,
-                host: np.ndarray | None = None):
+                host: np.ndarray | None = None, hulls: bool = False):
     """grown_mask of each of `regions`, their corner notches filled all at once (rank:
     each region's drawing rank; ranks: each pixel's region's, -1 where none; host: the
-    pieces tucked under each region, tucked.py)."""
-    grown = [grown_mask(labels, ranks, i, rank[i], boxes[i], overlap, host) for i in regions]
+    pieces tucked under each region; hulls: pieces grown under what covers them, both
+    tucked.py)."""
+    grown = [grown_mask(labels, ranks, i, rank[i], boxes[i], overlap, host, hulls) for i in regions]
     filled = fill_corner_notches_many([mask for mask, _ in grown])
     return [(mask, origin) for mask, (_, origin) in zip(filled, grown)]
 
 
 def grown_mask(labels: np.ndarray, ranks: np.ndarray, i: int, rank_i: int, box, overlap: int,
-               host: np.ndarray | None = None):
+               host: np.ndarray | None = None, hulls: bool = False):
     """Region i's mask, grown by `overlap` pixels into the regions drawn after it (on
     top; ranks: each pixel's region's drawing rank, -1 where none; rank_i: region i's). Two regions that meet
     side by side both have anti-aliased edges there, which would let the background show
@@ -161,6 +163,8 @@ def grown_mask(labels: np.ndarray, ranks: np.ndarray, i: int, rank_i: int, box, 
     mask = labels[r0:r1, c0:c1] == i
     if host is not None:  # the pieces tucked under it, where they are drawn after it
         mask |= (host[r0:r1, c0:c1] == i) & (ranks[r0:r1, c0:c1] > rank_i)
+    if hulls:
+        mask = hull_filled(mask, ranks[r0:r1, c0:c1] > rank_i)
     if overlap > 0:
         later = ranks[r0:r1, c0:c1] > rank_i
         size = 2 * overlap + 1

@@ -141,7 +141,7 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     drawn = [i for i in order.tolist() if i != background]
     drawn_rank = np.append(rank, -1)[regions.labels]  # each pixel's region's rank; -1: none
     masks = dict(zip(drawn, grown_masks(regions.labels, rank, drawn_rank, drawn, boxes, int(s.overlap),
-                                               host)))
+                                               host, hulls=compound)))
     for j, i in enumerate(order):
         if i == background:
             continue

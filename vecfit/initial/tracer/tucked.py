@@ -13,13 +13,20 @@ A shape enclosed by another was already drawn this way (its holes are filled); t
 takes pieces that reach the canvas's edge or touch a third region along a little of
 their outline. Rings that lie half against one region and half against another (an
 emoji's outline round its face) stay as they are: neither shares enough.
+
+A piece also runs on under what is drawn over it where that makes its outline simpler
+(``hull_filled``): it takes the pixels of its convex hull that later shapes cover, if its
+outline gets shorter (by 1% at least). A flag's stripes are then rectangles under the
+star, not rectangles with a star-shaped notch.
 """
 from __future__ import annotations
 
+import cv2
 import numpy as np
 from .regions import components
 
 TUCK_SHARE = 0.6
+HULL_GAIN = 0.99  # a piece takes the covered part of its hull where its outline gets shorter than this share
 
 _OUTSIDE = -2  # the neighbour "label" of a pixel edge on the canvas's edge
 
@@ -63,3 +70,42 @@ def tucked_hosts(labels: np.ndarray, count: int) -> np.ndarray:
     if not tucked.any():
         return host
     return np.where(tucked, by, -1)[pieces]
+
+
+def hull_filled(mask: np.ndarray, later: np.ndarray) -> np.ndarray:
+    """The shape's mask with each piece (8-connected) grown into the pixels of its convex
+    hull that ``later`` marks (drawn over it: they hide whatever lies under them), where
+    that cuts the piece's outline to HULL_GAIN of its length or less."""
+    whole = _hull_grown(mask, later)  # all the pieces at once: a band a star cuts in two
+    if whole is not None:
+        return mask | whole
+    count, pieces, stats, _ = cv2.connectedComponentsWithStats(mask.view(np.uint8), connectivity=8)
+    out = mask.copy()
+    for k in range(1, count):
+        x, y, w, h = (int(v) for v in stats[k, :4])
+        if w < 3 or h < 3:
+            continue
+        grown = _hull_grown(pieces[y:y + h, x:x + w] == k, later[y:y + h, x:x + w])
+        if grown is not None:
+            out[y:y + h, x:x + w] |= grown
+    return out
+
+
+def _hull_grown(mask: np.ndarray, later: np.ndarray) -> np.ndarray | None:
+    """The ``later`` pixels of the mask's convex hull that it lacks, if taking them cuts
+    its outline to HULL_GAIN of its length or less; else None."""
+    points = cv2.findNonZero(mask.view(np.uint8))
+    if points is None:
+        return None
+    hull = np.zeros(mask.shape, np.uint8)
+    cv2.fillConvexPoly(hull, cv2.convexHull(points), 1)
+    grown = (hull > 0) & later & ~mask
+    if grown.any() and _perimeter(mask | grown) <= HULL_GAIN * _perimeter(mask):
+        return grown
+    return None
+
+
+def _perimeter(mask: np.ndarray) -> int:
+    """The pixel edges between the mask and what is not."""
+    m = np.pad(mask, 1)
+    return int(np.count_nonzero(m[1:] != m[:-1]) + np.count_nonzero(m[:, 1:] != m[:, :-1]))
