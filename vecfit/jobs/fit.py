@@ -215,8 +215,9 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
                 background = nearest_colour(background, used / 255.0)
         if float(opt.get("simplify", 0)) > 0 and result.iterations > 0:  # fewer nodes (fitting/simplify.py)
             from vecfit.fitting.simplify import simplify_fitted
+            judged = {**opt, "eval_samples": int(opt["simplify_samples"]) or opt["eval_samples"]}
             render_rgb = lambda s, seed=0: to_rgb(to_numpy(_render_full(  # noqa: E731
-                s, sw, sh, {**opt, "seed": opt["seed"] + seed})), background)
+                s, sw, sh, {**judged, "seed": opt["seed"] + seed})), background)
             simplified = simplify_fitted(scene, goal, settings, render_rgb, target_rgb, float(opt["simplify"]),
                                          int(opt["simplify_iterations"]), hooks, keep_alpha)
     else:
