@@ -17,8 +17,10 @@ against the clean render.
 Each written SVG is rendered by resvg over white and scored against the target (PSNR on
 RGB, dB); vecfit.svg.stats.design_stats gives its elements (paths, the background rect not
 counted), segments and gzip bytes, compared with the designer's as multiples; the
-designer's row is scored as vecfit renders it too (16 samples a pixel): the PSNR a
-refinement through vecfit's renderer aims at, its floor against resvg's render. "filled" counts
+designer's row is scored as vecfit renders it too (16 samples a pixel): what the
+difference between the renderers costs the designer's own geometry (resvg's 1x
+anti-aliasing: tests/oracles/test_lineart_render.py; no ceiling for a trace, which resvg
+scores exactly where its geometry is the designer's). "filled" counts
 the elements other than the background that have a fill (0: only strokes). Times are
 in-process seconds and in R (benchmarks/machine.py). Prints medians per half and row;
 --out writes a row per icon and row (TSV).
@@ -72,7 +74,7 @@ def filled_elements(svg: str) -> int:
 
 def designer_in_vecfit(svg_path: Path, target: np.ndarray) -> float:
     """PSNR of the designer's file rendered by vecfit (16 samples a pixel) over white against
-    the target: what a refinement through vecfit's renderer aims at."""
+    the target: resvg's 1x anti-aliasing against vecfit's converged coverage."""
     import warnings
 
     import vecfit
@@ -144,7 +146,7 @@ def main():
                                 "paths": designer["paths"], "segments": designer["segments"],
                                 "gzip_bytes": designer["gzip_bytes"], "segments_x": 1.0, "gzip_x": 1.0,
                                 "filled": 0, "seconds": None})
-                # the floor of a refinement: the designer's own file in vecfit's renderer
+                # the designer's own file in vecfit's renderer: resvg's 1x anti-aliasing, measured
                 records.append({**records[-1], "row": "designer, vecfit's render",
                                 "psnr": designer_in_vecfit(svg_path, target)})
                 for row in rows:

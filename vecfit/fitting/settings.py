@@ -44,6 +44,7 @@ class Settings:
     palette: str  # the colours written ("" free; vecfit/jobs/palette.py reads it)
     simplify: float  # after the fit, nodes dropped while the picture loses at most this many dB (0: never)
     simplify_iterations: int  # the brief refinement after those joins (vecfit/fitting/simplify.py)
+    simplify_samples: int  # N x N samples of the renders that judge the joins (0: eval_samples')
     lr: dict
 
     @classmethod
@@ -105,6 +106,8 @@ class Settings:
             raise VecfitError(f"eval_samples must be at least 1, not {self.eval_samples}")
         if not (isinstance(self.simplify, (int, float)) and math.isfinite(self.simplify) and self.simplify >= 0):
             raise VecfitError(f"simplify must be a number of dB >= 0, not {self.simplify}")
+        if self.simplify_samples < 0:
+            raise VecfitError(f"simplify_samples must be 0 or more, not {self.simplify_samples}")
         if self.simplify_iterations < 0:
             raise VecfitError(f"simplify_iterations must be 0 or more, not {self.simplify_iterations}")
         if self.background.strip().lower() != "auto":

@@ -3,6 +3,7 @@ SVG, report and comparison picture written next to each other. `vecfit refine` s
 from the user's SVG, `vecfit trace` and `vecfit paint` from SVGs of their own making."""
 from __future__ import annotations
 
+import dataclasses
 import time
 import warnings
 from pathlib import Path
@@ -185,7 +186,9 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
                 background = nearest_colour(background, used / 255.0)
         if settings.simplify > 0 and result.iterations > 0:  # fewer nodes (fitting/simplify.py)
             from vecfit.fitting.simplify import simplify_fitted
-            render_rgb = lambda s, seed=0: rendered_rgb(s, sw, sh, settings, background, seed)  # noqa: E731
+            # (judged at simplify_samples where set: strokes' thin lines need more than quick's 2x2)
+            judged = dataclasses.replace(settings, eval_samples=settings.simplify_samples or settings.eval_samples)
+            render_rgb = lambda s, seed=0: rendered_rgb(s, sw, sh, judged, background, seed)  # noqa: E731
             simplified = simplify_fitted(scene, goal, settings, render_rgb, target_rgb, float(settings.simplify),
                                          int(settings.simplify_iterations), hooks, keep_alpha)
     else:

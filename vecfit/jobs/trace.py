@@ -61,7 +61,10 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
         # its blur and noise (paper #fafafa, ink 3% translucent: 1.5 dB of 28 on a scan)
         from vecfit.fitting.tame import tame_stroke_cubics
         hooks = (tame_stroke_cubics,)
-        config = {**config, "optimize": {**config["optimize"], "alpha": "fixed",
+        # no half-size start (coarse): there a line's width and place are a half-pixel guess;
+        # joins judged on 4 x 4 samples (refine.toml, simplify_samples)
+        config = {**config, "optimize": {**config["optimize"], "alpha": "fixed", "coarse": 0.0,
+                                         "simplify_samples": config["optimize"]["simplify_samples"] or 4,
                                          "lr": {**config["optimize"]["lr"], "colors": 0.0}}}
     return fit_and_write(scene, traced.document, target, config, outputs, progress, keep_alpha=backdrop, generated=True,
                          removed_background=removed, hooks=hooks,

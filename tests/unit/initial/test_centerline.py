@@ -113,6 +113,37 @@ def test_centerlines_join_straight_through_a_crossing():
         assert max(span) > 60 and min(span) < 4
 
 
+def test_a_fat_x_with_short_arms_keeps_both_lines():
+    # Tabler's "x" badge at 256 px: two crossing lines of 2 widths' length, 21 px wide.
+    # Zhang-Suen thinning leaves one diagonal (the other's arms erode away); Guo-Hall's
+    # skeleton keeps both, and the piece is strokes, not fills
+    elements = '<path d="M100 100 L142.67 142.67 M142.67 100 L100 142.67" stroke-width="21.33"/>'
+    image = drawn(elements, 256)
+    mask = image[..., 0] < 0.5
+    radius = cv2.distanceTransform(mask.astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+    assert len(centerlines(mask, radius)) == 1  # (what made the case)
+    assert len(centerlines(mask, radius, "guo-hall")) == 2
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", VecfitWarning)  # line work: no fallback warning
+        result = trace_image(image, TraceSettings.defaults(style="strokes"))
+    assert len(strokes_of(result.svg)) == 2, result.svg
+    assert psnr(rendered(result.svg, 256), image[..., :3]) > 24
+
+
+def test_a_line_shorter_than_its_width_is_a_line_not_a_dot():
+    # a 10.7 px line 21.3 px wide (Tabler's "M12 17l0 -1" at 256 px): its skeleton is a
+    # pixel or two, which made it a dot, and its ink, under the strokes' 85%, fills
+    image = drawn('<path d="M128 122.67 V133.33" stroke-width="21.33"/>', 256)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", VecfitWarning)
+        result = trace_image(image, TraceSettings.defaults(style="strokes"))
+    (found,) = strokes_of(result.svg)
+    numbers = [float(v) for v in re.findall(r"-?\d*\.?\d+", found["d"])]
+    assert "h0" not in found["d"] and "v0" not in found["d"]
+    assert max(abs(v) for v in numbers[2:]) > 6, found["d"]  # a line of about its length
+    assert psnr(rendered(result.svg, 256), image[..., :3]) > 28
+
+
 def test_fills_is_todays_trace_byte_for_byte():
     # the SHA-256 of main's trace of this picture (before --style existed; path text in its
     # shortest form since the node pass: the same points; concave corners through the

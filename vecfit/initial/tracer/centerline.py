@@ -274,7 +274,7 @@ def centred(points: np.ndarray, closed: bool, ink: np.ndarray, radius: float) ->
 def _extended(points: np.ndarray, ink: np.ndarray, radius: float) -> np.ndarray:
     """An open centerline's ends moved on to a half width short of where the ink ends ahead
     of them (thinning stops short of a line's end; a round cap then reaches the end)."""
-    if len(points) < 4:
+    if len(points) < 2:
         return points
     points = points.copy()
     steps = np.arange(0.0, 3 * radius + 3, 0.5)
@@ -312,6 +312,12 @@ def fitted_strokes(chains, radius: np.ndarray, ink: np.ndarray, color: str, s: T
         # the distance transform runs from the centre pixel to the nearest pixel outside:
         # half a pixel past the outline
         widths[id(c)] = max(2 * float(np.median(radius[ix[:, 1], ix[:, 0]])) - 1, 1.0)
+        if is_dot(c, widths[id(c)]) and len(c.points) >= 2:
+            # a short line's skeleton is a pixel or two: a line where its ends, moved on
+            # to the ink's, are a line apart
+            longer = _extended(c.points, ink, widths[id(c)] / 2)
+            if not is_dot(dataclasses.replace(c, points=longer), widths[id(c)]):
+                c.points = longer
         if not is_dot(c, widths[id(c)]):
             points, width = centred(_resampled(c.points, c.closed), c.closed, ink, widths[id(c)] / 2)
             if width is not None:
@@ -488,7 +494,15 @@ def trace_strokes(image: np.ndarray, settings: TraceSettings, progress=None) -> 
             chains = centerlines(piece, r)
             for c in chains:
                 c.points += (xs.start, ys.start)
-            if chains and _fits(chains, piece, r, (xs.start, ys.start), widest):
+            fits = bool(chains) and _fits(chains, piece, r, (xs.start, ys.start), widest)
+            if chains and not fits:
+                # the other thinning, where Zhang-Suen's skeleton misses part of the piece
+                other = centerlines(piece, r, "guo-hall")
+                for c in other:
+                    c.points += (xs.start, ys.start)
+                if other and _fits(other, piece, r, (xs.start, ys.start), widest):
+                    chains, fits = other, True
+            if fits:
                 strokes += fitted_strokes(chains, np.where(pieces == k, radius, 0), ink_cover, hex_color(color), s)
                 good[ys, xs] |= piece
             else:
@@ -550,6 +564,13 @@ def trace_strokes(image: np.ndarray, settings: TraceSettings, progress=None) -> 
                        seconds=time.perf_counter() - start, strokes=len(strokes), warnings=warnings_given)
 
 
+def _half_width(points: np.ndarray, radius: np.ndarray) -> float:
+    """A chain's half width: the median distance to the outline along it, less the half
+    pixel the distance transform counts past the outline."""
+    ix = np.clip(points.astype(int), 0, [radius.shape[1] - 1, radius.shape[0] - 1])
+    return max(float(np.median(radius[ix[:, 1], ix[:, 0]])) - 0.5, 0.5)
+
+
 def _fits(chains, piece: np.ndarray, radius: np.ndarray, origin, widest: float) -> bool:
     """Whether strokes along ``chains`` draw the ``piece`` (a bool mask whose top left is
     at ``origin``): thin enough, and covering it (MIN_COVER, intersection over union)."""
@@ -557,7 +578,12 @@ def _fits(chains, piece: np.ndarray, radius: np.ndarray, origin, widest: float) 
     ix = np.clip(along.astype(int), 0, [piece.shape[1] - 1, piece.shape[0] - 1])
     if 2 * float(np.median(radius[ix[:, 1], ix[:, 0]])) - 1 > widest:
         return False
-    local = [dataclasses.replace(c, points=c.points - origin) for c in chains]
+    # thinning stops short of a line's ends (a short line's skeleton is a fraction of it):
+    # the ends are judged as the strokes draw them, moved on as _extended moves them
+    inside = piece.astype(np.float32)
+    local = [dataclasses.replace(c, points=c.points - origin if c.closed else
+                                 _extended(c.points - origin, inside, _half_width(c.points - origin, radius)))
+             for c in chains]
     drawn = drawn_mask(local, radius)
     # judged a pixel either way: a thin line's width is rounded to whole pixels here
     near_drawn = cv2.dilate(drawn.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)

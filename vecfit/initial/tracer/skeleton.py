@@ -42,9 +42,12 @@ class Chain:
     closed: bool
 
 
-def skeleton_of(mask: np.ndarray) -> np.ndarray:
-    """The one-pixel skeleton of a bool mask (Zhang-Suen thinning), bool."""
-    thin = cv2.ximgproc.thinning(mask.astype(np.uint8) * 255, thinningType=cv2.ximgproc.THINNING_ZHANGSUEN)
+THINNINGS = {"zhang-suen": cv2.ximgproc.THINNING_ZHANGSUEN, "guo-hall": cv2.ximgproc.THINNING_GUOHALL}
+
+
+def skeleton_of(mask: np.ndarray, thinning: str = "zhang-suen") -> np.ndarray:
+    """The one-pixel skeleton of a bool mask (Zhang-Suen or Guo-Hall thinning), bool."""
+    thin = cv2.ximgproc.thinning(mask.astype(np.uint8) * 255, thinningType=THINNINGS[thinning])
     return thin > 0
 
 
@@ -138,15 +141,17 @@ def _prune(skel: np.ndarray, radius: np.ndarray) -> bool:
     return removed
 
 
-def centerlines(mask: np.ndarray, radius: np.ndarray) -> list[Chain]:
+def centerlines(mask: np.ndarray, radius: np.ndarray, thinning: str = "zhang-suen") -> list[Chain]:
     """The centerlines of a bool mask's line work; ``radius`` the distance transform of the
-    mask (each pixel's distance to the nearest pixel outside)."""
+    mask (each pixel's distance to the nearest pixel outside). ``thinning``: of THINNINGS
+    (Zhang-Suen keeps a T's bar straight through the junction; Guo-Hall keeps both lines
+    of a fat X with short arms, where Zhang-Suen erodes one of them away)."""
     h, w = mask.shape
-    skel = skeleton_of(mask)
+    skel = skeleton_of(mask, thinning)
     for _ in range(4):
         if not _prune(skel, radius):
             break
-        skel = skeleton_of(skel)  # a removed spur may leave a pixel or two of staircase
+        skel = skeleton_of(skel, thinning)  # a removed spur may leave a pixel or two of staircase
     links = _links(skel)
     junction_of, edges, cycles = _graph(links)
     xy = lambda p: (p % w + 0.5, p // w + 0.5)  # noqa: E731  (pixel centres)
