@@ -203,3 +203,15 @@ def test_mixed_draws_areas_as_fills_under_their_outlines_without_a_warning():
     yellow = [f for f in filled if f["fill"].lower().startswith("#f")]
     assert yellow, result.svg  # the face, run on under its outline
     assert psnr(rendered(result.svg), image[..., :3]) > 24
+
+
+def test_a_round_dot_comes_back_as_a_dot_stroke():
+    # a Tabler dot ("M12 8v.01", round caps): its ink is a disc whose skeleton thins to
+    # nothing; it was traced as a filled circle, the icon then not strokes only
+    _, result = traced('<path d="M40.3 60.6 v.01" stroke-width="12"/><path d="M60 30 H110" stroke-width="5"/>')
+    found = strokes_of(result.svg)
+    assert all(f.get("fill") == "none" and "stroke" in f for f in found) and len(found) == 2
+    dot = max(found, key=lambda f: float(f["stroke-width"]))
+    assert abs(float(dot["stroke-width"]) - 12) < 1.0
+    x, y = (float(v) for v in re.match(r"M([\d.]+) ([\d.]+)", dot["d"]).groups())
+    assert abs(x - 40.3) < 0.75 and abs(y - 60.6) < 0.75

@@ -35,7 +35,7 @@ from .bezier import TANGENT_REACH, Stretches, _unit, fit_outlines, fit_pieces, o
 from .primitives import _continues, as_primitive, open_outline, straightened
 from .quantize import OPAQUE, to_lab
 from .settings import TraceResult, TraceSettings
-from .skeleton import centerlines
+from .skeleton import Chain, centerlines
 from .svgtext import DECIMALS, add_rect, new_document
 
 # A pixel is ink where it differs from the background by more than this (CIELAB units).
@@ -399,6 +399,10 @@ def drawn_mask(chains, radius: np.ndarray) -> np.ndarray:
         ix = np.clip(c.points.astype(int), 0, [w - 1, h - 1])
         r = float(np.median(radius[ix[:, 1], ix[:, 0]]))
         pts = np.round(c.points * 4).astype(np.int32)[None]  # 2 bits of sub-pixel precision
+        if len(c.points) == 1:  # a dot (polylines draws nothing for one point)
+            cv2.circle(out, tuple(int(v) for v in pts[0, 0]), max(1, int(round(4 * (r - 0.5)))), 1, -1,
+                       lineType=cv2.LINE_8, shift=2)
+            continue
         cv2.polylines(out, pts, c.closed, 1, thickness=max(1, int(round(2 * r - 1))), lineType=cv2.LINE_8, shift=2)
     return out > 0
 
@@ -491,7 +495,7 @@ def trace_strokes(image: np.ndarray, settings: TraceSettings, progress=None) -> 
             ys, xs = slice(max(y0 - pad, 0), min(y0 + bh + pad, h)), slice(max(x0 - pad, 0), min(x0 + bw + pad, w))
             piece = pieces[ys, xs] == k
             r = np.where(piece, radius[ys, xs], 0)
-            chains = centerlines(piece, r)
+            chains = centerlines(piece, r) or _dot(piece)
             for c in chains:
                 c.points += (xs.start, ys.start)
             fits = bool(chains) and _fits(chains, piece, r, (xs.start, ys.start), widest)
@@ -562,6 +566,16 @@ def trace_strokes(image: np.ndarray, settings: TraceSettings, progress=None) -> 
                        colors=colors + len({st.color for st in strokes}),
                        segments=segments + sum(st.segments for st in strokes),
                        seconds=time.perf_counter() - start, strokes=len(strokes), warnings=warnings_given)
+
+
+def _dot(piece: np.ndarray) -> list:
+    """A piece whose skeleton thins to nothing (a round blob: a Tabler dot, a full stop)
+    as one dot at its centre, which _fits then judges: a dot stroke where the piece is
+    round, fills where it is not."""
+    ys, xs = np.nonzero(piece)
+    if not len(xs):
+        return []
+    return [Chain(points=np.array([[xs.mean() + 0.5, ys.mean() + 0.5]]), closed=False)]
 
 
 def _half_width(points: np.ndarray, radius: np.ndarray) -> float:
