@@ -85,6 +85,14 @@ def _same(a: list[np.ndarray], b: list[np.ndarray]) -> bool:
     return len(a) == len(b) and all(x.shape == y.shape and np.array_equal(x, y) for x, y in zip(a, b))
 
 
+def _at_start(c, loop: list[np.ndarray]) -> bool:
+    """Whether a crossing lies at the loop's start, where its first segment begins and a
+    segment ends that only segments of no length follow."""
+    return (c.seg_a == 0 and c.t_a <= 1e-12 and c.t_b >= 1 - 1e-12
+            and float(np.abs(loop[c.seg_b][-1] - loop[0][0]).max()) <= MIN_LENGTH
+            and not any(_usable(rest) for rest in loop[c.seg_b + 1:]))
+
+
 def simple_loops(segs: list[np.ndarray], tolerance: float, decimals: int | None = None) -> list[list[np.ndarray]]:
     """A closed loop cut at its crossings into loops that do not cross themselves; with
     ``decimals``, each loop's control points rounded to them before it is checked (as the
@@ -101,13 +109,10 @@ def simple_loops(segs: list[np.ndarray], tolerance: float, decimals: int | None 
             if loop:
                 done.append(loop)
             continue
-        # the first crossing whose cut makes progress: rounding can undo a cut, and a
-        # crossing at the loop's own start (where it closes) cuts off nothing
-        for c in found:
-            pieces = cut_at(loop, c.seg_a, c.t_a, c.seg_b, c.t_b, c.point)
-            if not any(_same(piece, loop) for piece in pieces):
-                break
-        else:
+        # (a crossing reported where the loop closes, its start, cuts off nothing: the next)
+        c = next((c for c in found if not _at_start(c, loop)), None)
+        pieces = cut_at(loop, c.seg_a, c.t_a, c.seg_b, c.t_b, c.point) if c is not None else [loop]
+        if any(_same(piece, loop) for piece in pieces):  # rounding undid the cut: no progress
             done.append(loop)
             continue
         todo.extend(pieces)
