@@ -41,12 +41,6 @@ ELLIPSE_TOLERANCE = 0.35
 from .svgtext import add_path, add_primitive, add_rect, new_document, outline_path_data, path_data
 
 
-def _same_colour(a, b) -> bool:
-    """Whether two fills look the same (under one CIELAB unit apart)."""
-    lab = to_lab(np.asarray([a, b], np.float64).reshape(2, 3))
-    return float(np.linalg.norm(lab[0] - lab[1])) < 1.0
-
-
 def check_image(image) -> np.ndarray:
     """The image as float32 RGBA [H, W, 4]; RGB is taken as opaque."""
     a = np.asarray(image)
@@ -173,11 +167,10 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     if background is not None:
         fills.add(hex_color(paint[background]))
         add_rect(document, w, h, hex_color(paint[background]))
-    for n, (i, sl) in enumerate(shapes):
+    for i, sl in shapes:
         subpaths = [sp for sp in fitted[sl] if len(sp)]
-        if not subpaths or (compound and n == 0 and background is not None
-                            and _same_colour(paint[i], paint[background])):
-            continue  # (the first shape over the backdrop, in its colour: it would paint nothing)
+        if not subpaths:
+            continue
         fill = hex_color(paint[i])
         fills.add(fill)
         cut = any(holes[sl])
