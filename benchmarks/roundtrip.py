@@ -2,8 +2,9 @@
 back at the designer's number of paths, and the traced file compared with the designer's.
 
     python benchmarks/roundtrip.py [--sets noto-emoji,fxemoji,flags,logos,devicon,vscode-icons,
-                                           fontawesome,tabler] [--limit 10] [--effort quick|normal|best]
-                                   [--no-refine] [--rows vecfit,vtracer] [--threads 2] [--simplify DB]
+                                           fontawesome,tabler] [--limit 10 | --names NAME,... | --folder DIR]
+                                   [--effort quick|normal|best] [--no-refine] [--rows vecfit,vtracer]
+                                   [--threads 2] [--simplify DB] [--style fills|strokes|mixed]
                                    [--stacking cutouts [--gap-filler]]
                                    [--json out.json] [--verbose]
 
@@ -60,6 +61,19 @@ def manifest_cases(prefix: str, limit: int) -> list[tuple[str, Path]]:
     return [(r["name"], folder / r["svg"]) for r in rows[::step][:limit]]
 
 
+def named_cases(names: list[str]) -> list[tuple[str, Path]]:
+    """(name, SVG) of the named files of the shared corpus (realworld or lineart)."""
+    cases = []
+    for name in names:
+        folder = SHARED / ("lineart" if name.startswith("tabler-") else "realworld")
+        with open(folder / "manifest.tsv", encoding="utf-8") as f:
+            found = [r for r in csv.DictReader(f, delimiter="\t") if r["name"] == name]
+        if not found:
+            raise SystemExit(f"roundtrip.py: no file named {name} in {folder / 'manifest.tsv'}")
+        cases.append((name, folder / found[0]["svg"]))
+    return cases
+
+
 def target_png(svg: Path) -> bytes:
     """The designer's file rendered by resvg at WIDTH px wide over white (opaque PNG)."""
     import resvg_py
@@ -73,10 +87,11 @@ def png_rgb(png: bytes) -> np.ndarray:
     return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), np.float64) / 255
 
 
-def run_vecfit(png: bytes, paths: int, effort: str, refine: bool, threads: int, simplify: float | None = None) -> str:
+def run_vecfit(png: bytes, paths: int, effort: str, refine: bool, threads: int, simplify: float | None = None,
+               style: str = "fills") -> str:
     import vecfit
 
-    settings = {"trace": {"paths": max(1, paths)}, "optimize": {"threads": threads}}
+    settings = {"trace": {"paths": max(1, paths), "style": style}, "optimize": {"threads": threads}}
     if simplify is not None:
         settings["optimize"]["simplify"] = simplify
     if not refine:
@@ -169,10 +184,14 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sets", default=",".join(SETS), help=f"of {','.join(SETS)}")
     ap.add_argument("--limit", type=int, default=10, help="files per set")
+    ap.add_argument("--names", help="these files only (comma-separated manifest names), each in its set")
+    ap.add_argument("--folder", type=Path, help="the SVG files of this folder instead of the shared sets (a set named by it)")
     ap.add_argument("--effort", default="normal", choices=["quick", "normal", "best"])
     ap.add_argument("--no-refine", action="store_true", help="vecfit's trace as it is, not refined")
     ap.add_argument("--rows", default=",".join(ROWS), help="vecfit, vtracer (vtracer where importable)")
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--style", choices=["fills", "strokes", "mixed"], default="fills",
+                    help="vecfit's --style (mixed: fills under strokes for line work)")
     ap.add_argument("--simplify", type=float, default=None,
                     help="optimize.simplify, the node pass's budget in dB (0: off; default: trace's)")
     ap.add_argument("--stacking", choices=["stacked", "cutouts"], default="stacked",
@@ -195,17 +214,25 @@ def main():
     unit = machine_note()
     if unit is not None:
         print(f"machine unit: {unit}")
-    print(f"effort: {'trace, not refined' if args.no_refine else args.effort}; threads {args.threads}; "
+    print(f"effort: {'trace, not refined' if args.no_refine else args.effort}; style {args.style}; threads {args.threads}; "
           f"{WIDTH} px over white")
+    if args.style != "fills" and args.stacking == "cutouts":
+        ap.error("cut-outs are filled pieces: --stacking cutouts needs --style fills")
     if "vecfit" in rows:
         warm_up(args)
     results: dict = {"effort": None if args.no_refine else args.effort, "threads": args.threads, "width": WIDTH,
                      "machine_unit": unit, "files": [], "sets": {}}
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        for set_name in args.sets.split(","):
+        for set_name in ([args.folder.name] if args.folder else args.sets.split(",")):
             per_row: dict = {"designer": []}
-            for name, svg in manifest_cases(set_name, args.limit):
+            if args.folder:
+                cases = [(svg.stem, svg) for svg in sorted(args.folder.glob("*.svg"))]
+            elif args.names:
+                cases = [case for case in named_cases(args.names.split(",")) if case[0].startswith(set_name + "-")]
+            else:
+                cases = manifest_cases(set_name, args.limit)
+            for name, svg in cases:
                 designer = {**design_stats(svg), "psnr": None, "segments_x": 1.0, "gzip_x": 1.0, "seconds": None}
                 per_row["designer"].append(designer)
                 png = target_png(svg)
@@ -221,7 +248,7 @@ def main():
                             written = run_cutouts(stacked, target.shape[1], target.shape[0], args.gap_filler)
                         else:
                             written = (run_vecfit(png, designer["paths"], args.effort, not args.no_refine, args.threads,
-                                                  args.simplify)
+                                                  args.simplify, args.style)
                                        if row == "vecfit" else run_vtracer(png))
                             if row == "vecfit":
                                 stacked = written

@@ -184,7 +184,7 @@ def test_no_line_work_gives_the_fills_trace_and_a_warning():
 
 
 @pytest.mark.parametrize("changes, word", [({"style": "lines"}, "style"), ({"max_stroke": 0.0}, "max_stroke"),
-                                           ({"max_stroke": 2.0}, "max_stroke")])
+                                           ({"max_stroke": 2.0}, "max_stroke"), ({"max_line": 0.0}, "max_line")])
 def test_bad_style_settings_are_refused(changes, word):
     with pytest.raises(VecfitError, match=word):
         trace_image(np.ones((16, 16, 3), np.float32), TraceSettings.defaults(**changes))
@@ -203,6 +203,26 @@ def test_mixed_draws_areas_as_fills_under_their_outlines_without_a_warning():
     yellow = [f for f in filled if f["fill"].lower().startswith("#f")]
     assert yellow, result.svg  # the face, run on under its outline
     assert psnr(rendered(result.svg), image[..., :3]) > 24
+
+
+def test_mixed_keeps_an_emojis_face_and_mouth_as_fills():
+    # an emoji as OpenMoji draws them, at 256 px: a face whose skeleton runs mostly through
+    # its narrow parts round the eyes and mouth (its median width under max_stroke, so it
+    # was stroked 30-100 px wide), and a mouth of uneven width (a crescent, stroked at its
+    # median width with gaps either side)
+    size = 256
+    image = drawn('<circle cx="128" cy="128" r="94" fill="#fcea2b" stroke-width="7"/>'
+                  '<circle cx="92" cy="108" r="11" fill="#202020"/><circle cx="164" cy="108" r="11" fill="#202020"/>'
+                  '<path d="M62 160 Q128 182 194 160 Q180 222 128 224 Q76 222 62 160 Z" fill="#ea5a47" stroke-width="7"/>',
+                  size)
+    result = trace_image(image, TraceSettings.defaults(style="mixed"))
+    found = strokes_of(result.svg)
+    stroked = [f for f in found if f.get("fill") == "none"]
+    filled = {f["fill"].lower() for f in found if f.get("fill", "none") != "none"}
+    assert stroked and max(float(f["stroke-width"]) for f in stroked) < 12, result.svg  # the outlines, 7 px
+    assert {f["stroke"].lower() for f in stroked} == {"#202020"}, result.svg
+    assert any(c.startswith("#f") for c in filled) and any(c.startswith("#e") for c in filled), result.svg
+    assert psnr(rendered(result.svg, size), image[..., :3]) > 24
 
 
 def test_a_round_dot_comes_back_as_a_dot_stroke():

@@ -63,8 +63,11 @@ class TraceSettings:
     centerline (centerline.py), fills only where no stroke fits; mixed: fills for areas and
     strokes for the line work over them."""
     max_stroke: float
-    """strokes, mixed: the widest line traced as a stroke, as a fraction of the image's
-    shorter side (thicker ink is traced as fills)."""
+    """strokes: the widest line traced as a stroke, as a fraction of the image's shorter
+    side (thicker ink is traced as fills)."""
+    max_line: float
+    """mixed: the widest line work stroked over the fills, as a fraction of the image's
+    shorter side (areas of colour are wider than outlines)."""
     seed: int
     """Seed of the k-means sampling and initialisation: equal seeds give equal output."""
 
@@ -123,7 +126,8 @@ def check_settings(s: TraceSettings) -> None:
     for name in ("blur", "overlap", "smoothing", "lines"):
         if getattr(s, name) < 0:
             bad(name, "must not be negative")
-    if not 0 < s.max_stroke <= 1:
-        bad("max_stroke", "must be in (0, 1]")
+    for name in ("max_stroke", "max_line"):
+        if not 0 < getattr(s, name) <= 1:
+            bad(name, "must be in (0, 1]")
     if s.seed < 0:
         bad("seed", "must not be negative")
