@@ -117,3 +117,28 @@ def test_a_loop_crossed_at_its_own_start_is_cut_at_its_other_crossings():
     assert len(loops) > 1
     for loop in loops:
         assert subpath_crossings(*layout_of(loop, True), True, 0.01) == []
+
+
+def test_an_outline_with_many_crossings_is_checked_in_a_few_batches(monkeypatch):
+    # a coiled ribbon (a prolate trochoid, 40 loops, closed below): 40 crossings. Checking
+    # the rest of the outline again after every cut made a gradient emoji's outline take
+    # 1,300 s; the crossings found are handed on to the loops each cut makes, and the loops
+    # handed none are checked together
+    import vecfit.scene.untangle as untangle_module
+    turns = 40
+    t = np.linspace(0, 2 * np.pi * turns, 24 * turns + 1)
+    coil = np.stack([20 + 5 * t, 40 + 12 * np.sin(t)], axis=1)
+    coil[:, 0] -= 12 * np.cos(t) - 12
+    points = np.concatenate([coil, [[coil[-1, 0], 70.0], [coil[0, 0], 70.0]]])
+    segs = [np.array([points[k], points[(k + 1) % len(points)]]) for k in range(len(points))]
+    assert len(subpath_crossings(*layout_of(segs, True), True, 0.01)) == turns
+    calls = []
+    real = untangle_module.many_subpath_crossings
+    monkeypatch.setattr(untangle_module, "many_subpath_crossings", lambda jobs: calls.append(len(jobs)) or real(jobs))
+    loops = untangle_module.simple_loops(segs, 0.01, 2)
+    assert len(loops) == turns + 1
+    assert len(calls) <= 3, calls  # the outline, then its loops together (and any a rounding crossed)
+    for loop in loops:
+        assert subpath_crossings(*layout_of(loop, True), True, 0.01) == []
+    # the same signed area, to the rounding of 963 points to 2 decimals
+    assert abs(sum(loop_area(loop) for loop in loops) - loop_area(segs)) < 1e-4 * abs(loop_area(segs))
