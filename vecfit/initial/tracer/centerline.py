@@ -558,7 +558,7 @@ def trace_strokes(image: np.ndarray, settings: TraceSettings, progress=None) -> 
             rest[paper, 3] = 0
         else:
             rest[paper, :3] = background
-        traced = trace_image(rest, fills_settings)
+        traced = trace_image(rest, fills_settings, covered=stroked if s.style == "mixed" else None)
         document, paths, segments, colors = traced.document, traced.paths, traced.segments, traced.colors
     else:
         document, paths, segments, colors = new_document(w, h), 0, 0, 0

@@ -20,6 +20,7 @@ from vecfit.svg.numbers import hex_color
 from .bezier import fit_outlines
 from .groups import grouped
 from .labels import bounding_boxes, covering_boxes
+from .hidden import straightened_hidden
 from .outlines import drawing_order, grown_masks, shape_outlines
 from .quantize import OPAQUE, nearest_centre, palette_classes, prefilter, quantize_colors, to_lab
 from .regions import build_regions, majority_class, palette_colors
@@ -64,7 +65,8 @@ def check_image(image) -> np.ndarray:
 
 
 def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
-                progress=None, palette: np.ndarray | None = None, palette_by: str = "pixels") -> TraceResult:
+                progress=None, palette: np.ndarray | None = None, palette_by: str = "pixels",
+                covered: np.ndarray | None = None) -> TraceResult:
     """Trace an image into an SVG document (vecfit.svg.document).
 
     image: float32 RGBA [H, W, 4], straight alpha in [0, 1] (what vecfit.io.images.load_rgba
@@ -83,6 +85,9 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     colour (anti-aliased rims then merge and place edges as in a free trace: 3.8 dB better
     on a two-colour logo, 1 dB worse on a flag's fine tree; the trace job keeps the
     better of the two).
+
+    covered (optional, bool [H, W]): pixels that strokes drawn over the trace cover
+    (``--style mixed``): outlines deep under them are straightened (hidden.py).
     """
     start = time.perf_counter()
     settings = TraceSettings.defaults() if settings is None else settings
@@ -153,6 +158,8 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
         owners = np.array([i for i, sl in shapes for _ in range(sl.start, sl.stop)], np.int64)
         outlines = refine_outlines(outlines, owners, regions.labels, rank, regions.color, rgb, alpha,
                                    np.array(holes, bool))
+    if covered is not None:  # under mixed's strokes: straightened (hidden.py)
+        outlines = straightened_hidden(outlines, covered)
     report("fit", 0.7)
     # one batched fit of all outlines (see bezier.py)
     fitted = fit_outlines(outlines, s.tolerance, s.corner_angle, s.smoothing)
