@@ -108,6 +108,22 @@ VF_HD double ellipse_closest(const EllipseFrame& f, Vec2 p, Vec2& closest) {
     return dist;
 }
 
+// Bounds on the distance from p to the ellipse, without solving for the closest point:
+// scaling by (1/r0, 1/r1) maps the ellipse to the unit circle and stretches distances by
+// between 1/r0 and 1/r1, so the distance lies in [r1, r0] times |rho - 1|, rho being p's
+// radius in the scaled frame. Most samples of a large ellipse lie far from it, where the
+// bounds decide a test that the bisection would take ~60 steps to. False for a degenerate
+// ellipse (no bounds).
+VF_HD bool ellipse_distance_bounds(const EllipseFrame& f, Vec2 p, double& lo, double& hi) {
+    if (f.r0 <= 0 || f.r1 <= 0) return false;
+    Vec2 d = p - f.c;
+    double u = (f.cs * d.x + f.sn * d.y) / f.r0, v = (-f.sn * d.x + f.cs * d.y) / f.r1;
+    double off = std::fabs(std::hypot(u, v) - 1);
+    lo = vmin(f.r0, f.r1) * off;
+    hi = vmax(f.r0, f.r1) * off;
+    return true;
+}
+
 VF_HD bool ellipse_contains(const EllipseFrame& f, Vec2 p) {
     if (f.r0 <= 0 || f.r1 <= 0) return false;
     Vec2 d = p - f.c;

@@ -520,6 +520,11 @@ VF_HD bool stroke_contains(const SceneView& sc, const PreparedDraw& d, const Ite
     Vec2 q = to_stroke_space(d, p);
     double hw = d.half_width;
     if (d.is_ellipse) {
+        double lo, hi;
+        if (ellipse_distance_bounds(d.ellipse, q, lo, hi)) {  // most samples: decided by the bounds
+            if (lo > hw) return false;
+            if (hi <= hw) return true;
+        }
         Vec2 c;
         return ellipse_closest(d.ellipse, q, c) <= hw;
     }
@@ -541,6 +546,10 @@ VF_HD double stroke_sdf(const SceneView& sc, const PreparedDraw& d, const Items&
     double hw = d.half_width;
     double sd = 1e300;
     if (d.is_ellipse) {
+        double lo, hi;
+        // without derivatives wanted, a sample farther than the clamp needs no closest point
+        if (!arg && ellipse_distance_bounds(d.ellipse, q, lo, hi) && (lo - hw) * d.metric_scale >= limit)
+            return limit;
         Vec2 c;
         sd = ellipse_closest(d.ellipse, q, c) - hw;
         if (arg) {
@@ -577,6 +586,10 @@ VF_HD double stroke_sdf(const SceneView& sc, const PreparedDraw& d, const Items&
 }
 
 VF_HD double ellipse_fill_sdf(const PreparedDraw& d, Vec2 p, double limit, SdfArg* arg = nullptr) {
+    double lo, hi;
+    // without derivatives wanted, a sample farther than the clamp needs no closest point
+    if (!arg && ellipse_distance_bounds(d.ellipse, p, lo, hi) && lo >= limit)
+        return ellipse_contains(d.ellipse, p) ? -limit : limit;
     Vec2 c;
     double dist = vmin(ellipse_closest(d.ellipse, p, c), limit);
     if (arg) {
