@@ -80,8 +80,7 @@ def validate(settings: dict) -> None:
     seed = settings["optimize"]["seed"]
     if "trace" in settings:
         from vecfit.initial.tracer import TraceSettings
-        from vecfit.initial.tracer.settings import check_settings
-        check_settings(settings_of(TraceSettings, settings["trace"], seed=seed))
+        settings_of(TraceSettings, settings["trace"], seed=seed)  # (checked as it is made)
     if "paint" in settings:
         from vecfit.initial.strokes import PaintSettings
         settings_of(PaintSettings, settings["paint"], seed=seed).check()
