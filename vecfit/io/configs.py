@@ -1,8 +1,8 @@
 """The packaged default settings (configs/*.toml, installed as vecfit.configs), TOML
-reading, and the one merge of settings tables. The defaults live only in those files, but
-for the render settings of [optimize], which are the renderer's (``refine_toml``): every
-settings class builds its default from here (``defaults``), and vecfit.jobs.config layers
-efforts, presets, the user's file and the command line over them with the same ``merge``."""
+reading, and the one merge of settings tables. The defaults live only in those files:
+every settings class builds its default from here (``defaults``), and vecfit.jobs.config
+layers efforts, presets, the user's file and the command line over them with the same
+``merge``."""
 from __future__ import annotations
 
 import copy
@@ -75,35 +75,13 @@ def _checked(value, expected, name: str, source: str):
     return value
 
 
-# [optimize]'s render settings are not written in refine.toml, which would repeat the
-# renderer's defaults: they are RenderOptions' but for a fit's FITTING (renderer/options.py).
-# Each joins the table after the key named here, where the file listed it, so that the
-# resolved settings, and the reports that hold them, keep their order.
-RENDER_SETTINGS_AFTER = {"loss": ("mode", "samples", "boundary_samples", "interior_samples"),
-                         "background": ("seed", "threads"), "outline": ("boundary_budget",)}
-
-
-def refine_toml() -> dict:
-    """configs/refine.toml, its [optimize] table completed with the render settings."""
-    from vecfit.renderer.options import fitting_default  # (plain Python, no torch)
-
-    settings = read_toml(configs_dir() / "refine.toml")
-    optimize = {}
-    for key, value in settings["optimize"].items():
-        optimize[key] = value
-        for name in RENDER_SETTINGS_AFTER.get(key, ()):
-            optimize[name] = fitting_default(name)
-    settings["optimize"] = optimize
-    return settings
-
-
 @functools.lru_cache(maxsize=None)
 def packaged(command: str) -> tuple[dict, dict, dict, dict]:
     """``command``'s packaged settings as (settings, schema, efforts, presets): refine.toml
     (what every command starts from) merged with the command's own file, whose own tables
     join the schema (every key a user may set, with its type); its ``[efforts.NAME]`` and
     ``[presets.NAME]`` tables apart. Cached: copy before changing."""
-    settings = refine_toml()
+    settings = read_toml(configs_dir() / "refine.toml")
     efforts = settings.pop("efforts", {})
     presets: dict = {}
     schema = copy.deepcopy(settings)

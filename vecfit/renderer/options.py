@@ -9,7 +9,7 @@ at start-up.)"""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 from vecfit.errors import VecfitError
 from vecfit.names import FILTERS, MODES
@@ -60,22 +60,14 @@ class RenderOptions:
             boundary_budget=float(self.boundary_budget))
 
 
-# Where a fit (the [optimize] table, the loop's Settings) renders otherwise than
+# Where a fit (configs/refine.toml's [optimize], the loop's Settings) renders otherwise than
 # vecfit.render, on purpose: its Monte Carlo backward revisits one of each pixel's N x N
 # samples for the colours' term (an iteration's noise averages out over the next ones, at
 # a fraction of the cost), and bounds the boundary samples at 2 per pixel of the image, put
 # where the error is (dense traces had iterations dominated by their boundaries). A single
-# render's gradients keep every sample and no bound.
+# render's gradients keep every sample and no bound. tests/unit/renderer/test_options.py
+# holds refine.toml to RenderOptions' defaults but for these.
 FITTING = {"interior_samples": 1, "boundary_budget": 2.0}
-
-
-def fitting_default(name: str):
-    """The default of render setting ``name`` in a fit's [optimize] table: RenderOptions'
-    but for FITTING (configs/refine.toml leaves these settings out, vecfit.io.configs
-    fills them in from here)."""
-    if name in FITTING:
-        return FITTING[name]
-    return next(f.default for f in fields(RenderOptions) if f.name == name)
 
 
 def check_options(samples, mode: str, filter: str, filter_radius: float) -> None:

@@ -423,9 +423,8 @@ def test_settings_defaults_are_the_config_defaults():
     from vecfit.editing.settings import EditSettings, RetargetSettings
     from vecfit.initial.strokes import PaintSettings
     from vecfit.initial.tracer import TraceSettings
-    from vecfit.io.configs import refine_toml
-    from vecfit.jobs.config import resolve, settings_of
-    assert Settings.defaults() == Settings.from_config(refine_toml()["optimize"])
+    from vecfit.jobs.config import configs_dir, read_toml, resolve, settings_of
+    assert Settings.defaults() == Settings.from_config(read_toml(configs_dir() / "refine.toml")["optimize"])
     for command, cls in (("trace", TraceSettings), ("paint", PaintSettings), ("edit", EditSettings),
                          ("retarget", RetargetSettings)):
         assert all(f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING

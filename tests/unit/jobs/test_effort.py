@@ -14,7 +14,7 @@ import vecfit
 from helpers import run, two_shapes_png
 from vecfit.batch import DONE, EXIT_OK, EXIT_USAGE, run_batch
 from vecfit.errors import VecfitError
-from vecfit.io.configs import configs_dir, read_toml, refine_toml
+from vecfit.io.configs import configs_dir, read_toml
 from vecfit.jobs.config import EFFORTS, merge, resolve
 
 COMMANDS = ("refine", "trace", "paint", "edit", "retarget")
@@ -23,7 +23,7 @@ COMMANDS = ("refine", "trace", "paint", "edit", "retarget")
 def _files_without_efforts(command: str) -> dict:
     """refine.toml and the command's file merged by hand, their presets and efforts left out:
     the defaults as they were before efforts existed."""
-    base = refine_toml()
+    base = read_toml(configs_dir() / "refine.toml")
     base.pop("efforts", None)
     if command != "refine":
         own = read_toml(configs_dir() / f"{command}.toml")

@@ -1,7 +1,7 @@
 """The render defaults have one source in Python, RenderOptions (vecfit/renderer/options.py):
 vecfit.render, render_numpy, render_batch and the render command take theirs from it, the
 core's struct starts from the same, and a fit's [optimize] table renders with them but for
-the differences options.FITTING names (configs/refine.toml does not repeat them)."""
+the differences options.FITTING names."""
 from __future__ import annotations
 
 import dataclasses
@@ -14,7 +14,7 @@ import torch
 import vecfit
 from vecfit import _core
 from vecfit.cli.commands import main
-from vecfit.io.configs import configs_dir, defaults, read_toml
+from vecfit.io.configs import defaults
 from vecfit.renderer.forward import render_numpy
 from vecfit.renderer.many import render_batch
 from vecfit.renderer.options import FITTING, RenderOptions
@@ -56,22 +56,6 @@ def test_a_fit_renders_with_them_but_for_the_named_differences():
     for name in render_keys:
         assert optimize[name] == FITTING.get(name, DEFAULTS[name]), name
     assert all(FITTING[name] != DEFAULTS[name] for name in FITTING)  # (each a real difference)
-
-
-def test_refine_toml_repeats_none_of_them_and_a_fit_still_starts_alike():
-    """configs/refine.toml leaves the render settings out (vecfit.io.configs fills them in
-    from RenderOptions and FITTING): the [optimize] table a fit starts from is what the file
-    once wrote, values, types and order."""
-    written = read_toml(configs_dir() / "refine.toml")["optimize"]
-    assert set(written) & set(DEFAULTS) == {"background"}  # (a fit's own: "auto", the target's corners)
-    optimize = defaults("refine", "optimize")
-    render = {k: v for k, v in optimize.items() if k in DEFAULTS and k != "background"}
-    expected = {"mode": "mc", "samples": 2, "boundary_samples": 2.0, "interior_samples": 1, "seed": 0,
-                "threads": 0, "boundary_budget": 2.0}
-    assert render == expected and [type(v) for v in render.values()] == [type(v) for v in expected.values()]
-    assert list(optimize)[:10] == ["iterations", "loss", "mode", "samples", "boundary_samples", "interior_samples",
-                                   "max_size", "background", "seed", "threads"]
-    assert list(optimize)[list(optimize).index("outline") + 1] == "boundary_budget"
 
 
 def test_boundary_samples_reach_the_backward_pass():
