@@ -13,7 +13,8 @@ from pathlib import Path
 import click
 
 from vecfit.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE
-from vecfit.names import EFFORTS, FILTERS, FORMATS, GROUP_BY, JOBS, LOSSES, MODES, PAINT_KINDS, STACKINGS, STYLES
+from vecfit.names import (EFFORTS, FILTERS, FORMATS, GROUP_BY, JOBS, LOSSES, MAX_DECIMALS, MODES, PAINT_KINDS,
+                          STACKINGS, STYLES)
 from vecfit.renderer.options import RenderOptions
 
 DEVICE_OPTION = dict(metavar="auto|cpu|cuda[:N]",
@@ -262,7 +263,7 @@ def optimize_options(f):
         click.option("--seed", type=int, help="Random seed."),
         click.option("--threads", type=click.IntRange(min=0), help="Threads (0: all cores)."),
         click.option("--device", **DEVICE_OPTION),
-        click.option("--precision", type=click.IntRange(0, 6),
+        click.option("--precision", type=click.IntRange(0, MAX_DECIMALS),
                      help="Decimals of the coordinates written (default: what the canvas needs, "
                           "a hundredth of a pixel up to 1,024 px)."),
         click.option("-q", "--quiet", is_flag=True, help="No progress bar."),

@@ -1,7 +1,8 @@
 """Small helpers the test modules share: the CLI runner, quiet SVG loading, skipping when
-shared data is missing, and skimage photos as small PNG targets."""
+shared data is missing, skimage photos as small PNG targets, and the core's test switches."""
 from __future__ import annotations
 
+import contextlib
 import warnings
 from pathlib import Path
 
@@ -9,6 +10,7 @@ import pytest
 from click.testing import CliRunner
 
 import vecfit
+from vecfit import _core
 from vecfit.cli.commands import main
 
 
@@ -22,6 +24,28 @@ def quiet_load(path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return vecfit.load_svg(path)
+
+
+@contextlib.contextmanager
+def brute_force():
+    """Renders in this block test every draw at every sample (the core's test switch): the
+    plain loop that the tiles are checked against."""
+    old = _core.brute_force(True)
+    try:
+        yield
+    finally:
+        _core.brute_force(old)
+
+
+@contextlib.contextmanager
+def gpu_lists():
+    """Backward passes in this block run the CPU lanes with a GPU thread's list sizes first
+    (the core's test switch), as a GPU run would, falling back where they overflow."""
+    old = _core.emulate_gpu_lists(True)
+    try:
+        yield
+    finally:
+        _core.emulate_gpu_lists(old)
 
 
 def need(path: Path) -> Path:

@@ -36,3 +36,7 @@ GROUP_BY = ("none", "colour", "color")
 # How the written shapes lie ([output] stacking): over one another, or as cut-outs that
 # do not overlap (vecfit/initial/tracer/cutouts.py).
 STACKINGS = ("stacked", "cutouts")
+
+# The decimals of written coordinates a user may ask for ([output] precision, --precision):
+# 0 to this many (float32 coordinates hold no more; vecfit/svg/precision.py).
+MAX_DECIMALS = 6

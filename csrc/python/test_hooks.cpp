@@ -1,6 +1,7 @@
 // Test hooks: the core's geometry called directly from the tests (tests/unit/scene/test_geometry.py),
-// which check it against brute force and a Python reference renderer. Registered on
-// vecfit._core by the module (bindings.cpp); nothing in vecfit/ calls them.
+// which check it against brute force and a Python reference renderer; and the switches of
+// test_hooks.h (tests/helpers.py turns them on for a block). Registered on vecfit._core by
+// the module (module.cpp); nothing in vecfit/ calls them.
 #include "python/test_hooks.h"
 
 #include <pybind11/numpy.h>
@@ -14,6 +15,7 @@
 #include "common/bezier.h"
 #include "common/ellipse.h"
 #include "common/roots.h"
+#include "python/arrays.h"
 #include "scene/coverage.h"
 #include "scene/field.h"
 #include "scene/scene.h"
@@ -21,10 +23,14 @@
 namespace py = pybind11;
 using namespace vf;
 
-namespace {
+using vf::python::Array;
 
-template <typename T>
-using Array = py::array_t<T, py::array::c_style | py::array::forcecast>;
+TestSwitches& test_switches() {
+    static TestSwitches switches;
+    return switches;
+}
+
+namespace {
 
 Segment segment_from(const Array<double>& pts) {
     if (pts.ndim() != 2 || pts.shape(1) != 2 || pts.shape(0) < 2 || pts.shape(0) > 4)
@@ -38,6 +44,22 @@ Segment segment_from(const Array<double>& pts) {
 }  // namespace
 
 void register_test_hooks(py::module_& m) {
+    m.def("brute_force", [](bool on) {
+        // Every draw tested at every sample by the renders whose options are made while on (a
+        // check of the tiles against the plain loop); returns the previous setting.
+        bool old = test_switches().brute_force;
+        test_switches().brute_force = on;
+        return old;
+    }, py::arg("on"));
+
+    m.def("emulate_gpu_lists", [](bool on) {
+        // While on, the CPU backward pass runs first with a GPU thread's list sizes, so that
+        // a CPU run shows what a GPU run would (its fallbacks); returns the previous setting.
+        bool old = test_switches().emulate_gpu_lists;
+        test_switches().emulate_gpu_lists = on;
+        return old;
+    }, py::arg("on"));
+
     m.def("field_min_items", [](int n) {
         // The fewest segments a tile's fill entry lists for the analytical passes to compute
         // it a tile at a time (scene/field.h); returns the previous value. 0: every entry.

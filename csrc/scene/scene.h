@@ -25,7 +25,7 @@ enum Join : int32_t { JOIN_MITER = 0, JOIN_ROUND = 1, JOIN_BEVEL = 2 };
 enum PaintKind : int32_t { PAINT_SOLID = 0, PAINT_LINEAR = 1, PAINT_RADIAL = 2 };
 
 // Column layouts of the input tables (row-major, one row per item). These, the enums above
-// and the tables' keys are what _core.layout() exports to Python (python/bindings.cpp).
+// and the tables' keys are what _core.layout() exports to Python (python/bind_render.cpp).
 constexpr int POINT_COLS = 2;     // x, y
 constexpr int SEGMENT_COLS = 5;   // degree, point index of each control point (-1 unused)
 constexpr int SUBPATH_COLS = 3;   // first segment, segment count, closed (0/1)

@@ -67,7 +67,7 @@ struct Curve {
 
 class Fitter {
 public:
-    explicit Fitter(const FitInput& in) : in_(in), tol2_(in.tolerance * in.tolerance) {}
+    explicit Fitter(const FitInput& in) : in_(in), tol2_(in.options.tolerance * in.options.tolerance) {}
 
     FitResult run() {
         std::vector<Piece> level;
@@ -212,12 +212,13 @@ private:
             for (int64_t i = pc.a; i <= pc.b; ++i) s.u[i - pc.a] = (in_.arc[i] - in_.arc[pc.a]) / scale;
             s.curve = least_squares(pc, s.u, length[k]);
             s.worst = errors(pc, s.curve, s.u, s.err, s.at);
-            if (s.worst > tol2_ && s.worst < in_.newton_range * in_.newton_range * tol2_) retry.push_back(k);
+            const double range = in_.options.newton_range;
+            if (s.worst > tol2_ && s.worst < range * range * tol2_) retry.push_back(k);
         }
         // reparameterise the pieces close to the tolerance, keeping improvements; all
         // of them step until every one is within tolerance
         State trial;
-        for (int step = 0; step < in_.newton_steps && !retry.empty(); ++step) {
+        for (int step = 0; step < in_.options.newton_steps && !retry.empty(); ++step) {
             bool all_within = true;
             for (size_t k : retry) {
                 const Piece& pc = pieces[k];
@@ -237,7 +238,7 @@ private:
             const int64_t n = pc.b - pc.a + 1;
             // a piece that turns too far is split halfway through its turn without being judged
             const double turn = in_.heading[pc.b] - in_.heading[pc.a];
-            const bool looping = std::fabs(turn) > in_.max_turn && n > 3;
+            const bool looping = std::fabs(turn) > in_.options.max_turn && n > 3;
             if ((s.worst <= tol2_ || n <= 3) && !looping) {
                 done_.push_back({s.curve, pc.a, pc.owner});
                 continue;

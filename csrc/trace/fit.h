@@ -8,6 +8,14 @@
 
 namespace vf {
 
+// The fit's settings (Python binds this struct as _core.FitOptions; bezier.py sets them).
+struct FitOptions {
+    double tolerance = 1;
+    double max_turn = 0;               // radians: a piece turning further is split, not judged
+    double newton_range = 4;           // reparameterise pieces within this many tolerances
+    int newton_steps = 4;
+};
+
 struct FitInput {
     const double* points = nullptr;    // [M, 2] the (smoothed) stretches laid end to end
     const double* tangents = nullptr;  // [M, 2] unit forward tangent at each point (used at splits)
@@ -18,10 +26,7 @@ struct FitInput {
     const int64_t* lengths = nullptr;  // [K] its points
     const double* t1 = nullptr;        // [K, 2] tangent leaving its first point
     const double* t2 = nullptr;        // [K, 2] tangent arriving at its last, pointing back into it
-    double tolerance = 1;
-    double max_turn = 0;               // radians: a piece turning further is split, not judged
-    double newton_range = 4;           // reparameterise pieces within this many tolerances
-    int newton_steps = 4;
+    FitOptions options;
 };
 
 struct FitResult {

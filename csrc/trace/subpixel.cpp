@@ -81,7 +81,7 @@ std::vector<double> refine_outlines(const SubpixelInput& in) {
             const double* cin = in.colors + 3 * r;
             const double* cout = in.colors + 3 * lo;
             const double e0 = cin[0] - cout[0], e1 = cin[1] - cout[1], e2 = cin[2] - cout[2];
-            if (std::sqrt(e0 * e0 + e1 * e1 + e2 * e2) >= in.min_contrast) {
+            if (std::sqrt(e0 * e0 + e1 * e1 + e2 * e2) >= in.options.min_contrast) {
                 const double f_out = coverage(in.rgb + 3 * (oy * w + ox), cin, cout);
                 const double f_in = coverage(in.rgb + 3 * (iy * w + ix), cin, cout);
                 offset[i] = f_out - (1 - f_in);
@@ -106,15 +106,15 @@ std::vector<double> refine_outlines(const SubpixelInput& in) {
         vals[j] = valid[i] ? offset[i] : nan;
     }
     std::vector<double> robust(mids.size());
-    std::vector<double> window(2 * in.reach + 1);
+    std::vector<double> window(2 * in.options.reach + 1);
     for (int64_t k = 0; k < in.outlines; ++k) {
         const int64_t f = mid_first[k], len = mid_first[k + 1] - f;
         for (int64_t j = f; j < f + len; ++j) {
             int count = 0;
-            for (int d = -in.reach; d <= in.reach; ++d) {
+            for (int d = -in.options.reach; d <= in.options.reach; ++d) {
                 const int64_t o = f + (((j - f + d) % len) + len) % len;
                 const double v = code[o] == code[j] ? vals[o] : nan;
-                window[d + in.reach] = v;
+                window[d + in.options.reach] = v;
                 count += !std::isnan(v);
             }
             std::sort(window.begin(), window.end(), nan_last_less);
@@ -127,7 +127,7 @@ std::vector<double> refine_outlines(const SubpixelInput& in) {
     // along a straight run, the sum where the outline turns
     std::vector<double> shift(2 * n);
     for (int64_t i = 0; i < n; ++i) {
-        const double o = std::min(std::max(offset[i], -in.max_shift), in.max_shift);
+        const double o = std::min(std::max(offset[i], -in.options.max_shift), in.options.max_shift);
         shift[2 * i] = o * normal[2 * i];
         shift[2 * i + 1] = o * normal[2 * i + 1];
     }

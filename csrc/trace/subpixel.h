@@ -7,6 +7,13 @@
 
 namespace vf {
 
+// The placement's settings (Python binds this struct as _core.SubpixelOptions; subpixel.py
+// sets them).
+struct SubpixelOptions {
+    double min_contrast = 0.1, max_shift = 0.5;
+    int reach = 2;
+};
+
 struct SubpixelInput {
     int64_t points = 0;
     const double* xy = nullptr;        // [points, 2] the outlines laid end to end
@@ -21,8 +28,7 @@ struct SubpixelInput {
     const double* colors = nullptr;    // [regions, 3] fill colours
     const float* rgb = nullptr;        // [height, width, 3] the target
     const float* alpha = nullptr;      // [height, width]
-    double min_contrast = 0.1, max_shift = 0.5;
-    int reach = 2;
+    SubpixelOptions options;
 };
 
 // The points moved ([points, 2]).

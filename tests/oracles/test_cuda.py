@@ -13,7 +13,7 @@ import pytest
 import torch
 
 import vecfit
-from helpers import quiet_load, run
+from helpers import gpu_lists, quiet_load, run
 from shared_data import ROOT, SCENES
 from vecfit.errors import VecfitError
 
@@ -169,7 +169,8 @@ def test_gpu_list_sizes_on_the_cpu(mode, make, depth, falls_back):
     from vecfit.renderer.raster import backward_fallbacks
     scene = make(depth)
     before = backward_fallbacks()
-    emulated = gradients(scene, samples=2, mode=mode, threads=2, _gpu_lists=True)
+    with gpu_lists():
+        emulated = gradients(scene, samples=2, mode=mode, threads=2)
     assert backward_fallbacks() - before == int(falls_back)
     exact = gradients(scene, samples=2, mode=mode, threads=2)
     assert backward_fallbacks() - before == int(falls_back)  # (only fixed lists count)
@@ -187,7 +188,8 @@ def test_benchmark_scenes_fit_a_gpu_thread():
     for name in names:
         scene = quiet_load(SCENES / f"{name}.svg")
         for mode, samples in (("mc", 2), ("analytic", 1)):
-            gradients(scene, samples=samples, mode=mode, _gpu_lists=True)
+            with gpu_lists():
+                gradients(scene, samples=samples, mode=mode)
     assert backward_fallbacks() == before
 
 

@@ -14,12 +14,13 @@ import functools
 import gc
 import math
 import time
+import warnings
 from dataclasses import dataclass
 from typing import Callable, Optional
 
 import torch
 
-from vecfit.errors import NonFiniteScene, VecfitError
+from vecfit.errors import NonFiniteScene, VecfitError, VecfitWarning
 from vecfit.io.compositing import composite_torch
 from vecfit.io.images import downscaled, downscaled_weight
 from vecfit.renderer.persistent import PersistentPack
@@ -190,6 +191,7 @@ class _Fit:
             self.outline = OutlineCost(scene, kinds[self.points], width, height, settings.outline) or None
         self.image = None  # the last render, detached (for hooks)
         self.packs: dict = {}  # (width, height) -> PersistentPack, or None where it does not apply
+        self.declined = False  # whether the run has said that it packs on every iteration
         self.leaves: list = []  # this iteration's kinds' flat tensors as autograd leaves
         self.where = {id(t): (i, k.offsets[id(t)], t.numel()) for i, k in enumerate(kinds) for t in k.tensors}
         self.skipped = 0  # steps refused for a non-finite loss, gradient or parameter
@@ -205,8 +207,20 @@ class _Fit:
         pack = self.packs.get((w, h), False)
         if pack is False or (pack is not None and not pack.still_valid([k.flat for k in self.kinds])):
             with phase("pack"):
-                pack = self.packs[(w, h)] = PersistentPack.build(self.scene, w, h, self.kinds)
+                pack = PersistentPack.attempt(self.scene, w, h, self.kinds)
+            if isinstance(pack, str):
+                self.say_declined(pack)
+                pack = None
+            self.packs[(w, h)] = pack
         return pack.arrays(self.leaves) if pack is not None else None
+
+    def say_declined(self, reason: str) -> None:
+        """A warning, once a run (each image size asks for its own pack): every iteration
+        packs the scene anew, the same fit at some cost in time."""
+        if not self.declined:
+            self.declined = True
+            warnings.warn(f"the scene is packed on every iteration, which is slower: {reason}", VecfitWarning,
+                          stacklevel=2)
 
     def evaluate(self, iteration: int, grad: bool):
         settings = self.settings

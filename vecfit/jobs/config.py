@@ -17,7 +17,7 @@ import dataclasses
 from vecfit.errors import VecfitError
 from vecfit.fitting.settings import Settings  # torch-free: trace --no-refine checks it too
 from vecfit.io.configs import configs_dir, merge, packaged, read_toml  # noqa: F401 (configs_dir: for callers)
-from vecfit.names import EFFORTS, GROUP_BY, STACKINGS
+from vecfit.names import EFFORTS, GROUP_BY, MAX_DECIMALS, STACKINGS
 
 DEFAULT_EFFORT = "normal"
 
@@ -80,8 +80,7 @@ def validate(settings: dict) -> None:
     seed = settings["optimize"]["seed"]
     if "trace" in settings:
         from vecfit.initial.tracer import TraceSettings
-        from vecfit.initial.tracer.settings import check_settings
-        check_settings(settings_of(TraceSettings, settings["trace"], seed=seed))
+        settings_of(TraceSettings, settings["trace"], seed=seed)  # (checked as it is made)
     if "paint" in settings:
         from vecfit.initial.strokes import PaintSettings
         settings_of(PaintSettings, settings["paint"], seed=seed).check()
@@ -105,8 +104,6 @@ def loop_settings(config: dict) -> Settings:
 def output_precision(settings: dict) -> int | None:
     """[output] precision: the decimals of written coordinates, None for what the canvas
     needs (-1)."""
-    from vecfit.svg.precision import MAX_DECIMALS
-
     value = settings["output"]["precision"]
     if value == -1:
         return None

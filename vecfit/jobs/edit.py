@@ -24,7 +24,7 @@ from vecfit.scene.crossings import crossed_subpaths
 from vecfit.svg.write import svg_bytes
 
 from .config import loop_settings, output_precision, settings_of
-from .fit import background_for, cut_crossed_outlines, load_scene_to_fit, load_target
+from .fit import background_for, check_has_size, cut_crossed_outlines, load_scene_to_fit, load_target
 from .protocol import Inputs, Outputs, listener
 from .report import job_report
 from .scoring import refuse_non_finite, render_for_scoring
@@ -40,8 +40,7 @@ def fit_canvas(scene: Scene, image: np.ndarray, svg_path, image_path) -> None:
     nearest), and fitting the image stretched to the canvas would move every shape by up
     to half a pixel. The written SVG keeps its own size."""
     h, w = image.shape[:2]
-    if scene.width <= 0 or scene.height <= 0:
-        raise VecfitError(f"{svg_path}: the SVG has no size")
+    check_has_size(scene, svg_path)
     expected_h = scene.height * w / scene.width
     expected_w = scene.width * h / scene.height
     if abs(h - expected_h) > 1 and abs(w - expected_w) > 1:

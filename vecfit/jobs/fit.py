@@ -83,10 +83,16 @@ def load_scene_to_fit(svg) -> tuple[Scene, SvgDocument]:
     return scene, document
 
 
+def check_has_size(scene: Scene, svg_path) -> None:
+    """Refuses an SVG whose canvas has no positive width and height (refine, edit and
+    retarget need one to fit to)."""
+    if not (scene.width > 0 and scene.height > 0):
+        raise VecfitError(f"{svg_path}: the SVG has no size")
+
+
 def check_sizes(scene: Scene, target: np.ndarray, svg_path, target_path) -> None:
     h, w = target.shape[:2]
-    if scene.width <= 0 or scene.height <= 0:
-        raise VecfitError(f"{svg_path}: the SVG has no size")
+    check_has_size(scene, svg_path)
     a, b = scene.width / scene.height, w / h
     if abs(a - b) > ASPECT_TOLERANCE * max(a, b):
         raise VecfitError(f"{svg_path} is {scene.width:g}x{scene.height:g} but {target_path} is "

@@ -31,7 +31,7 @@ from vecfit.scene.crossings import crossed_subpaths
 from vecfit.svg.write import svg_bytes
 
 from .config import loop_settings, output_precision, settings_of
-from .fit import MIN_SIDE, background_for, cut_crossed_outlines, load_scene_to_fit
+from .fit import MIN_SIDE, background_for, check_has_size, cut_crossed_outlines, load_scene_to_fit
 from .protocol import Inputs, Outputs, listener
 from .report import job_report
 from .scoring import refuse_non_finite, render_for_scoring
@@ -78,9 +78,8 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
     if width is None and height is None:
         raise VecfitError("no new size: give --width (or --height), or retarget.width in the config")
     scene, document = load_scene_to_fit(inputs.svg)
+    check_has_size(scene, svg_path)
     w0, h0 = scene.width, scene.height
-    if not (w0 > 0 and h0 > 0):
-        raise VecfitError(f"{svg_path}: the SVG has no size")
     new_w = parse_size(width, w0, "--width") if width is not None else w0
     new_h = parse_size(height, h0, "--height") if height is not None else h0
     if new_w > w0 + 0.5 or new_h > h0 + 0.5:

@@ -20,8 +20,7 @@ class RenderOptions:
     """width x height pixels; samples: N for N x N per pixel; mode: "mc" or "analytic";
     filter and filter_radius: the pixel filter (box always covers exactly the pixel);
     seed; threads (0: all cores); background: None or straight RGBA; interior_samples:
-    of the N x N, those the Monte Carlo backward pass revisits (0: all); brute_force:
-    every draw tested at every sample (a check of the tiles, for tests); premultiplied:
+    of the N x N, those the Monte Carlo backward pass revisits (0: all); premultiplied:
     the image as premultiplied RGBA (the layers of renderer/layers.py); boundary_budget:
     the Monte Carlo backward's boundary samples per pixel of the image at most (0: no
     bound), allotted by the pixel adjoints; boundary_samples: the Monte Carlo backward's
@@ -37,7 +36,6 @@ class RenderOptions:
     threads: int = 0
     background: tuple | None = None
     interior_samples: int = 0
-    brute_force: bool = False
     premultiplied: bool = False
     boundary_budget: float = 0.0
     boundary_samples: float = 2.0
@@ -58,8 +56,8 @@ class RenderOptions:
             width=int(self.width), height=int(self.height), samples=int(self.samples), mode=self.mode,
             filter=self.filter, filter_radius=float(self.filter_radius), seed=int(self.seed),
             threads=int(self.threads or 0), background=None if bg is None else [float(v) for v in bg],
-            interior_samples=int(self.interior_samples), brute_force=bool(self.brute_force),
-            premultiplied=bool(self.premultiplied), boundary_budget=float(self.boundary_budget))
+            interior_samples=int(self.interior_samples), premultiplied=bool(self.premultiplied),
+            boundary_budget=float(self.boundary_budget))
 
 
 # Where a fit (configs/refine.toml's [optimize], the loop's Settings) renders otherwise than

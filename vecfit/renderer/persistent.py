@@ -18,14 +18,13 @@ gather and a scatter, so gradients reach the flat tensors by index.
 PersistentPack.build answers None where that does not hold (transforms or opacities
 optimised; a rounded rect's corners, or geometry under a bounding-box gradient, optimised;
 a dashed stroke, whose dashes change in number and place as the points move; clip paths,
-masks and filters, drawn in layers), saying why on this module's logger, and the loop
-packs on every iteration as before. That the floats and their gradients are those of
+masks and filters, drawn in layers), and PersistentPack.attempt the reason instead; the
+loop then packs on every iteration as before, and warns once a run with that reason. That the floats and their gradients are those of
 packing anew is what tests/unit/renderer/test_persistent_pack.py checks, on every kind of
 value a route serves; the build does not check itself.
 """
 from __future__ import annotations
 
-import logging
 from typing import Protocol
 
 import numpy as np
@@ -38,8 +37,6 @@ from .pack import pack_scene
 from .raster import FLOAT_INPUTS
 from .routes import routes_of
 from .stopwatch import phase
-
-log = logging.getLogger(__name__)
 
 # Parameter kinds (Scene.parameters) whose values enter the packed floats non-linearly
 # (matrix products, alpha products): with either optimised, the loop packs the scene on
@@ -73,12 +70,17 @@ class PersistentPack:
     @classmethod
     def build(cls, scene: Scene, width: int, height: int, kinds: list[FlatTensors]) -> "PersistentPack | None":
         """The pack of ``scene`` at width x height whose floats follow the values in
-        ``kinds`` (side by side, in order), or None where they are not affine in them
-        (logged, with the reason)."""
+        ``kinds`` (side by side, in order), or None where they are not affine in them."""
+        pack = cls.attempt(scene, width, height, kinds)
+        return pack if isinstance(pack, PersistentPack) else None
+
+    @classmethod
+    def attempt(cls, scene: Scene, width: int, height: int, kinds: list[FlatTensors]) -> "PersistentPack | str":
+        """The pack as ``build`` makes it, or where it declines, why (a phrase)."""
         kinds = list(kinds)
         reason = _not_affine(scene, kinds)
         if reason is not None:
-            return _declined(reason)
+            return reason
         with torch.no_grad():
             packed = pack_scene(scene, width, height, keep_empty=True)
             arrays = packed.arrays()
@@ -89,7 +91,7 @@ class PersistentPack:
             at.update((i, offset + o) for i, o in k.offsets.items())
             offset += k.flat.numel()
         if any(i in at for i in routes.nonlinear):
-            return _declined("a rounded rect's corners, or geometry under a bounding-box gradient, are optimised")
+            return "a rounded rect's corners, or geometry under a bounding-box gradient, are optimised"
         floats = [arrays[name].to(torch.float32) for name in FLOAT_INPUTS]
         starts = np.concatenate([[0], np.cumsum([f.numel() for f in floats])])
         first_of = dict(zip(FLOAT_INPUTS, starts[:-1]))
@@ -180,11 +182,6 @@ def _not_affine(scene: Scene, kinds: list[FlatTensors]) -> str | None:
     kinds_seen = [kind for kind in NON_AFFINE_KINDS if any(id(t) in optimised for t in parameters[kind])]
     if kinds_seen:
         return f"{' and '.join(kinds_seen)} optimised"
-    return None
-
-
-def _declined(reason: str) -> None:
-    log.info("the scene is packed on every iteration: %s", reason)
     return None
 
 

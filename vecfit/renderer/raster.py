@@ -23,10 +23,9 @@ class _Render(torch.autograd.Function):
     (the autograd graph of vecfit.renderer.pack carries them on to the Scene's tensors)."""
 
     @staticmethod
-    def forward(ctx, options, device, boundary_density, emulate_gpu_lists, structure, *floats):
+    def forward(ctx, options, device, boundary_density, structure, *floats):
         ctx.scene, ctx.image, ctx.prepared = _core_render(options, device, structure, floats, keep=True)
         ctx.options, ctx.device, ctx.boundary_density = options, device, boundary_density
-        ctx.emulate_gpu_lists = emulate_gpu_lists
         ctx.shapes = [t.shape for t in floats]
         return torch.from_numpy(ctx.image)
 
@@ -35,14 +34,13 @@ class _Render(torch.autograd.Function):
         try:
             with phase("call backward"):
                 grads = _core.render_grad(ctx.scene, ctx.image, grad_image.detach().cpu().contiguous().numpy(),
-                                          ctx.options, ctx.boundary_density, ctx.device, ctx.emulate_gpu_lists,
-                                          ctx.prepared)
+                                          ctx.options, ctx.boundary_density, ctx.device, ctx.prepared)
             ctx.prepared = None  # (its memory, before the next forward pass)
             add_core_phases()
         except RuntimeError as e:  # the GPU failed (out of memory, driver)
             raise VecfitError(f"gradients on {devices.device_name(ctx.device)} failed: {e}") from None
         out = [torch.from_numpy(grads[name]).reshape(shape) for name, shape in zip(FLOAT_INPUTS, ctx.shapes)]
-        return (None, None, None, None, None, *out)
+        return (None, None, None, None, *out)
 
 
 _D = RenderOptions  # (its defaults)
@@ -53,8 +51,7 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
            filter_radius: float = _D.filter_radius, seed: int = _D.seed, background=_D.background,
            threads: int | None = _D.threads, boundary_samples: float = _D.boundary_samples,
            interior_samples: int = _D.interior_samples, boundary_budget: float = _D.boundary_budget,
-           device: str = "cpu", packed: tuple | None = None, _brute_force: bool = False, _gpu_lists: bool = False,
-           _premultiplied: bool = False) -> torch.Tensor:
+           device: str = "cpu", packed: tuple | None = None, _premultiplied: bool = False) -> torch.Tensor:
     """Render ``scene`` into an [H, W, 4] float tensor of straight RGBA.
 
     samples: N means N x N stratified samples per pixel (jittered in "mc" mode, at the
@@ -81,9 +78,7 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
     FLOAT_INPUTS order), as PersistentPack.arrays gives it; the image and its gradients
     then follow those arrays, and the scene gives only its size.
 
-    (_brute_force and _gpu_lists are for tests: every draw tested at every sample, and the
-    CPU backward pass run first with a GPU thread's list sizes, see backward_fallbacks.
-    _premultiplied: the image as premultiplied RGBA, for the layers of layers.py.)
+    (_premultiplied: the image as premultiplied RGBA, for the layers of layers.py.)
     """
     width, height = output_size(scene, width, height)
     if packed is None and scene.has_effects():  # clip paths, masks, filters: in layers
@@ -93,12 +88,12 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
             layer_seed = (int(seed) + 1_000_003 * number) % (1 << 62)
             return render(sub, samples=samples, mode=mode, filter=filter, filter_radius=filter_radius, seed=layer_seed,
                           threads=threads, boundary_samples=boundary_samples, interior_samples=interior_samples,
-                          boundary_budget=boundary_budget, device=device, _brute_force=_brute_force, _gpu_lists=_gpu_lists, _premultiplied=True)
+                          boundary_budget=boundary_budget, device=device, _premultiplied=True)
         return render_layered(scene, width, height, draw, background_rgba(background))
     options = RenderOptions(width, height, samples=int(samples), mode=mode, filter=filter,
                             filter_radius=float(filter_radius), seed=int(seed), threads=int(threads or 0),
                             background=background_rgba(background), interior_samples=int(interior_samples),
-                            brute_force=bool(_brute_force), premultiplied=bool(_premultiplied),
+                            premultiplied=bool(_premultiplied),
                             boundary_budget=float(boundary_budget), boundary_samples=float(boundary_samples))
     if packed is None:
         structure, floats = packed_for_core(scene, width, height)
@@ -106,8 +101,8 @@ def render(scene: Scene, width: int | None = None, height: int | None = None, *,
         structure, floats = packed
         check_finite(floats)
     core, where = options.core(), devices.resolve(device)
-    if torch.is_grad_enabled() and any(t.requires_grad for t in floats) and not _brute_force:
-        return _Render.apply(core, where, options.boundary_samples, bool(_gpu_lists), structure, *floats)
+    if torch.is_grad_enabled() and any(t.requires_grad for t in floats):
+        return _Render.apply(core, where, options.boundary_samples, structure, *floats)
     return torch.from_numpy(_core_render(core, where, structure, floats)[1])
 
 

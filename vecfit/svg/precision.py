@@ -13,13 +13,13 @@ import math
 
 import numpy as np
 
+from vecfit.names import MAX_DECIMALS
 from vecfit.scene import Scene
 from vecfit.scene.arrays import to_numpy
 from vecfit.scene.placement import pixel_scales
 
 STEP_PIXELS = 0.01     # the written step, in pixels ...
 STEP_CANVAS = 1024     # ... of a canvas up to this long side; beyond, in proportion
-MAX_DECIMALS = 6       # float32 coordinates hold no more
 
 
 def decimals_for(pixels_per_unit: float, long_side: float) -> int:

@@ -369,8 +369,8 @@ def test_the_fit_of_smooth_and_sharp_curves_is_the_numpy_fits():
 def test_bad_input_is_refused():
     p = np.zeros((3, 2))
     args = dict(points=p, tangents=p, heading=np.zeros(3), arc=np.zeros(3), t1=np.zeros((1, 2)),
-                t2=np.zeros((1, 2)), tolerance=1.0, max_turn=float(MAX_TURN), newton_range=NEWTON_RANGE,
-                newton_steps=NEWTON_STEPS)
+                t2=np.zeros((1, 2)), options=_core.FitOptions(tolerance=1.0, max_turn=float(MAX_TURN),
+                                                               newton_range=NEWTON_RANGE, newton_steps=NEWTON_STEPS))
     with pytest.raises(ValueError, match="outside the points"):
         _core.fit_stretches(first=np.array([1]), lengths=np.array([3]), **args)
     with pytest.raises(ValueError, match="expected"):

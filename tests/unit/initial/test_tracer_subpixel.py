@@ -172,7 +172,8 @@ def test_bad_input_is_refused():
     labels = np.zeros((2, 2), np.int32)
     good = dict(points=np.zeros((4, 2)), lengths=np.array([4]), region=np.array([0]), hole=np.array([False]),
                 labels=labels, rank=np.array([0]), colors=np.zeros((1, 3)), rgb=np.zeros((2, 2, 3), np.float32),
-                alpha=np.ones((2, 2), np.float32), min_contrast=MIN_CONTRAST, max_shift=MAX_SHIFT, reach=REACH)
+                alpha=np.ones((2, 2), np.float32),
+                options=_core.SubpixelOptions(min_contrast=MIN_CONTRAST, max_shift=MAX_SHIFT, reach=REACH))
     assert _core.refine_outlines(**good).shape == (4, 2)
     with pytest.raises(ValueError, match="expected"):
         _core.refine_outlines(**{**good, "lengths": np.array([3])})

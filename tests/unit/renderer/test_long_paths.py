@@ -15,7 +15,7 @@ import torch
 
 import vecfit
 from vecfit import _core
-from helpers import quiet_load
+from helpers import brute_force, quiet_load
 
 NS = 'xmlns="http://www.w3.org/2000/svg"'
 
@@ -65,7 +65,8 @@ def test_tiles_match_brute_force(tmp_path, name, mode):
     scene = quiet_load(svg)
     for size in (40, 64):
         fast = vecfit.render(scene, size, size, samples=2, mode=mode, threads=2)
-        brute = vecfit.render(scene, size, size, samples=2, mode=mode, _brute_force=True)
+        with brute_force():
+            brute = vecfit.render(scene, size, size, samples=2, mode=mode)
         assert fast[..., 3].sum() > 0
         assert torch.allclose(fast, brute, atol=1e-6, rtol=0), float((fast - brute).abs().max())
 

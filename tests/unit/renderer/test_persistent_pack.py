@@ -6,12 +6,12 @@ adjoint, where a missed or wrong route shows) is asserted here, on every kind of
 route serves and on the shared scenes."""
 from __future__ import annotations
 
-import logging
 import warnings
 
 import pytest
 import torch
 
+from vecfit.errors import VecfitWarning
 from vecfit.fitting import loop
 from vecfit.fitting.loop import Settings, Target, optimize
 from vecfit.fitting.rates import parameter_kinds
@@ -166,25 +166,22 @@ def _shared_scenes():
 
 
 @pytest.mark.parametrize("name", _shared_scenes())
-def test_shared_scenes_agree_or_say_why_not(name, caplog):
+def test_shared_scenes_agree_or_say_why_not(name):
     """Each shared scene with the default rates: the pack agrees, or there is none and the
-    log says why (clip paths, masks, filters or dashes: what the scene has)."""
+    reason says why (clip paths, masks, filters or dashes: what the scene has)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # (what the reader leaves out is not the point here)
         scene = load_svg(SHARED / "data" / "scenes" / name)
     w, h = output_size_at_most(scene, 96)
     kinds = parameter_kinds(scene, loop.Settings.defaults().lr, w, h)
-    with caplog.at_level(logging.INFO, logger="vecfit.renderer.persistent"):
-        pack = PersistentPack.build(scene, w, h, kinds)
-    if pack is None:
-        (record,) = caplog.records
-        reason = record.getMessage()
+    pack = PersistentPack.attempt(scene, w, h, kinds)
+    if isinstance(pack, str):
+        reason = pack
         if scene.has_effects():
             assert "clip paths, masks or filters" in reason
         else:
             assert "dashed strokes" in reason and any(s.dash_array is not None for s in scene.shapes)
         return
-    assert not caplog.records
     assert _assert_agrees(scene, kinds, w, h) > 0
 
 
@@ -193,18 +190,36 @@ def output_size_at_most(scene, side: int) -> tuple[int, int]:
     return max(1, round(float(scene.width) * s)), max(1, round(float(scene.height) * s))
 
 
-def test_declines_say_why(tmp_path, caplog):
+def _clipped(tmp_path):
+    return _scene(tmp_path, MIXED.replace(
+        "<defs>", '<defs><clipPath id="c"><rect width="60" height="60"/></clipPath>').replace(
+        '<circle cx="90"', '<circle clip-path="url(#c)" cx="90"'))
+
+
+def test_declines_say_why(tmp_path):
     scene = _scene(tmp_path)
-    with caplog.at_level(logging.INFO, logger="vecfit.renderer.persistent"):
-        assert PersistentPack.build(scene, 64, 48, parameter_kinds(scene, {"transforms": 0.01}, 64, 48)) is None
-        assert PersistentPack.build(scene, 64, 48, parameter_kinds(scene, {"points": 1.0}, 64, 48)) is not None
-        clipped = _scene(tmp_path, MIXED.replace(
-            "<defs>", '<defs><clipPath id="c"><rect width="60" height="60"/></clipPath>').replace(
-            '<circle cx="90"', '<circle clip-path="url(#c)" cx="90"'))
-        assert PersistentPack.build(clipped, 64, 48, parameter_kinds(clipped, {"points": 1.0}, 64, 48)) is None
-    assert [r.getMessage() for r in caplog.records] == [
-        "the scene is packed on every iteration: transforms optimised",
-        "the scene is packed on every iteration: clip paths, masks or filters (drawn in layers, several packs a render)"]
+    assert PersistentPack.build(scene, 64, 48, parameter_kinds(scene, {"transforms": 0.01}, 64, 48)) is None
+    assert PersistentPack.attempt(scene, 64, 48, parameter_kinds(scene, {"transforms": 0.01}, 64, 48)) == \
+        "transforms optimised"
+    assert isinstance(PersistentPack.attempt(scene, 64, 48, parameter_kinds(scene, {"points": 1.0}, 64, 48)),
+                      PersistentPack)
+    clipped = _clipped(tmp_path)
+    assert PersistentPack.attempt(clipped, 64, 48, parameter_kinds(clipped, {"points": 1.0}, 64, 48)) == \
+        "clip paths, masks or filters (drawn in layers, several packs a render)"
+
+
+def test_a_declined_pack_is_a_warning_once_a_run(tmp_path):
+    """The loop asks for a pack at each image size (coarse, then fine); where the pack is
+    declined the run says so once, as a VecfitWarning with the reason."""
+    target = Target(torch.rand(96, 128, 4, generator=torch.Generator().manual_seed(1)), background=(1, 1, 1))
+    target.image[..., 3] = 1
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        optimize(_clipped(tmp_path), target, Settings.defaults(iterations=4, threads=2, coarse=0.5, max_size=0))
+    declined = [w for w in said if "packed on every iteration" in str(w.message)]
+    assert [(w.category, str(w.message)) for w in declined] == [
+        (VecfitWarning, "the scene is packed on every iteration, which is slower: clip paths, masks or filters "
+                        "(drawn in layers, several packs a render)")]
 
 
 def test_square_rect(tmp_path):

@@ -16,6 +16,7 @@ import pytest
 import torch
 
 import vecfit
+from helpers import brute_force
 from test_gradients import OFF_GRID, W, background, check, solid
 from vecfit.errors import VecfitError
 from vecfit.scene import Path, Scene, Shape
@@ -112,7 +113,8 @@ def test_tiles_match_brute_force(mode):
     scene = tapered_cubic("round", "miter", scale=2.0)
     n = 2 if mode == "mc" else 1
     tiled = vecfit.render(scene, samples=n, mode=mode)
-    brute = vecfit.render(scene, samples=n, mode=mode, _brute_force=True)
+    with brute_force():
+        brute = vecfit.render(scene, samples=n, mode=mode)
     assert torch.equal(tiled, brute)
 
 

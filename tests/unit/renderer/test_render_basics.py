@@ -6,6 +6,7 @@ import pytest
 import torch
 
 import vecfit
+from helpers import brute_force
 from vecfit.renderer.raster import output_size
 from vecfit.scene import Circle, LinearGradient, Path, Rect, Scene, Shape, Solid
 
@@ -100,7 +101,8 @@ def test_tiles_match_brute_force(mode, samples, filter):
         warnings.simplefilter("ignore")
         scene = vecfit.load_svg(tiger)
     fast = vecfit.render(scene, 248, 255, samples=samples, mode=mode, filter=filter)
-    brute = vecfit.render(scene, 248, 255, samples=samples, mode=mode, filter=filter, _brute_force=True)
+    with brute_force():
+        brute = vecfit.render(scene, 248, 255, samples=samples, mode=mode, filter=filter)
     assert torch.equal(fast, brute)
 
 

@@ -226,9 +226,10 @@ def _fit_all(st: Stretches, s: np.ndarray, tangents: np.ndarray, t1, t2, tol: fl
     cum = np.concatenate([[0.0], np.cumsum(steps)])
     f64 = lambda a: np.ascontiguousarray(a, np.float64)  # noqa: E731
     i64 = lambda a: np.ascontiguousarray(a, np.int64)  # noqa: E731
+    options = _core.FitOptions(tolerance=float(tol), max_turn=float(MAX_TURN), newton_range=float(NEWTON_RANGE),
+                               newton_steps=int(NEWTON_STEPS))
     return _core.fit_stretches(f64(s), f64(tangents), f64(heading), f64(cum), i64(st.first), i64(st.lengths),
-                               f64(t1), f64(t2), float(tol), float(MAX_TURN), float(NEWTON_RANGE),
-                               int(NEWTON_STEPS))
+                               f64(t1), f64(t2), options)
 
 
 def _medians(values: np.ndarray, group: np.ndarray, valid: np.ndarray, wanted: np.ndarray) -> np.ndarray:

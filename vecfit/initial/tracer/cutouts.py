@@ -41,7 +41,7 @@ from vecfit.svg.precision import root_decimals
 
 from .bezier import TANGENT_REACH, Stretches, fit_outlines, fit_pieces, open_corners
 from .cutout_curves import OutlineFinder, closed_loops, crossing_near, layout, local_polyline, on_outline
-from .primitives import open_outline, straightened
+from .primitives import line_like, open_outline, straightened
 
 MAX_SAMPLES = 16_000_000  # the sampling grid's size at most (a 2,000-px canvas at 2x2)
 SCALE = 4                 # samples a pixel side where the canvas allows
@@ -217,19 +217,14 @@ def _collinear_as_lines(points: np.ndarray, degrees: list[int], tolerance: float
     """The open curve with each cubic whose control points lie within ``tolerance`` of
     its chord's line written as a line. Moving a chain's end back along a straight stretch
     can leave a control point past the new end: a flat cubic that runs beyond its end and
-    doubles back, a spike the crossing test rightly finds (noto-emoji-040's cut-outs)."""
+    doubles back, a spike the crossing test rightly finds (noto-emoji-040's cut-outs): so
+    unlike the tracer's lines, past the chord's ends counts as on it."""
     out, kept, at = [points[:1]], [], 0
     for d in degrees:
         seg = points[at:at + d + 1]
         at += d
-        if d == 3:
-            chord = seg[-1] - seg[0]
-            length = float(np.hypot(*chord))
-            if length > 1e-9:
-                rel = seg[1:3] - seg[0]
-                across = np.abs(rel[:, 0] * chord[1] - rel[:, 1] * chord[0]) / length
-                if float(across.max()) <= tolerance:
-                    seg, d = seg[[0, -1]], 1
+        if d == 3 and line_like(seg[None], tolerance, within_chord=False)[0]:
+            seg, d = seg[[0, -1]], 1
         out.append(seg[1:])
         kept.append(d)
     return np.concatenate(out), kept

@@ -47,9 +47,11 @@ def cubic_outline(segs: np.ndarray) -> Outline:
     return Outline(points, [3] * len(segs) + [1])
 
 
-def _line_like(segs: np.ndarray, tolerance: float) -> np.ndarray:
-    """[S] bool: cubics [S, 4, 2] whose control points lie within ``tolerance`` of the chord
-    and project inside it (so the curve neither bulges nor doubles back)."""
+def line_like(segs: np.ndarray, tolerance: float, within_chord: bool = True) -> np.ndarray:
+    """[S] bool: cubics [S, 4, 2] whose control points lie within ``tolerance`` of the chord's
+    line and, with ``within_chord``, project inside the chord (so the curve neither bulges
+    nor doubles back). Without it a flat cubic that runs past its end and back is line-like
+    too (cutouts.py: such a spike is what it straightens)."""
     p0, p1, p2, p3 = segs[:, 0], segs[:, 1], segs[:, 2], segs[:, 3]
     chord = p3 - p0
     length = np.hypot(chord[:, 0], chord[:, 1])
@@ -59,15 +61,17 @@ def _line_like(segs: np.ndarray, tolerance: float) -> np.ndarray:
     for c in (p1, p2):
         rel = c - p0
         across = np.abs(rel[:, 0] * unit[:, 1] - rel[:, 1] * unit[:, 0])
-        along = (rel * unit).sum(1) / np.maximum(length, 1e-12)
-        ok &= (across <= tolerance) & (along >= -1e-6) & (along <= 1 + 1e-6)
+        ok &= across <= tolerance
+        if within_chord:
+            along = (rel * unit).sum(1) / np.maximum(length, 1e-12)
+            ok &= (along >= -1e-6) & (along <= 1 + 1e-6)
     return ok
 
 
 def _runs(segs: np.ndarray, tolerance: float) -> list[list]:
     """Cubics [S, 4, 2] as runs [degree, start, the points after the start]: cubics within
     ``tolerance`` of their chord become lines, and lines that continue each other one."""
-    straight = _line_like(segs, tolerance) if tolerance > 0 else np.zeros(len(segs), bool)
+    straight = line_like(segs, tolerance) if tolerance > 0 else np.zeros(len(segs), bool)
     runs: list[list] = []
     for k in range(len(segs)):
         if not straight[k]:

@@ -71,6 +71,9 @@ class TraceSettings:
     seed: int
     """Seed of the k-means sampling and initialisation: equal seeds give equal output."""
 
+    def __post_init__(self):
+        check_settings(self)  # the one check: every TraceSettings made (defaults, a job's, replace) is sound
+
     @classmethod
     def defaults(cls, **changes) -> "TraceSettings":
         """The defaults of configs/trace.toml ([trace], and [optimize]'s seed), with ``changes``."""

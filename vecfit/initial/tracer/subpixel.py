@@ -47,5 +47,6 @@ def refine_outlines(outlines: list[np.ndarray], regions: np.ndarray, labels: np.
                                   np.asarray(regions, np.int64), np.asarray(holes, bool),
                                   np.asarray(labels, np.int32), np.asarray(rank, np.int64),
                                   np.asarray(colors, np.float64), np.asarray(rgb, np.float32),
-                                  np.asarray(alpha, np.float32), MIN_CONTRAST, MAX_SHIFT, REACH)
+                                  np.asarray(alpha, np.float32),
+                                  _core.SubpixelOptions(min_contrast=MIN_CONTRAST, max_shift=MAX_SHIFT, reach=REACH))
     return np.split(moved, np.cumsum(lengths)[:-1])

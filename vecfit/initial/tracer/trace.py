@@ -24,7 +24,7 @@ from .hidden import straightened_hidden
 from .outlines import drawing_order, grown_masks, shape_outlines
 from .quantize import OPAQUE, nearest_centre, palette_classes, prefilter, quantize_colors, to_lab
 from .regions import build_regions, majority_class, palette_colors
-from .settings import TraceResult, TraceSettings, check_settings
+from .settings import TraceResult, TraceSettings
 from .subpixel import refine_outlines
 from .primitives import as_primitive, straightened
 from .tucked import tucked_hosts
@@ -72,7 +72,8 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     image: float32 RGBA [H, W, 4], straight alpha in [0, 1] (what vecfit.io.images.load_rgba
     returns). Pixels with alpha >= 0.5 are traced as opaque shapes; the others get no shape,
     so a transparent background stays transparent. settings: None for the defaults
-    (TraceSettings.defaults()). Raises VecfitError for a bad image or settings.
+    (TraceSettings.defaults()). Raises VecfitError for a bad image (bad settings are
+    refused where TraceSettings is made).
 
     progress, if given, is called as progress(stage, fraction): stage is one of
     "quantise", "regions", "order", "outline", "fit", fraction how much of the whole
@@ -91,7 +92,6 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     """
     start = time.perf_counter()
     settings = TraceSettings.defaults() if settings is None else settings
-    check_settings(settings)
     image = check_image(image)
     if settings.style != "fills":  # line work as strokes (fills where they do not fit)
         from .centerline import trace_strokes
