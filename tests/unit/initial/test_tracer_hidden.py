@@ -5,7 +5,7 @@ import cv2
 import numpy as np
 
 from vecfit.initial.tracer.bezier import fit_outlines
-from vecfit.initial.tracer.hidden import MARGIN, MIN_DEPTH, _point_depth, straightened_hidden
+from vecfit.initial.tracer.hidden import MARGIN, MIN_DEPTH, _point_depth, smoothed_under_strokes
 
 
 def box_outline(x0, y0, x1, y1, step=0.5):
@@ -27,7 +27,7 @@ def test_a_wobbling_edge_under_a_line_is_smoothed_and_the_rest_stays():
     wobble = outline.copy()
     # where two areas meet under the line: a wobble of 2 px every 8 px
     wobble[bottom, 1] += 2 * np.sin(np.arange(bottom.sum()) * 2 * np.pi / 16)
-    (smoothed,) = straightened_hidden([wobble], covered)
+    (smoothed,) = smoothed_under_strokes([wobble], covered)
     inside = cv2.distanceTransform(np.pad(covered.astype(np.uint8), 1), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
     depth = _point_depth(wobble, inside, 100, 100)
     moved = np.linalg.norm(smoothed - wobble, axis=1)
@@ -42,5 +42,5 @@ def test_a_wobbling_edge_under_a_line_is_smoothed_and_the_rest_stays():
 
 def test_nothing_covered_nothing_moves():
     outline = box_outline(10.0, 10.0, 50.0, 40.0)
-    (same,) = straightened_hidden([outline], np.zeros((64, 64), bool))
+    (same,) = smoothed_under_strokes([outline], np.zeros((64, 64), bool))
     assert np.array_equal(same, outline)

@@ -1,4 +1,4 @@
-"""Outlines of the fills that the strokes hide (``--style mixed``): straightened before the fit.
+"""Outlines of the fills that the strokes hide (``--style mixed``): smoothed before the fit.
 
 In mixed, the colour areas run on under their outlines (centerline.py paints the lines'
 pixels with the nearest area's colour), and two areas meet somewhere under the line that
@@ -22,7 +22,7 @@ MARGIN = 1.0
 SMOOTHING = 8.0
 
 
-def straightened_hidden(outlines: list[np.ndarray], covered: np.ndarray) -> list[np.ndarray]:
+def smoothed_under_strokes(outlines: list[np.ndarray], covered: np.ndarray) -> list[np.ndarray]:
     """The outlines (each [N, 2], closed, evenly spaced, in pixel units, as the tracer
     makes them) smoothed where they lie under ``covered`` (bool [H, W]: the pixels drawn
     over them; see the module's docstring)."""

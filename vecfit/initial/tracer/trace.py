@@ -20,7 +20,7 @@ from vecfit.svg.numbers import hex_color
 from .bezier import fit_outlines
 from .groups import grouped
 from .labels import bounding_boxes, covering_boxes
-from .hidden import straightened_hidden
+from .hidden import smoothed_under_strokes
 from .outlines import drawing_order, grown_masks, shape_outlines
 from .quantize import OPAQUE, nearest_centre, palette_classes, prefilter, quantize_colors, to_lab
 from .regions import build_regions, majority_class, palette_colors
@@ -88,7 +88,7 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     better of the two).
 
     covered (optional, bool [H, W]): pixels that strokes drawn over the trace cover
-    (``--style mixed``): outlines deep under them are straightened (hidden.py).
+    (``--style mixed``): outlines deep under them are smoothed (hidden.py).
     """
     start = time.perf_counter()
     settings = TraceSettings.defaults() if settings is None else settings
@@ -158,8 +158,8 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
         owners = np.array([i for i, sl in shapes for _ in range(sl.start, sl.stop)], np.int64)
         outlines = refine_outlines(outlines, owners, regions.labels, rank, regions.color, rgb, alpha,
                                    np.array(holes, bool))
-    if covered is not None:  # under mixed's strokes: straightened (hidden.py)
-        outlines = straightened_hidden(outlines, covered)
+    if covered is not None:  # under mixed's strokes: smoothed (hidden.py)
+        outlines = smoothed_under_strokes(outlines, covered)
     report("fit", 0.7)
     # one batched fit of all outlines (see bezier.py)
     fitted = fit_outlines(outlines, s.tolerance, s.corner_angle, s.smoothing)
