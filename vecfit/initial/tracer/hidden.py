@@ -14,6 +14,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from .bezier import Loops
+
 # A point is hidden where every pixel within this many pixels of it is covered.
 MIN_DEPTH = 2.0
 # Of its depth under the strokes, a smoothed point may move this much less.
@@ -26,10 +28,24 @@ def smoothed_under_strokes(outlines: list[np.ndarray], covered: np.ndarray) -> l
     """The outlines (each [N, 2], closed, evenly spaced, in pixel units, as the tracer
     makes them) smoothed where they lie under ``covered`` (bool [H, W]: the pixels drawn
     over them; see the module's docstring)."""
+    if not outlines:
+        return []
     h, w = covered.shape
     inside = cv2.distanceTransform(np.pad(covered.astype(np.uint8), 1), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
     inside = inside[1:-1, 1:-1]
-    return [_smoothed(o, _point_depth(o, inside, w, h)) for o in outlines]
+    points = np.concatenate(outlines).astype(np.float64, copy=False)
+    depth = _point_depth(points, inside, w, h)
+    hidden = depth >= MIN_DEPTH
+    if not hidden.any():
+        return outlines
+    loops = Loops(points, np.array([len(o) for o in outlines], np.int64))
+    step = float(np.median(np.hypot(*np.diff(outlines[0], axis=0).T))) if len(outlines[0]) > 1 else 1.0
+    move = loops.smoothed(SMOOTHING / (step or 1.0)) - points  # all loops at once (bezier.py)
+    # each hidden point moved at most its depth less MARGIN; the others stay
+    room = np.where(hidden, np.maximum(depth - MARGIN, 0.0), 0.0)
+    length = np.hypot(move[:, 0], move[:, 1])
+    moved = points + move * np.minimum(1.0, room / np.maximum(length, 1e-12))[:, None]
+    return np.split(moved, np.cumsum(loops.lengths)[:-1])
 
 
 def _point_depth(points: np.ndarray, inside: np.ndarray, w: int, h: int) -> np.ndarray:
@@ -45,23 +61,3 @@ def _point_depth(points: np.ndarray, inside: np.ndarray, w: int, h: int) -> np.n
             on = (xi >= 0) & (xi < w) & (yi >= 0) & (yi < h)
             least = np.minimum(least, np.where(on, inside[np.clip(yi, 0, h - 1), np.clip(xi, 0, w - 1)], 0.0))
     return least - 0.5
-
-
-def _smoothed(points: np.ndarray, depth: np.ndarray) -> np.ndarray:
-    """The closed outline with its hidden points smoothed, each moved at most its depth
-    less MARGIN."""
-    hidden = depth >= MIN_DEPTH
-    if len(points) < 3 or not hidden.any():
-        return points
-    step = float(np.median(np.linalg.norm(np.diff(points, axis=0), axis=1))) or 1.0
-    sigma = SMOOTHING / step
-    reach = min(int(3 * sigma), (len(points) - 1) // 2)
-    kernel = np.exp(-0.5 * (np.arange(-reach, reach + 1) / sigma) ** 2)
-    kernel /= kernel.sum()
-    wrapped = np.concatenate([points[-reach:], points, points[:reach]]) if reach else points
-    smooth = np.stack([np.convolve(wrapped[:, k], kernel, mode="valid") for k in range(2)], axis=1)
-    move = smooth - points
-    room = np.maximum(depth - MARGIN, 0.0)
-    length = np.linalg.norm(move, axis=1)
-    scale = np.where(length > room, room / np.maximum(length, 1e-12), 1.0)
-    return np.where(hidden[:, None], points + move * scale[:, None], points)
