@@ -34,9 +34,13 @@ def cut_at(segs: list[np.ndarray], seg_a: int, t_a: float, seg_b: int, t_b: floa
     """The closed loop of segments ``segs`` cut where it passes ``point`` twice (segment
     seg_a at t_a, then seg_b at t_b) into two closed loops, each from the point back to it:
     the stretch between the two passes, and the rest."""
+    return _closed_both(_laid_out(segs, seg_a, t_a, seg_b, t_b), point)
+
+
+def _closed_both(laid, point) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """_closed_at of both loops _laid_out makes."""
     p = np.asarray(point, np.float64)
-    loop, other = _laid_out(segs, seg_a, t_a, seg_b, t_b)
-    return _closed_at(loop, p), _closed_at(other, p)
+    return _closed_at(laid[0], p), _closed_at(laid[1], p)
 
 
 def _laid_out(segs: list[np.ndarray], seg_a: int, t_a: float, seg_b: int, t_b: float):
@@ -143,12 +147,14 @@ def simple_loops_many(jobs) -> list[list[list[np.ndarray]]]:
                 continue
             # (a crossing reported where the loop closes, its start, cuts off nothing: the next)
             c = next((c for c in crossings if not _at_start(c, loop)), None)
-            pieces = cut_at(loop, c.seg_a, c.t_a, c.seg_b, c.t_b, c.point) if c is not None else [loop]
+            laid = _laid_out(loop, c.seg_a, c.t_a, c.seg_b, c.t_b) if c is not None else None
+            pieces = _closed_both(laid, c.point) if c is not None else [loop]
             if any(_same(piece, loop) for piece in pieces):  # rounding undid the cut: no progress
                 done[k].append(loop)
                 continue
             cuts[k] += 1
-            for piece, handed in zip(pieces, _handed_on(loop, c, [other for other in crossings if other is not c])):
+            handed_on = _handed_on(len(loop), c, laid, [other for other in crossings if other is not c])
+            for piece, handed in zip(pieces, handed_on):
                 ready = prepared(k, piece, handed)
                 if ready is None:
                     continue
@@ -159,13 +165,14 @@ def simple_loops_many(jobs) -> list[list[list[np.ndarray]]]:
     return done
 
 
-def _handed_on(loop: list[np.ndarray], cut: Crossing, others: list[Crossing]) -> tuple[list, list]:
-    """The crossings ``others`` of ``loop`` that lie wholly in each of the two loops
-    cut_at(loop, cut) makes (the stretch between the cut's passes, then the rest), their
-    places rewritten in that loop's segments and in order along it. A crossing on a pass
-    at the cut's own parameters, or on a piece _closed_at drops, is left out: the loop is
-    then checked again (simple_loops), as one handed none is."""
-    n, sa, ta, sb, tb = len(loop), cut.seg_a, cut.t_a, cut.seg_b, cut.t_b
+def _handed_on(n: int, cut: Crossing, laid, others: list[Crossing]) -> tuple[list, list]:
+    """The crossings ``others`` of a loop of ``n`` segments that lie wholly in each of the
+    two loops its cut at ``cut`` makes (``laid``: as _laid_out lays them out, the stretch
+    between the cut's passes, then the rest), their places rewritten in that loop's
+    segments and in order along it. A crossing on a pass at the cut's own parameters, or on
+    a piece _closed_at drops, is left out: the loop is then checked again (simple_loops),
+    as one handed none is."""
+    sa, ta, sb, tb = cut.seg_a, cut.t_a, cut.seg_b, cut.t_b
 
     def place(seg: int, t: float):
         """(which loop: 0 the stretch, 1 the rest, its segment, parameter) as cut_at lays
@@ -188,8 +195,7 @@ def _handed_on(loop: list[np.ndarray], cut: Crossing, others: list[Crossing]) ->
             return 0, seg - sa, t
         return (1, seg - sb, t) if seg > sb else (1, n - sb + seg, t)
 
-    # each loop's segments as cut_at lays them out, renumbered past those _closed_at drops
-    laid = _laid_out(loop, sa, ta, sb, tb)
+    # each loop's segments renumbered past those _closed_at drops
     usable = [[_usable(c) for c in side] for side in laid]
     renumbered = [np.cumsum(kept) - 1 for kept in usable]
     handed: tuple[list, list] = ([], [])
