@@ -483,7 +483,8 @@ def trace_strokes(image: np.ndarray, settings: TraceSettings, progress=None) -> 
         which, covered = coverage(rgb, background, inks)
     report("regions", 0.2)
 
-    widest = (s.max_line if s.style == "mixed" else s.max_stroke) * min(h, w)
+    limit = "max_line" if s.style == "mixed" else "max_stroke"  # the setting that bounds line work
+    widest = getattr(s, limit) * min(h, w)
     strokes: list[Stroke] = []
     stroked = np.zeros((h, w), bool)   # pixels whose ink the strokes draw
     left_over = np.zeros((h, w), bool)  # ink pixels left to fills
@@ -528,9 +529,8 @@ def trace_strokes(image: np.ndarray, settings: TraceSettings, progress=None) -> 
     warnings_given = []
     thick = int(left_over.sum())
     if not strokes:
-        limit = ("max_line", s.max_line) if s.style == "mixed" else ("max_stroke", s.max_stroke)
-        warnings_given.append(f"no line work thin enough for strokes ({limit[0]} "
-                              f"{limit[1]:g} of the shorter side): traced as fills")
+        warnings_given.append(f"no line work thin enough for strokes ({limit} "
+                              f"{getattr(s, limit):g} of the shorter side): traced as fills")
     elif thick >= max(MIN_PIECE, s.min_area) and s.style == "strokes":
         warnings_given.append(f"{thick} pixels of ink are not line work (too thick, or shapes): traced as fills")
     for message in warnings_given:
