@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import functools
 import io
 import json
 import statistics
@@ -51,12 +52,22 @@ WIDTH = 512
 WHITE = "#ffffff"
 
 
+@functools.lru_cache(maxsize=None)
+def _manifest(folder: Path) -> tuple[dict, ...]:
+    """The rows of a shared corpus's manifest.tsv (read once a run)."""
+    with open(folder / "manifest.tsv", encoding="utf-8") as f:
+        return tuple(csv.DictReader(f, delimiter="\t"))
+
+
+def _folder(name: str) -> Path:
+    return SHARED / ("lineart" if name.startswith("tabler") else "realworld")
+
+
 def manifest_cases(prefix: str, limit: int) -> list[tuple[str, Path]]:
     """(name, SVG) of ``limit`` files of one set, every k-th of the manifest's so that one
     family of glyphs does not fill it."""
-    folder = SHARED / ("lineart" if prefix == "tabler" else "realworld")
-    with open(folder / "manifest.tsv", encoding="utf-8") as f:
-        rows = [r for r in csv.DictReader(f, delimiter="\t") if r["name"].startswith(prefix + "-")]
+    folder = _folder(prefix)
+    rows = [r for r in _manifest(folder) if r["name"].startswith(prefix + "-")]
     step = max(1, len(rows) // max(limit, 1))
     return [(r["name"], folder / r["svg"]) for r in rows[::step][:limit]]
 
@@ -65,9 +76,8 @@ def named_cases(names: list[str]) -> list[tuple[str, Path]]:
     """(name, SVG) of the named files of the shared corpus (realworld or lineart)."""
     cases = []
     for name in names:
-        folder = SHARED / ("lineart" if name.startswith("tabler-") else "realworld")
-        with open(folder / "manifest.tsv", encoding="utf-8") as f:
-            found = [r for r in csv.DictReader(f, delimiter="\t") if r["name"] == name]
+        folder = _folder(name)
+        found = [r for r in _manifest(folder) if r["name"] == name]
         if not found:
             raise SystemExit(f"roundtrip.py: no file named {name} in {folder / 'manifest.tsv'}")
         cases.append((name, folder / found[0]["svg"]))
