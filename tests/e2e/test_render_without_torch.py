@@ -29,15 +29,23 @@ GRADIENT = (f'<svg {NS} width="40" height="30"><linearGradient id="g"><stop offs
 PLAIN = f'<svg {NS} width="40" height="30"><circle cx="20" cy="15" r="9" fill="#3a6" stroke="#000"/></svg>'
 
 
-def _render_command(*args) -> tuple[str, bool]:
-    """`vecfit render ARGS` in a fresh Python: its output, and whether it imported torch."""
+def _render_command(*args, module: str = "torch") -> tuple[str, bool]:
+    """`vecfit render ARGS` in a fresh Python: its output, and whether it imported
+    ``module``."""
     code = ("import sys\nfrom vecfit.cli.commands import main\n"
             f"sys.argv = ['vecfit', 'render', *{list(map(str, args))!r}]\n"
             "try:\n    main()\nexcept SystemExit:\n    pass\n"
-            "print('torch' in sys.modules)")
+            f"print({module!r} in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     lines = out.stdout.split()
     return out.stdout + out.stderr, (lines[-1] == "True") if lines else True
+
+
+def test_a_plain_render_imports_no_opencv(tmp_path):
+    """OpenCV's import is a tenth of a second, a fifth of the command: the reader and
+    the PNG writer have no use for it (issue 41: `vecfit render` within 3x resvg's)."""
+    output, cv2_loaded = _render_command(TIGER, "-o", tmp_path / "tiger.png", module="cv2")
+    assert "[1/1]" in output and not cv2_loaded, output
 
 
 def _with_torch(svg, png, **options) -> bytes:

@@ -8,7 +8,6 @@ import tempfile
 import warnings
 from pathlib import Path
 
-import cv2
 import numpy as np
 from PIL import Image, UnidentifiedImageError
 
@@ -168,6 +167,8 @@ def downscaled(image: np.ndarray, max_size: int) -> np.ndarray:
     scale = working_scale(w, h, max_size)
     if scale >= 1:
         return image
+    import cv2  # here, not at the top: `vecfit render` writes PNGs without it (0.1 s of start-up)
+
     size = (max(1, round(w * scale)), max(1, round(h * scale)))
     pre = np.concatenate([image[..., :3] * image[..., 3:], image[..., 3:]], axis=2)
     small = cv2.resize(pre, size, interpolation=cv2.INTER_AREA)
@@ -180,5 +181,7 @@ def downscaled_weight(weight: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     """A per-pixel weight [H, W] area-averaged to ``size`` = (height, width)."""
     if weight.shape[:2] == tuple(size):
         return weight
+    import cv2
+
     return cv2.resize(weight.astype(np.float32), (size[1], size[0]),
                       interpolation=cv2.INTER_AREA).astype(np.float32)
