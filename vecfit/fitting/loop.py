@@ -34,7 +34,7 @@ from .settings import PARAMETER_KINDS, Settings  # noqa: F401  (re-exported: the
 from .adam import Adam
 from .outline import OutlineCost
 from .opacity import colors_kept_opaque, translucency_wanted
-from .rates import dense_point_rate, outline_density, parameter_kinds
+from .rates import boundary_length_density, dense_point_rate, held_boundary_budget, outline_density, parameter_kinds
 
 # The coarse level must leave each shape some pixels (8 x 8 on average), or its small shapes
 # get no useful gradient there: the 128-px peppers trace (705 shapes) lost 1 dB coarse.
@@ -177,6 +177,7 @@ class _Fit:
             lr["points"] = dense_point_rate(float(lr["points"]), self.density, settings.dense_outline,
                                             settings.dense_points)
         self.point_rate = lr.get("points")
+        self.boundary_budget = settings.boundary_budget  # held at the first full-size iteration (hold_boundary)
         translucent = settings.alpha == "auto" and target.wants_translucency
         keep_alpha = [*keep_alpha, *colors_kept_opaque(scene, settings.alpha, translucent)]
         self.kinds = kinds = parameter_kinds(scene, lr, width, height, keep_alpha)
@@ -231,7 +232,7 @@ class _Fit:
             image = render(self.scene, w, h, samples=settings.samples, mode=settings.mode,
                            seed=settings.seed + iteration, background=self.target.background,
                            threads=settings.threads, boundary_samples=settings.boundary_samples,
-                           interior_samples=settings.interior_samples, boundary_budget=settings.boundary_budget,
+                           interior_samples=settings.interior_samples, boundary_budget=self.boundary_budget,
                            device=settings.device,
                            packed=self.packed(w, h))
             self.image = image.detach()
@@ -287,8 +288,10 @@ class _Fit:
     def iteration(self, it: int) -> tuple[float, bool]:
         """One iteration: its loss, and whether to go on (False once a refused step has
         halved the rate below 1e-4). ``skipped`` counts the refused steps."""
-        if it == self.fine_from and it > 0:
-            self.best_loss = math.inf  # losses at the coarse size do not compare with these
+        if it == self.fine_from:
+            if it > 0:
+                self.best_loss = math.inf  # losses at the coarse size do not compare with these
+            self.hold_boundary()
         try:
             with phase("forward"):
                 loss = self.evaluate(it, grad=True)
@@ -306,6 +309,17 @@ class _Fit:
         if not all(torch.isfinite(k.flat).all() for k in self.kinds):
             self.refuse_step()
         return value, True
+
+    def hold_boundary(self) -> None:
+        """A dense scene's boundary samples (its outlines past settings.dense_outline at the
+        start, as the point rate has it) may grow to settings.boundary_growth times what
+        this first full-size iteration asks, and no further (rates.held_boundary_budget)."""
+        s = self.settings
+        if s.mode != "mc" or s.boundary_growth <= 0 or not (0 < s.dense_outline < self.density):
+            return
+        h, w = self.target.image.shape[:2]
+        self.boundary_budget = held_boundary_budget(s.boundary_budget, s.boundary_growth, s.boundary_samples,
+                                                    boundary_length_density(self.scene, w, h))
 
     def refuse_step(self) -> None:
         self.skipped += 1

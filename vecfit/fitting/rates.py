@@ -11,7 +11,7 @@ import torch
 from vecfit.scene.arrays import to_numpy
 from vecfit.scene.geometry import local_bbox_size
 from vecfit.scene.placement import canvas_matrix, group_matrices, shape_matrices
-from vecfit.scene import LinearGradient, Path, RadialGradient, Scene
+from vecfit.scene import Circle, Ellipse, LinearGradient, Path, RadialGradient, Scene
 
 from .adam import ParameterKind
 
@@ -121,6 +121,57 @@ def outline_density(scene: Scene, width: int, height: int) -> float:
                 q = np.concatenate([q, q[:1]])
             total += scale * float(np.sqrt(((q[1:] - q[:-1]) ** 2).sum(1)).sum())
     return total / max(width * height, 1)
+
+
+def boundary_length_density(scene: Scene, width: int, height: int) -> float:
+    """What the Monte Carlo backward's boundary samples are counted by, per pixel of a
+    width x height image: each path's control-polygon length (outline_density's), once for
+    a fill and twice for a stroke (its two sides), and the perimeters of circles,
+    ellipses and rectangles alike."""
+    scales = shape_pixel_scales(scene, width, height)
+    total = 0.0
+    for shape, scale in zip(scene.shapes, scales):
+        sides = (shape.fill is not None) + 2 * (shape.stroke is not None)
+        if sides:
+            total += sides * scale * _outline_length(shape.geometry)
+    return total / max(width * height, 1)
+
+
+def _outline_length(g) -> float:
+    """The geometry's outline in its own units: a path's control polygons, a primitive's
+    perimeter (an ellipse's by Ramanujan's approximation)."""
+    if isinstance(g, Path):
+        p = np.asarray(to_numpy(g.points), np.float64)
+        total = 0.0
+        for (first, count, closed), (p0, n) in zip(g.subpaths, g.subpath_point_ranges()):
+            q = p[p0:p0 + n]
+            if closed and n > 1:
+                q = np.concatenate([q, q[:1]])
+            total += float(np.sqrt(((q[1:] - q[:-1]) ** 2).sum(1)).sum())
+        return total
+    if isinstance(g, Circle):
+        return 2 * math.pi * abs(float(to_numpy(g.radius)))
+    if isinstance(g, Ellipse):
+        a, b = (abs(float(r)) for r in to_numpy(g.radii))
+        return math.pi * (3 * (a + b) - math.sqrt(max((3 * a + b) * (a + 3 * b), 0.0)))
+    size = np.abs(np.asarray(to_numpy(g.p_max), np.float64) - np.asarray(to_numpy(g.p_min), np.float64))
+    return 2 * float(size.sum())
+
+
+def held_boundary_budget(budget: float, growth: float, boundary_samples: float, length_density: float) -> float:
+    """The boundary budget (samples per image pixel, 0: none) of a fit whose boundary
+    samples may grow to ``growth`` times what its first full-size iteration asks
+    (``boundary_samples`` per pixel of ``length_density``, boundary_length_density's):
+    the smaller of the two bounds. ``growth`` 0, or nothing drawn to count, holds nothing.
+
+    A dense trace's outlines lengthen over a run (the fit, not noise: DESIGN.md "Flat
+    iteration cost"), and the samples counted by their length with them; held to the
+    start's number they are allotted where the error is (the budget's rule), so the last
+    iterations cost about what the first did."""
+    asked = growth * boundary_samples * length_density
+    if not asked > 0:
+        return budget
+    return asked if budget <= 0 else min(budget, asked)
 
 
 def dense_point_rate(rate: float, density: float, dense_outline: float, dense_points: float) -> float:

@@ -36,6 +36,7 @@ class Settings:
     coarse: float  # fraction of the iterations run at half the size (coarse to fine)
     outline: float  # weight of the cost on outlines growing (outline.py), per px of growth per px
     boundary_budget: float  # Monte Carlo boundary samples per image pixel at most (0: no bound)
+    boundary_growth: float  # a dense scene's boundary samples: at most this many times the first full-size iteration's (0: free)
     dense_outline: float  # control polygon px per image px past which the point rate falls (rates.py)
     dense_points: float  # ... to this rate (px a step) at twice that density
     max_size: int  # the target downscaled to this longest side to optimise on (0: never)
@@ -96,7 +97,7 @@ class Settings:
             raise VecfitError("lr_warmup must be 0 or more")
         if not 0 <= self.coarse < 1:  # the last iterations must be at full size
             raise VecfitError(f"coarse must be at least 0 and below 1, not {self.coarse}")
-        for name in ("outline", "boundary_budget", "dense_outline", "dense_points"):
+        for name in ("outline", "boundary_budget", "boundary_growth", "dense_outline", "dense_points"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
                 raise VecfitError(f"{name} must be a number >= 0, not {value}")

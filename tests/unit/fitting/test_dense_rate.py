@@ -1,5 +1,6 @@
 """Dense scenes (issue 29): the point rate that follows the outline density
-(vecfit/fitting/rates.py), the report's figures, and the boundary budget as a setting."""
+(vecfit/fitting/rates.py), the report's figures, the boundary budget as a setting, and a
+dense scene's boundary samples held to what its first full-size iteration asks (issue 41)."""
 from __future__ import annotations
 
 import numpy as np
@@ -9,8 +10,8 @@ import torch
 from vecfit import VecfitError
 from vecfit.fitting import loop
 from vecfit.fitting.loop import Settings, Target, optimize
-from vecfit.fitting.rates import dense_point_rate, outline_density
-from vecfit.scene import Path, Scene, Shape, Solid
+from vecfit.fitting.rates import boundary_length_density, dense_point_rate, held_boundary_budget, outline_density
+from vecfit.scene import Circle, Ellipse, Path, Rect, Scene, Shape, Solid
 
 
 def squares(count: int, side: float, size: int = 64) -> Scene:
@@ -75,7 +76,54 @@ def test_the_boundary_budget_setting_reaches_the_renderer(monkeypatch):
     assert seen and set(seen) == {0.5}
 
 
-@pytest.mark.parametrize("key", ["boundary_budget", "dense_outline", "dense_points"])
+@pytest.mark.parametrize("key", ["boundary_budget", "boundary_growth", "dense_outline", "dense_points"])
 def test_the_new_settings_are_checked(key):
     with pytest.raises(VecfitError, match=key):
         Settings.defaults(**{key: -1.0})
+
+
+def test_the_boundary_length_counts_a_stroke_twice_and_primitives_by_their_perimeter():
+    blue = Solid(torch.tensor([0.2, 0.4, 0.8, 1.0]))
+    square = squares(1, 8.0).shapes[0].geometry  # 32 px of outline
+    scene = Scene(64, 64, [Shape(square, fill=blue), Shape(square, stroke=blue), Shape(square, fill=blue, stroke=blue)])
+    assert boundary_length_density(scene, 64, 64) == pytest.approx((32 + 64 + 96) / 4096, rel=1e-6)
+    t = torch.tensor
+    primitives = Scene(64, 64, [Shape(Circle(t([32.0, 32.0]), t(10.0)), fill=blue),
+                                Shape(Ellipse(t([32.0, 32.0]), t([10.0, 10.0])), fill=blue),
+                                Shape(Rect(t([0.0, 0.0]), t([8.0, 4.0])), fill=blue)])
+    assert boundary_length_density(primitives, 64, 64) == pytest.approx((2 * 20 * np.pi + 24) / 4096, rel=1e-5)
+    # twice the resolution: twice the length over four times the pixels
+    assert boundary_length_density(scene, 128, 128) == pytest.approx((32 + 64 + 96) / 4096 / 2, rel=1e-6)
+
+
+@pytest.mark.parametrize("budget, growth, samples, density, expected", [
+    (2.0, 1.0, 2.0, 0.64, 1.28),  # held below the budget
+    (2.0, 1.0, 2.0, 1.50, 2.0),  # the budget the lower bound
+    (0.0, 1.5, 2.0, 0.50, 1.5),  # no budget: the hold alone
+    (2.0, 0.0, 2.0, 0.64, 2.0),  # growth 0: not held
+    (2.0, 1.0, 2.0, 0.00, 2.0),  # nothing to count: not held (0 would mean no bound)
+])
+def test_the_held_budget_is_the_lower_of_the_two_bounds(budget, growth, samples, density, expected):
+    assert held_boundary_budget(budget, growth, samples, density) == pytest.approx(expected)
+
+
+@pytest.mark.parametrize("count, growth, expected", [
+    (4, 1.0, 2.0),  # sparse (0.047 px a pixel): the budget as set
+    (60, 1.0, 2 * 60 * 48 / 4096),  # dense (0.70): held to the samples its outlines ask at the start
+    (60, 1.2, 1.2 * 2 * 60 * 48 / 4096),
+    (60, 1.5, 2.0),  # past the budget: the budget
+    (60, 0.0, 2.0),  # not held
+])
+def test_a_dense_scenes_boundary_samples_are_held_from_its_first_full_size_iteration(monkeypatch, count, growth,
+                                                                                      expected):
+    seen = []
+    real = loop.render
+
+    def spy(*args, **kwargs):
+        seen.append(kwargs["boundary_budget"])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(loop, "render", spy)
+    optimize(squares(count, 12.0), _target(), Settings.defaults(iterations=3, threads=1, boundary_budget=2.0,
+                                                                 boundary_samples=2.0, boundary_growth=growth))
+    assert len(seen) == 4 and seen == pytest.approx([expected] * 4, rel=1e-5)
