@@ -79,6 +79,9 @@ NOISE_FLOOR = 0.12
 # paper and ink of a scan or a photo of a drawing come out a shade off (noise clipped at
 # white and black, JPEG), where a designer's are pure.
 SNAP = 0.04
+# A corner sharper than this many degrees (its sides as they leave it) is acute: a wide
+# line's skeleton falls short of its apex by more than thinning's few pixels (see _apex).
+ACUTE = 80.0
 CAPS = ("round", "butt", "square")  # (the first of each is the default)
 # Another cap or join is chosen where its render's squared error is this share of the
 # default's or less.
@@ -183,48 +186,74 @@ def _resampled(points: np.ndarray, closed: bool, step: float = 1.0) -> np.ndarra
     return out[:-1] if closed and len(out) > 3 else out
 
 
-def _apex(p: np.ndarray, c: int, reach: int) -> np.ndarray:
-    """Where the lines through the two sides of the corner at p[c] meet (each side's
-    points `reach` to 3 `reach` away), if near p[c]; else p[c]."""
-    def side(lo, hi):
-        q = p[max(lo, 0):min(hi, len(p))]
+def _apex(p: np.ndarray, c: int, reach: int, lo: int, hi: int, half_width: float = 0.0) -> tuple[np.ndarray, int]:
+    """(Where the lines through the two sides of the corner at p[c] meet, if near p[c],
+    else p[c]; how many points either side of it thinning rounded). Each side's points
+    2 `reach` to 5 `reach` away. Thinning rounds an acute corner of a wide line (half width
+    ``half_width``) further: its inner corner lies a half width over the sine of half
+    the angle from the apex, and the skeleton forks (to a spur that pruning removes)
+    short of the apex by half the difference; there the sides are judged from beyond the
+    inner corner (within p[lo:hi + 1], the neighbouring corners) and the apex taken that
+    much further."""
+    def side(a, b, lo=0, hi=len(p) - 1):
+        q = p[max(a, lo):min(b, hi + 1)]
         if len(q) < 2:
             return None
         centre = q.mean(0)
         _, _, vt = np.linalg.svd(q - centre)
         return centre, vt[0]
+
+    def meet(a, b):
+        if a is None or b is None:
+            return None
+        (pa, da), (pb, db) = a, b
+        det = da[0] * -db[1] + db[0] * da[1]
+        if abs(det) < 0.3:  # nearly parallel sides: no clear apex
+            return None
+        t = ((pb - pa)[0] * -db[1] + db[0] * (pb - pa)[1]) / det
+        # (and the corner's angle: between the sides as they leave it)
+        angle = np.degrees(np.arccos(np.clip(float(_unit(pa - p[c]) @ _unit(pb - p[c])), -1, 1)))
+        return pa + t * da, angle
     # the sides a little way off: thinning rounds an acute corner over a half width or more
-    a, b = side(c - 5 * reach, c - 2 * reach), side(c + 2 * reach + 1, c + 5 * reach + 1)
-    if a is None or b is None:
-        return p[c]
-    (pa, da), (pb, db) = a, b
-    det = da[0] * -db[1] + db[0] * da[1]
-    if abs(det) < 0.3:  # nearly parallel sides: no clear apex
-        return p[c]
-    t = ((pb - pa)[0] * -db[1] + db[0] * (pb - pa)[1]) / det
-    x = pa + t * da
-    # thinning stops short of an acute corner by up to about the line's half width
-    return x if np.hypot(*(x - p[c])) < 1.5 * reach else p[c]
+    found = meet(side(c - 5 * reach, c - 2 * reach), side(c + 2 * reach + 1, c + 5 * reach + 1))
+    if found is None:
+        return p[c], reach
+    limit, drop = 1.5 * reach, reach
+    if half_width > 0 and found[1] < ACUTE:
+        sin_half = np.sin(np.radians(found[1]) / 2)
+        near = max(2 * reach, int(round(half_width / sin_half)))
+        again = meet(side(c - near - 3 * reach, c - near, lo, hi), side(c + near + 1, c + near + 3 * reach + 1, lo, hi))
+        if again is not None:
+            found = again
+            limit += half_width * (1 / sin_half - 1) / 2
+            drop = max(reach, near // 2)
+    x = found[0]
+    return (x, drop) if np.hypot(*(x - p[c])) < limit else (p[c], reach)
 
 
 def fit_open(polylines: list[np.ndarray], tolerance: float, corner_angle: float,
-             smoothing: float) -> list[np.ndarray]:
+             smoothing: float, half_widths: list[float] | None = None) -> list[np.ndarray]:
     """Cubic segments [S, 4, 2] of each open polyline (points at 1 px steps): cut at its
     corners, each stretch smoothed with its ends held and fitted as bezier.fit_outlines
-    fits a closed outline's stretches."""
+    fits a closed outline's stretches. ``half_widths``: each line's half width (thinning
+    rounds a corner over about that: its apex is found, and its points dropped, that far)."""
     pieces, owner = [], []
     reach = int(round(CORNER_REACH))
     for k, p in enumerate(polylines):
         bounds = [0, *open_corners(Stretches(p, np.array([len(p)])).smoothed(smoothing / 2), corner_angle, reach),
                   len(p) - 1]
+        r = 0.0 if half_widths is None else half_widths[k]
         p = p.copy()
-        for c in bounds[1:-1]:  # a corner at the meeting of its sides' lines (see _apex)
-            p[c] = _apex(p, c, reach)
-        for a, b in zip(bounds[:-1], bounds[1:]):
+        drops = [0]
+        for i, c in enumerate(bounds[1:-1], 1):  # a corner at the meeting of its sides' lines (see _apex)
+            p[c], cut = _apex(p, c, reach, bounds[i - 1], bounds[i + 1], r)
+            drops.append(cut)
+        drops.append(0)
+        for i, (a, b) in enumerate(zip(bounds[:-1], bounds[1:])):
             inner = np.arange(a, b + 1)
-            # thinning cuts the corner over about `reach` points: those go
-            cut = ((inner - a < reach) & (inner != a) & (a > 0)) | \
-                  ((b - inner < reach) & (inner != b) & (b < len(p) - 1))
+            # thinning cuts the corner over about `drop` points: those go
+            cut = ((inner - a < drops[i]) & (inner != a) & (a > 0)) | \
+                  ((b - inner < drops[i + 1]) & (inner != b) & (b < len(p) - 1))
             if (~cut).sum() >= 2:
                 inner = inner[~cut]
             pieces.append(p[inner])
@@ -357,7 +386,8 @@ def fitted_strokes(chains, radius: np.ndarray, ink: np.ndarray, color: str, s: T
         x, y = fmt_many(list(centre), DECIMALS)
         out.append(Stroke("path", {"d": f"M{x} {y}h0"}, 1, widths[id(c)], color))
     if runs:
-        fitted = fit_open([c.points for c in runs], s.tolerance, s.corner_angle, s.smoothing)
+        fitted = fit_open([c.points for c in runs], s.tolerance, s.corner_angle, s.smoothing,
+                          [widths[id(c)] / 2 for c in runs])
         for c, segs in zip(runs, fitted):
             points, degrees = open_outline(segs, s.lines)
             if c.closed:
