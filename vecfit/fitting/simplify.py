@@ -40,6 +40,9 @@ REPARAM = 2       # Newton reparameterisations after the split's search
 CONTRAST_PX = 1.5  # where the edge's two sides are read, pixels from it
 BRIEF_RATE = 0.05  # the brief refinement's rates: this share of the fit's (half where the fit ended)
 CORNER = 90.0     # degrees: a node turning more than this is a corner (kept unless its segments are short)
+HIDDEN_JUMP = 1e-4  # squared colour difference across an edge below which it does not show
+TIDY_DB = 0.02     # dB: what tidy (after the brief refinement) may cost
+HIDDEN_ERROR = 3.0  # px: how far a join may stray from a pair that shows nowhere, itself showing nowhere
 
 
 def _cubic(ctrl: np.ndarray) -> np.ndarray:
@@ -214,8 +217,18 @@ def _sample(image: np.ndarray, xy: np.ndarray) -> np.ndarray:
     return image[y, x]
 
 
+def _jumps(image: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    """[N, M-1] the squared colour difference of the render ``image`` CONTRAST_PX either
+    side of each piece of the polylines ``pts`` [N, M, 2] (pixels)."""
+    normal = np.diff(pts, axis=1)
+    normal = _unit(np.stack([-normal[..., 1], normal[..., 0]], -1))
+    mid = 0.5 * (pts[:, 1:] + pts[:, :-1])
+    jump = _sample(image, mid + CONTRAST_PX * normal) - _sample(image, mid - CONTRAST_PX * normal)
+    return (jump ** 2).sum(-1)
+
+
 def candidates(scene, shapes: dict[int, list], image: np.ndarray, size: tuple[int, int], max_error: float,
-               lines: float, changed: dict[int, set] | None = None) -> list[_Candidate]:
+               lines: float, changed: dict[int, set] | None = None, hidden_error: float = 0.0) -> list[_Candidate]:
     """Every node of the paths ``shapes`` (shape index -> _subpath_segments) that can go,
     priced; with ``changed`` ((shape, subpath) -> segment indices made last round), only
     nodes next to those."""
@@ -256,14 +269,15 @@ def candidates(scene, shapes: dict[int, list], image: np.ndarray, size: tuple[in
     a_px, b_px, m, lines_both = a_px[fit], b_px[fit], m[fit], lines_both[fit]
     c_px, err, mean, length, pts = fit_pairs(a_px, b_px)
     straight = _straight(c_px, np.full(len(rows), lines))
-    # two lines join only into a line; a join close to its chord is written as one
-    keep = (err <= max_error) & (~lines_both | straight)
     # contrast across the pair: the render 1.5 px either side of its samples
-    normal = np.diff(pts, axis=1)
-    normal = _unit(np.stack([-normal[..., 1], normal[..., 0]], -1))
-    mid = 0.5 * (pts[:, 1:] + pts[:, :-1])
-    jump = _sample(image, mid + CONTRAST_PX * normal) - _sample(image, mid - CONTRAST_PX * normal)
-    contrast = (jump ** 2).sum(-1).mean(1)
+    jumps = _jumps(image, pts)
+    contrast = jumps.mean(1)
+    # an edge that shows nowhere (under a later shape) may be replaced by one up to
+    # ``hidden_error`` from it, where that one shows nowhere either
+    new_pts = _eval(c_px, np.broadcast_to(np.linspace(0.0, 1.0, 2 * SAMPLES + 1), (len(c_px), 2 * SAMPLES + 1)))
+    hidden = (jumps.max(1) <= HIDDEN_JUMP) & (_jumps(image, new_pts).max(1) <= HIDDEN_JUMP)
+    # two lines join only into a line; a join close to its chord is written as one
+    keep = ((err <= max_error) | (hidden & (err <= hidden_error))) & (~lines_both | straight)
     cost = mean * length * contrast
     inverse = np.linalg.inv(m)
     out = []
@@ -313,24 +327,29 @@ def _apply(shapes: dict[int, list], chosen: list[_Candidate]):
 
 
 def reduce_nodes(scene, measure, image: np.ndarray, size: tuple[int, int], budget_db: float = 0.1,
-                 max_error: float = 0.5, lines: float = 0.25, rounds: int = 2, noise: float = 0.0) -> dict:
+                 max_error: float = 0.5, lines: float = 0.25, rounds: int = 2, noise: float = 0.0,
+                 base: float | None = None, hidden_error: float = 0.0) -> dict:
     """Join segments of ``scene``'s paths (in place) while ``measure(scene)`` (the MSE of
     its render against the target) stays within ``budget_db`` of where it started.
     ``image``: the current render, RGB [H, W, 3] at ``size`` (width, height). ``noise``:
     the part of the MSE that is the renderer's sampling noise, not the picture's error
     (the budget is a share of the rest: at 45 dB, the noise of 16 Monte Carlo samples a
-    pixel is a fifth of what they measure, and of 4 two thirds). Returns counts."""
+    pixel is a fifth of what they measure, and of 4 two thirds). ``base``: the MSE the
+    budget is counted from, where it is not the scene's now (a pass before this one spent
+    some of it). ``hidden_error``: how far (px) a join may stray from a pair that shows
+    nowhere in ``image`` (nor does the join): under a later shape. Returns counts."""
     started = time.perf_counter()
-    base = measure(scene)
+    now = measure(scene)
+    base = now if base is None else base
     limit = base + max(base - noise, 0.0) * (10 ** (budget_db / 10) - 1)
     shapes = {i: _subpath_segments(sh.geometry) for i, sh in enumerate(scene.shapes)
               if isinstance(sh.geometry, Path) and sh.geometry.widths is None}
     before = sum(len(segs) for subs in shapes.values() for segs, _ in subs)
-    renders, joined, mse = 1, 0, base
+    renders, joined, mse = 1, 0, now
     originals = {i: scene.shapes[i].geometry for i in shapes}
     changed = None
     for _ in range(rounds):
-        chosen = _disjoint(candidates(scene, shapes, image, size, max_error, lines, changed))
+        chosen = _disjoint(candidates(scene, shapes, image, size, max_error, lines, changed, hidden_error))
         if not chosen:
             break
 
@@ -409,4 +428,234 @@ def simplify_fitted(scene, goal, settings, render_rgb, target_rgb: np.ndarray, b
             stats["mse_refined"] = refined
         stats["seconds_refine"] = time.perf_counter() - started
     stats["seconds"] += stats["seconds_refine"]
+    stats["tidied"] = tidy(scene, measure, render_rgb, (w, h), noise, max_error, lines)
     return stats
+
+
+def tidy(scene, measure, render_rgb, size: tuple[int, int], noise: float, max_error: float = 0.5,
+         lines: float = 0.25, budget_db: float = TIDY_DB) -> dict:
+    """After the brief refinement (which it leaves as it went): all but straight cubics
+    written as lines (straighten), then one round of joins (reduce_nodes) that also joins
+    lines going on in one direction and pairs under a later shape (up to HIDDEN_ERROR px
+    from where they were); ``budget_db`` for both, measured as reduce_nodes measures."""
+    base = measure(scene)
+    limit = base + max(base - noise, 0.0) * (10 ** (budget_db / 10) - 1)
+    straight = straighten(scene, measure, size, limit, lines)
+    joins = reduce_nodes(scene, measure, render_rgb(scene), size, budget_db, max_error, lines, rounds=1,
+                         noise=noise, base=base, hidden_error=HIDDEN_ERROR)
+    return {"straightened": straight["straightened"], "joined": joins["joined"], "mse_before": base,
+            "mse_after": joins["mse_after"]}
+
+
+STRAIGHT = 0.25  # px: a cubic that strays no further than this from its chord is tried as a line
+
+
+def straight_candidates(scene, shapes: dict[int, list], size: tuple[int, int],
+                        tolerance: float = STRAIGHT) -> list[tuple[float, int, int, int]]:
+    """(area between the curve and its chord in px², shape, subpath, segment) of every cubic
+    of ``shapes`` (shape index -> _subpath_segments) whose points all lie within ``tolerance``
+    pixels of its chord (the segment between its ends: a flat cubic whose control points run
+    past an end, drawing a hair's overshoot, counts by how far it goes), cheapest first."""
+    mats = np.asarray(to_numpy(shape_matrices(scene, size[0], size[1])), np.float64)
+    rows, ctrls = [], []
+    for s, subs in shapes.items():
+        for j, (segs, _) in enumerate(subs):
+            for k, c in enumerate(segs):
+                if len(c) == 4:
+                    rows.append((s, j, k))
+                    ctrls.append(c)
+    if not rows:
+        return []
+    m = mats[np.array([r[0] for r in rows])]
+    c = np.einsum("nij,nkj->nki", m[:, :2, :2], np.stack(ctrls)) + m[:, None, :2, 2]
+    u = np.broadcast_to(np.linspace(0.0, 1.0, 17), (len(c), 17))
+    pts = _eval(c, u)
+    a, d = c[:, None, 0], (c[:, 3] - c[:, 0])[:, None]
+    ll = (d * d).sum(-1)
+    along = np.clip(((pts - a) * d).sum(-1) / np.maximum(ll, 1e-18), 0.0, 1.0)
+    dist = np.linalg.norm(pts - a - along[..., None] * d, axis=-1)
+    length = np.sqrt(ll[:, 0])
+    ok = (dist.max(1) <= tolerance) & (length > 1e-6)
+    out = [(float(dist[i].mean() * length[i]), *rows[i]) for i in np.flatnonzero(ok)]
+    out.sort()
+    return out
+
+
+def straighten(scene, measure, size: tuple[int, int], limit: float, tolerance: float = STRAIGHT) -> dict:
+    """The cubics of ``scene``'s paths that are all but straight (straight_candidates)
+    written as lines (their ends kept), in place, as many as keep ``measure(scene)`` (the
+    MSE of a render, the same samples every call) within ``limit``, cheapest first (by
+    bisection). A line is four numbers fewer in the file, and lines that go on in one
+    direction join into one (reduce_nodes). Returns counts."""
+    shapes = {i: _subpath_segments(sh.geometry) for i, sh in enumerate(scene.shapes)
+              if isinstance(sh.geometry, Path) and sh.geometry.widths is None}
+    found = straight_candidates(scene, shapes, size, tolerance)
+    stats = {"candidates": len(found), "straightened": 0, "renders": 0}
+    if not found:
+        return stats
+    originals = {s: scene.shapes[s].geometry for _, s, _, _ in found}
+
+    def made(k):
+        new: dict[int, list] = {}
+        for _, s, j, i in found[:k]:
+            subs = new.setdefault(s, [(list(segs), closed) for segs, closed in shapes[s]])
+            c = subs[j][0][i]
+            subs[j][0][i] = c[[0, 3]]
+        for s, subs in new.items():
+            scene.shapes[s].geometry = _with_segments(originals[s], subs)
+
+    def within(k):
+        made(k)
+        value = measure(scene)
+        for s, g in originals.items():
+            scene.shapes[s].geometry = g
+        stats["renders"] += 1
+        return value <= limit
+
+    lo, hi = 0, len(found)
+    if within(hi):
+        lo = hi
+    else:
+        hi -= 1
+    while hi - lo > max(1, len(found) // 64):
+        mid = (lo + hi + 1) // 2
+        if within(mid):
+            lo = mid
+        else:
+            hi = mid - 1
+    made(lo)
+    stats["straightened"] = lo
+    return stats
+
+
+
+MAX_UNSEEN_CHECKS = 200  # subpaths checked by drop_unseen, the smallest first (two small renders each)
+UNSEEN_MARGIN = 2        # px around a subpath's box that its check renders
+
+
+def _unseen_candidates(scene, size: tuple[int, int]) -> list[tuple[float, int, int, tuple]]:
+    """(area in px², shape, subpath, its box in pixels grown by UNSEEN_MARGIN) of every
+    closed subpath of an opaque, filled, unstroked path but its largest (the path stays a
+    path), smallest first, at most MAX_UNSEEN_CHECKS."""
+    from vecfit.scene.untangle import loop_area
+
+    w, h = size
+    mats = np.asarray(to_numpy(shape_matrices(scene, w, h)), np.float64)
+    out = []
+    for s, shape in enumerate(scene.shapes):
+        g = shape.geometry
+        if (not isinstance(g, Path) or g.widths is not None or shape.fill is None or shape.stroke is not None
+                or len(g.subpaths) < 2 or float(to_numpy(shape.opacity)) < 1 or float(to_numpy(shape.fill_opacity)) < 1):
+            continue
+        m = mats[s]
+        subs = _subpath_segments(g)
+        areas = []
+        for segs, closed in subs:
+            if not (closed and segs):
+                areas.append(np.inf)
+                continue
+            px = [c @ m[:2, :2].T + m[:2, 2] for c in segs]
+            areas.append(abs(loop_area(px)))
+        largest = int(np.argmax(areas))
+        for j, ((segs, _), area) in enumerate(zip(subs, areas)):
+            if j == largest or not np.isfinite(area):
+                continue
+            pts = np.concatenate(segs) @ m[:2, :2].T + m[:2, 2]
+            x0, y0 = np.floor(pts.min(0)).astype(int) - UNSEEN_MARGIN
+            x1, y1 = np.ceil(pts.max(0)).astype(int) + UNSEEN_MARGIN
+            box = (max(x0, 0), max(y0, 0), min(x1, w), min(y1, h))
+            if box[2] > box[0] and box[3] > box[1]:
+                out.append((area, s, j, box))
+    out.sort(key=lambda r: r[:3])
+    return out[:MAX_UNSEEN_CHECKS]
+
+
+def _cropped(scene, size: tuple[int, int], box: tuple):
+    """The scene as drawn into ``box`` (x0, y0, x1, y1: pixels of a ``size`` render), to be
+    rendered at the box's size: the same pixels."""
+    import torch
+
+    w, h = size
+    x0, y0, x1, y1 = box
+    kx, ky = w / float(scene.width), h / float(scene.height)
+    shift = torch.eye(3, dtype=scene.view.dtype)
+    shift[0, 2], shift[1, 2] = -x0 / kx, -y0 / ky
+    return dataclasses.replace(scene, width=(x1 - x0) / kx, height=(y1 - y0) / ky, view=shift @ scene.view)
+
+
+def drop_unseen(scene, render, target_rgb: np.ndarray, budget_db: float = 0.01) -> dict:
+    """Closed subpaths of filled paths that the picture does not need, removed from
+    ``scene`` (in place): the slivers an outline the refinement crossed leaves when it is
+    cut into simple loops (a designer deletes them), and pieces wholly under the shapes
+    drawn over them (a trace's piece grown under a later one). Each subpath (the smallest
+    first, _unseen_candidates) is judged on a render of its box with and without it
+    (``render(scene, width, height)``: RGB, the same samples every call) against the
+    target there (``target_rgb``, RGB [H, W, 3]); those that cost least go while the
+    squared error they add stays within ``budget_db``, and a render of the whole picture
+    confirms it (else fewer go, by bisection). Returns counts."""
+    if scene.groups or scene.has_effects() or not is_tensor(scene.view):
+        return {"candidates": 0, "dropped": 0, "renders": 0}
+    h, w = target_rgb.shape[:2]
+    found = _unseen_candidates(scene, (w, h))
+    stats = {"candidates": len(found), "dropped": 0, "renders": 0}
+    if not found:
+        return stats
+    originals = {s: scene.shapes[s].geometry for _, s, _, _ in found}
+    subs_of = {s: _subpath_segments(g) for s, g in originals.items()}
+
+    def without(pairs):
+        gone: dict[int, set] = {}
+        for s, j in pairs:
+            gone.setdefault(s, set()).add(j)
+        for s, js in gone.items():
+            scene.shapes[s].geometry = _with_segments(originals[s], [x for j, x in enumerate(subs_of[s]) if j not in js])
+
+    def restore():
+        for s, g in originals.items():
+            scene.shapes[s].geometry = g
+
+    costs = []
+    for area, s, j, box in found:
+        x0, y0, x1, y1 = box
+        goal = target_rgb[y0:y1, x0:x1]
+        crop = _cropped(scene, (w, h), box)
+        before = float(((render(crop, x1 - x0, y1 - y0) - goal) ** 2).sum())
+        without([(s, j)])
+        after = float(((render(_cropped(scene, (w, h), box), x1 - x0, y1 - y0) - goal) ** 2).sum())
+        restore()
+        stats["renders"] += 2
+        costs.append((after - before, s, j))
+    costs.sort()
+
+    def measure():
+        stats["renders"] += 1
+        return float(((render(scene, w, h) - target_rgb) ** 2).mean())
+
+    base = measure()
+    limit = base * 10 ** (budget_db / 10)
+    allowed = (limit - base) * target_rgb.size
+    chosen, spent = [], 0.0
+    for cost, s, j in costs:
+        if spent + max(cost, 0.0) > allowed:
+            break
+        chosen.append((s, j))
+        spent += max(cost, 0.0)
+    lo, hi = 0, len(chosen)
+    without(chosen)
+    if measure() <= limit:
+        lo = hi
+    else:
+        hi -= 1
+        while hi > lo:
+            mid = (lo + hi + 1) // 2
+            restore()
+            without(chosen[:mid])
+            if measure() <= limit:
+                lo = mid
+            else:
+                hi = mid - 1
+    restore()
+    without(chosen[:lo])
+    stats["dropped"] = lo
+    return stats
+

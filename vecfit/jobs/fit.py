@@ -201,6 +201,10 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         progress.start(0)
         result = _not_optimised(scene, settings)
     untangled = cut_crossed_outlines(scene, drawn_crossed, config, (w, h))
+    if simplified is not None:  # subpaths the picture does not need: the cuts' slivers, pieces under others
+        from vecfit.fitting.simplify import drop_unseen
+        simplified["unseen"] = drop_unseen(scene, lambda s, w_, h_: rendered_rgb(s, w_, h_, judged, background),
+                                           target_rgb)
     if result.iterations == 0:  # nothing moved: the same picture and figures
         final_image, final_rgb, final = initial_image, initial_rgb, dict(initial)
     else:

@@ -9,7 +9,7 @@ import pytest
 import torch
 
 import vecfit
-from vecfit.fitting.simplify import fit_pairs, reduce_nodes
+from vecfit.fitting.simplify import drop_unseen, fit_pairs, reduce_nodes, straighten
 from vecfit.renderer.raster import render
 from vecfit.scene import Path, Scene, Shape, Solid
 from vecfit.scene.segments import layout_of, split_at
@@ -116,3 +116,99 @@ def test_trace_drops_nodes_within_a_tenth_of_a_db():
     assert design_stats(on)["segments"] <= design_stats(off)["segments"]
     assert report_on["optimized"]["psnr"] >= report_off["optimized"]["psnr"] - 0.15
     assert design_stats(on)["crossed_outlines"] == 0
+    assert s["unseen"]["dropped"] <= s["unseen"]["candidates"]  # (the pass after the untangling)
+
+
+def speck_scene(sliver: bool = True, dot: bool = True, island: bool = True) -> Scene:
+    """A black path: a square, a sliver of 1 px² along its top edge (what a cut crossing
+    leaves), a real dot of 3 px² apart from it and an island of 100 px² that a blue square
+    drawn over the path covers with a margin."""
+    square = [[10, 10], [34, 10], [34, 34], [10, 34]]
+    loops = [square]
+    if sliver:
+        loops.append([[16, 10], [26, 9.8], [26, 10]])  # 10 px long, 0.2 px high: 1 px²
+    if dot:
+        loops.append([[42, 20], [44, 20], [44, 21.5], [42, 21.5]])
+    if island:
+        loops.append([[44, 44], [54, 44], [54, 54], [44, 54]])
+    points, degrees, table = [], [], []
+    for loop in loops:
+        table.append((len(degrees), len(loop), True))
+        points += loop
+        degrees += [1] * len(loop)
+    path = Path(points=torch.tensor(points, dtype=torch.float32), degrees=np.array(degrees), subpaths=table)
+    cover = Path(points=torch.tensor([[40.0, 40], [58, 40], [58, 58], [40, 58]]), degrees=np.array([1, 1, 1, 1]),
+                 subpaths=[(0, 4, True)])
+    return Scene(64, 64, [Shape(path, fill=Solid(torch.tensor([0.0, 0.0, 0.0, 1.0]))),
+                          Shape(cover, fill=Solid(torch.tensor([0.1, 0.3, 0.8, 1.0])))])
+
+
+def rgb_at(scene, width, height):
+    return render(scene, width, height, samples=4, seed=3, background=[1, 1, 1, 1]).numpy()[..., :3]
+
+
+def test_a_sliver_and_a_hidden_piece_are_dropped_and_a_small_shape_kept():
+    """The sliver's render is next to nothing against a target without it; the island is
+    under the blue square; the dot (as small as the sliver, nearly) is part of the picture.
+    The picture is the same, less the sliver."""
+    target = rgb(speck_scene(sliver=False), 8)
+    scene = speck_scene()
+    before = float(((rgb(scene) - target) ** 2).mean())
+    stats = drop_unseen(scene, rgb_at, target)
+    assert stats["candidates"] == 3 and stats["dropped"] == 2
+    path = scene.shapes[0].geometry
+    assert [count for _, count, _ in path.subpaths] == [4, 4]  # the square and the dot
+    assert float(((rgb(scene) - target) ** 2).mean()) < before
+    assert np.abs(rgb(scene) - rgb(speck_scene(sliver=False, island=False))).max() == 0
+    # a sliver the target shows (its pixels are a part of the picture) stays
+    kept = speck_scene()
+    stats = drop_unseen(kept, rgb_at, rgb(kept, 8))
+    assert stats["dropped"] == 1 and len(kept.shapes[0].geometry.subpaths) == 3  # (the island went)
+
+
+def outline_scene(right: list, top_flat: bool = True) -> Scene:
+    """A black outline from (10, 10): its top edge a cubic 0.1 px from straight (or a
+    line), then the cubics ``right`` down to (30, 40), the bottom and left edges lines;
+    over it, a blue square covering x 26-38 (the right side's neighbourhood)."""
+    top = np.array([[10, 10], [16, 10.1], [24, 9.9], [30, 10]], float) if top_flat else np.array([[10, 10], [30, 10]], float)
+    segs = [top] + [np.array(c, float) for c in right] + [np.array([[30, 40], [10, 40]], float),
+                                                          np.array([[10, 40], [10, 10]], float)]
+    points, degrees = layout_of(segs, True)
+    outline = Path(points=torch.tensor(points, dtype=torch.float32), degrees=np.array(degrees),
+                   subpaths=[(0, len(degrees), True)])
+    cover = Path(points=torch.tensor([[26.0, 4], [38, 4], [38, 46], [26, 46]]), degrees=np.array([1, 1, 1, 1]),
+                 subpaths=[(0, 4, True)])
+    return Scene(64, 64, [Shape(outline, fill=Solid(torch.tensor([0.0, 0.0, 0.0, 1.0]))),
+                          Shape(cover, fill=Solid(torch.tensor([0.1, 0.3, 0.8, 1.0])))])
+
+
+BUMPS = [[[30, 10], [33, 15], [33, 20], [30, 25]], [[30, 25], [33, 30], [33, 35], [30, 40]]]
+
+
+def test_a_flat_cubic_becomes_a_line_and_a_curve_stays():
+    scene = outline_scene([[[30, 10], [38, 20], [38, 30], [30, 40]]])
+    target = noisy(rgb(scene, 8))
+
+    def measure(s):
+        return float(((rgb(s) - target) ** 2).mean())
+
+    base = measure(scene)
+    stats = straighten(scene, measure, (64, 64), base * 10 ** 0.002)
+    assert stats["candidates"] == 1 and stats["straightened"] == 1
+    assert list(scene.shapes[0].geometry.degrees) == [1, 3, 1, 1]  # the bulge is 6 px from its chord
+    assert measure(scene) <= base * 10 ** 0.002
+
+
+def test_a_pair_under_a_later_shape_joins_beyond_the_error_allowed():
+    """Two bumps under the blue square: one cubic cannot follow them within 0.5 px, and
+    need not: nothing of them shows."""
+    def joined(hidden_error):
+        scene = outline_scene(BUMPS, top_flat=False)
+        target = noisy(rgb(scene, 8))
+        measure = lambda s: float(((rgb(s) - target) ** 2).mean())  # noqa: E731
+        before = rgb(scene)
+        stats = reduce_nodes(scene, measure, before, (64, 64), budget_db=0.1, hidden_error=hidden_error)
+        assert np.abs(rgb(scene) - before).max() < 1e-6  # the picture is the same
+        return len(scene.shapes[0].geometry.degrees), stats["segments_after"]
+
+    assert joined(0.0) == (5, 9) and joined(3.0) == (4, 8)  # (the blue square: 4 lines)

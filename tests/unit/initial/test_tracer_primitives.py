@@ -10,7 +10,7 @@ from vecfit.initial.tracer import TraceSettings, trace_image
 from vecfit.initial.tracer.bezier import fit_closed
 from vecfit.initial.tracer.primitives import as_primitive, straightened
 
-from test_trace import coverage, paint, psnr, render
+from test_trace import count_shapes, coverage, over_white, paint, psnr, render
 
 
 def line_cubic(a, b, bend=0.0):
@@ -103,3 +103,45 @@ def test_striped_flag_traces_to_rects(tmp_path):
     assert " d=" not in shapes.svg and len(shapes.svg) < 0.8 * len(plain.svg)
     out, before = render(shapes, w, h, tmp_path), render(plain, w, h, tmp_path)
     assert psnr(image[..., :3], out[..., :3]) >= psnr(image[..., :3], before[..., :3]) - 0.3
+
+
+def two_eyes(w: int = 96, h: int = 64) -> np.ndarray:
+    """Two black discs on a yellow face-coloured page, and a red bar: the discs are one
+    colour, one compound path."""
+    left = coverage(lambda x, y: (x - 28.3) ** 2 + (y - 30.6) ** 2 < 9.2 ** 2, w, h)
+    right = coverage(lambda x, y: (x - 66.7) ** 2 + (y - 31.2) ** 2 < 9.2 ** 2, w, h)
+    bar = coverage(lambda x, y: (y > 50) & (y < 56) & (x > 20) & (x < 76), w, h)
+    return paint([(left, (0, 0, 0)), (right, (0, 0, 0)), (bar, (0.9, 0.2, 0.1))], w, h,
+                 background=(0.99, 0.92, 0.17))
+
+
+def test_a_compound_path_of_two_discs_is_written_as_two_circles(tmp_path):
+    """Each disc of a compound path is its own <circle>, of the same paint, drawn as the
+    path drew it; with the budget full (paths=2: the discs' path and the bar), the path
+    stays one path."""
+    image = two_eyes()
+    split = trace_image(image, TraceSettings.defaults(paths=4))
+    assert len(re.findall(r"<circle\b", split.svg)) == 2 and split.svg.count('fill="#000000"') == 2
+    assert split.paths == 3 and count_shapes(split.svg) == 3 and split.segments == 4 + 4 + 4
+    whole = trace_image(image, TraceSettings.defaults(paths=4, primitives=False))
+    assert "<circle" not in whole.svg and whole.paths == 2
+    full = trace_image(image, TraceSettings.defaults(paths=2))
+    assert "<circle" not in full.svg and full.paths == count_shapes(full.svg) == 2
+    out, before = render(split, 96, 64, tmp_path), render(whole, 96, 64, tmp_path)
+    assert psnr(image[..., :3], out[..., :3]) >= psnr(image[..., :3], before[..., :3]) - 0.3
+    assert float(np.abs(out - before).max()) < 0.5  # the same picture: only the discs' rims differ
+
+
+def test_a_disc_with_a_hole_beside_it_is_not_split(tmp_path):
+    """A ring over transparency (its hole cut out of it: no page to paint the hole with):
+    its outlines meet each other's boxes, so the ring stays a path; the disc beside it in
+    the same colour becomes a circle."""
+    w, h = 96, 64
+    ring = coverage(lambda x, y: ((x - 28) ** 2 + (y - 32) ** 2 < 16 ** 2) & ((x - 28) ** 2 + (y - 32) ** 2 > 8 ** 2), w, h)
+    disc = coverage(lambda x, y: (x - 72.4) ** 2 + (y - 32.3) ** 2 < 9.5 ** 2, w, h)
+    image = paint([(ring, (0.1, 0.3, 0.8)), (disc, (0.1, 0.3, 0.8))], w, h)
+    result = trace_image(image, TraceSettings.defaults(paths=4))
+    assert len(re.findall(r"<circle\b", result.svg)) == 1 and len(re.findall(r"<path\b", result.svg)) == 1
+    assert 'fill-rule="evenodd"' in result.svg and result.svg.count("z") == 2  # the ring: outline and hole
+    out = render(result, w, h, tmp_path)
+    assert psnr(over_white(image), out[..., :3]) > 30

@@ -42,6 +42,26 @@ ELLIPSE_TOLERANCE = 0.35
 from .svgtext import add_path, add_primitive, add_rect, new_document, outline_path_data, path_data
 
 
+def separate_primitives(edges: list, simplified: list, lines: float, most: int) -> list:
+    """For each outline of one shape (its traced ``edges`` and fitted ``simplified``
+    outlines), the rect, circle or ellipse it is (primitives.as_primitive), or None: only
+    outlines whose control points' bounding box meets no other outline's of the shape,
+    so each draws alone what it drew in the compound path (no hole in it, none it cuts),
+    and its own element of the same opaque paint in the same stacking place leaves the
+    picture as it was. At most ``most`` elements in all: the path left (if any) and the
+    primitives, the first outlines first."""
+    boxes = np.array([[*o.points.min(0), *o.points.max(0)] for o in simplified])
+    meets = ((boxes[:, None, 0] <= boxes[None, :, 2]) & (boxes[None, :, 0] <= boxes[:, None, 2])
+             & (boxes[:, None, 1] <= boxes[None, :, 3]) & (boxes[None, :, 1] <= boxes[:, None, 3]))
+    alone = meets.sum(1) == 1  # (each box meets itself)
+    found = [as_primitive(edge, o, lines, ELLIPSE_TOLERANCE) if ok else None
+             for edge, o, ok in zip(edges, simplified, alone)]
+    while sum(f is not None for f in found) + any(f is None for f in found) > most:
+        last = max(k for k, f in enumerate(found) if f is not None)
+        found[last] = None
+    return found
+
+
 def check_image(image) -> np.ndarray:
     """The image as float32 RGBA [H, W, 4]; RGB is taken as opaque."""
     a = np.asarray(image)
@@ -174,10 +194,14 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
     if background is not None:
         fills.add(hex_color(paint[background]))
         add_rect(document, w, h, hex_color(paint[background]))
+    # the elements the budget still allows beyond one a shape: a compound path's subpaths
+    # that are primitives each become one (separate_primitives)
+    spare = int(s.paths) - sum(1 for _, sl in shapes if any(len(sp) for sp in fitted[sl]))
     for i, sl in shapes:
-        subpaths = [sp for sp in fitted[sl] if len(sp)]
-        if not subpaths:
+        kept = [k for k in range(sl.start, sl.stop) if len(fitted[k])]
+        if not kept:
             continue
+        subpaths = [fitted[k] for k in kept]
         fill = hex_color(paint[i])
         fills.add(fill)
         cut = any(holes[sl])
@@ -186,14 +210,21 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
             segments += sum(len(sp) for sp in subpaths)
             continue
         simplified = [straightened(sp, s.lines) for sp in subpaths]
-        shape = as_primitive(outlines[sl.start], simplified[0], s.lines, ELLIPSE_TOLERANCE) \
-            if s.primitives and len(simplified) == 1 and sl.stop - sl.start == 1 else None
-        if shape is not None:
-            add_primitive(document, shape.tag, shape.attributes, fill)
-            segments += 4
+        if s.primitives and len(simplified) == 1 and sl.stop - sl.start == 1:
+            found = [as_primitive(outlines[sl.start], simplified[0], s.lines, ELLIPSE_TOLERANCE)]
+        elif s.primitives and spare > 0:
+            found = separate_primitives([outlines[k] for k in kept], simplified, s.lines, spare + 1)
         else:
-            add_path(document, outline_path_data(simplified), fill, evenodd=cut)
-            segments += sum(len(o.degrees) - 1 for o in simplified)
+            found = [None] * len(simplified)
+        rest = [o for o, shape in zip(simplified, found) if shape is None]
+        if rest:
+            add_path(document, outline_path_data(rest), fill, evenodd=cut)
+            segments += sum(len(o.degrees) - 1 for o in rest)
+        for shape in found:
+            if shape is not None:
+                add_primitive(document, shape.tag, shape.attributes, fill)
+                segments += 4
+        spare -= sum(shape is not None for shape in found) - (not rest)
     report("fit", 1.0)
     return TraceResult(document=document, paths=len(document.root) - (background is not None), colors=len(fills),
                        segments=segments, seconds=time.perf_counter() - start)
