@@ -2,7 +2,7 @@
 
     python benchmarks/palette.py [--sections own,photos,emoji,background,alpha] [--limit 6]
                                  [--width 512] [--effort quick|normal|best] [--threads 2]
-                                 [--photo-paths 1000] [--json out.json]
+                                 [--photo-paths 1000] [--names flags-002,logos-005] [--json out.json]
 
 Sections (each a table; every PSNR is resvg's render of the written SVG against the target,
 on RGB over white unless said):
@@ -23,8 +23,9 @@ on RGB over white unless said):
 - alpha: emoji and logos rendered with transparency (RGBA targets), traced free; PSNR of
   the render, alpha included, over white and over black. Target: 35 dB both.
 
-Times are in-process seconds of vecfit.trace and in R (benchmarks/machine.py), measured in
-the same run.
+--names keeps only the cases named (each section still picks its own kind: flat, with a
+clear fifth, ...), in place of --limit's even spread. Times are in-process seconds of
+vecfit.trace and in R (benchmarks/machine.py), measured in the same run.
 """
 from __future__ import annotations
 
@@ -46,6 +47,7 @@ SECTIONS = ["own", "photos", "emoji", "background", "alpha"]
 PHOTOS = ["astronaut", "chelsea", "coffee", "rocket"]
 PAGE = "#2a9d8f"
 NOT_FLAT = re.compile(r"Gradient|<mask|<filter|<pattern|opacity|<image", re.I)
+NAMES: set[str] = set()  # --names: only these cases
 
 
 def cases(prefixes, limit: int, flat: bool = False) -> list[tuple[str, Path]]:
@@ -61,6 +63,8 @@ def cases(prefixes, limit: int, flat: bool = False) -> list[tuple[str, Path]]:
             if NOT_FLAT.search(svg.read_text(encoding="utf-8")) or len(written_colours(svg.read_bytes())) > 8:
                 continue
         out.append((r["name"], svg))
+    if NAMES:
+        return [c for c in out if c[0] in NAMES]
     step = max(1, len(out) // max(limit, 1))
     return out[::step][:limit]
 
@@ -143,7 +147,7 @@ def section_photos(args, unit, folder):
     import skimage.data
     from PIL import Image
     out = []
-    for name in PHOTOS[:args.limit]:
+    for name in [n for n in PHOTOS if n in NAMES] if NAMES else PHOTOS[:args.limit]:
         buffer = io.BytesIO()
         Image.fromarray(getattr(skimage.data, name)()).convert("RGB").save(buffer, format="PNG")
         png = buffer.getvalue()
@@ -237,8 +241,10 @@ def main():
     p.add_argument("--effort", default="normal", choices=["quick", "normal", "best"])
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--photo-paths", type=int, default=1000)
+    p.add_argument("--names", default="", help="comma-separated case names, instead of --limit's spread")
     p.add_argument("--json")
     args = p.parse_args()
+    NAMES.update(n for n in args.names.split(",") if n)
     from machine import machine_unit
     unit = machine_unit(repeats=5)
     print(f"machine unit R: {unit * 1000:.1f} ms; effort {args.effort}; width {args.width}\n")

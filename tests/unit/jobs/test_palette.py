@@ -83,14 +83,29 @@ def test_an_empty_palette_file_is_refused(tmp_path):
         parse_palette(str(tmp_path / "empty.txt"))
 
 
+def test_a_palette_file_is_refused_naming_the_line_that_does_not_parse(tmp_path):
+    (tmp_path / "typo.txt").write_text("#ff0000\n\n#00fg00 green\n")
+    with pytest.raises(VecfitError, match=r"typo.txt', line 3: '#00fg00' is not a colour"):
+        parse_palette(str(tmp_path / "typo.txt"))
+    (tmp_path / "high.gpl").write_text("GIMP Palette\n255 0 0 red\n256 0 0 brighter\n")
+    with pytest.raises(VecfitError, match=r"high.gpl', line 3: .* has a value above 255"):
+        parse_palette(str(tmp_path / "high.gpl"))
+    (tmp_path / "binary.txt").write_bytes(b"\x89PNG\r\n\x1a\n\xff\xfe")
+    with pytest.raises(VecfitError, match=r"binary.txt': cannot be read"):
+        parse_palette(str(tmp_path / "binary.txt"))
+
+
 @pytest.mark.parametrize("command", ["trace", "refine", "paint"])
 def test_the_cli_refuses_each_bad_palette_with_exit_2_before_writing(tmp_path, command):
     two_shapes_png(tmp_path / "in.png")
     (tmp_path / "init.svg").write_text('<svg xmlns="http://www.w3.org/2000/svg" width="48" height="36">'
                                        '<circle cx="20" cy="18" r="10" fill="#884444"/></svg>')
     (tmp_path / "empty.gpl").write_text("GIMP Palette\nName: none\n")
+    (tmp_path / "typo.txt").write_text("#ff0000\n#00ff00\n#00fg00 green\n")  # line 3 does not parse
+    (tmp_path / "binary.txt").write_bytes(b"\x89PNG\r\n\x1a\n\xff\xfe")  # not text: unreadable
     args = [tmp_path / "in.png"] + ([tmp_path / "init.svg"] if command == "refine" else [])
-    for value in (str(tmp_path / "nowhere.gpl"), str(tmp_path / "empty.gpl"), "#ff0000,#notacolour", "auto:0"):
+    for value in (str(tmp_path / "nowhere.gpl"), str(tmp_path / "binary.txt"), str(tmp_path / "empty.gpl"),
+                  ",", "#ff0000,#notacolour", str(tmp_path / "typo.txt"), "#ff000080", "auto:0"):
         out = tmp_path / "out.svg"
         result = run(command, *args, "-o", out, "--iterations", 2, "--palette", value, "-q")
         assert result.exit_code == 2, (value, result.output)
@@ -196,6 +211,50 @@ def test_remove_background_takes_the_colour_given(tmp_path):
     bare = drawn(svg, 64, 48)
     assert bare[:, :4, 3].max() < 0.01 and bare[20:30, 40:50, 3].max() < 0.01
     assert bare[2:5, 20:30, 3].min() > 0.99  # the off-white page is drawn
+
+
+def disc_at_the_edge_png(path, line=None):
+    """A blue disc whose left side runs 0.3 px past the canvas's edge, anti-aliased (drawn
+    8x and averaged), on a teal page; ``line``: a colour drawn over the disc's middle
+    seven pixels of the canvas's left column."""
+    big = Image.new("RGB", (64 * 8, 48 * 8), (42, 157, 143))
+    ImageDraw.Draw(big).ellipse((19.7 * 8 - 160, 24 * 8 - 160, 19.7 * 8 + 160, 24 * 8 + 160), fill=(41, 98, 255))
+    image = big.reduce(8)
+    if line is not None:
+        ImageDraw.Draw(image).line((0, 21, 0, 27), fill=line)
+    image.save(path)
+    return np.asarray(image, np.float32) / 255
+
+
+def test_remove_background_unmixes_a_shape_tangent_to_the_canvas_edge(tmp_path):
+    """The disc's blends along the canvas's left column have no page pixel beside them
+    (beyond the canvas counts as page): they are unmixed like any rim, so every pixel
+    left drawn is the disc's blue (they kept their blends, then traced as pixel-sized
+    pieces of other colours)."""
+    from vecfit.initial.tracer.background import without_background
+    target = disc_at_the_edge_png(tmp_path / "in.png")
+    page = np.array([42, 157, 143]) / 255
+    edge = target[:, 0, :3]
+    assert ((np.abs(edge - page).max(1) > 0.02) & (np.abs(edge - [41 / 255, 98 / 255, 1]).max(1) > 0.02)).sum() >= 4
+    out = without_background(np.concatenate([target, np.ones_like(target[..., :1])], 2), page)
+    shown = out[..., 3] > 0
+    assert np.abs(out[shown][:, :3] - np.array([41, 98, 255]) / 255).max() < 1.5 / 255
+    column = out[:, 0, 3]
+    assert ((column > 0.02) & (column < 0.98)).sum() >= 4  # the blends: partly covered, the page unmixed out
+    svg, report = vecfit.trace(tmp_path / "in.png", settings={
+        **FAST, "optimize": {**FAST["optimize"], "iterations": 0}, "trace": {"remove_background": True}})
+    assert paints(svg) == {"#2962ff"} and report["trace"]["paths"] == 1
+
+
+def test_remove_background_keeps_a_line_along_the_canvas_edge(tmp_path):
+    """A pixel on the canvas's edge that is no blend of the page and its inner neighbour
+    (a red line in the left column, over the disc) keeps its colour and stays opaque."""
+    from vecfit.initial.tracer.background import without_background
+    target = disc_at_the_edge_png(tmp_path / "in.png", line=(230, 20, 20))
+    out = without_background(np.concatenate([target, np.ones_like(target[..., :1])], 2),
+                             np.array([42, 157, 143]) / 255)
+    assert np.abs(out[21:28, 0, :3] - np.array([230, 20, 20]) / 255).max() < 1e-6
+    assert out[21:28, 0, 3].min() == 1.0
 
 
 # ------------------------------------------------------------------ colour layers

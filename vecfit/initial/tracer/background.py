@@ -9,8 +9,11 @@ logo's counters and holes show the page too; as a commercial tracer's "ignore wh
 a white eye on a white page goes with it). The anti-aliased rim around it is unmixed:
 each rim pixel is taken as the nearest shape pixel's colour over the background, with
 the coverage that explains it as its alpha, so the tracer places the edges between
-pixels as it does on a transparent image. The fit then runs on the original image over
-the background colour, which the written SVG leaves out.
+pixels as it does on a transparent image. Beyond the canvas counts as background: the
+edge pixels of a shape that touches the canvas's edge are rim too, unmixed where they are
+a blend (left mixed, they were traced as pixel-sized pieces of their own colours). The
+fit then runs on the original image over the background colour, which the written SVG
+leaves out.
 """
 from __future__ import annotations
 
@@ -21,6 +24,7 @@ from .quantize import to_lab
 
 BACKGROUND_DELTA_E = 6.0  # JPEG noise on a flat colour stays within 2-4 units
 BORDER = 2  # pixels of each edge looked at for the dominant colour
+EDGE_BLEND = 0.05  # RGB distance within which an edge pixel is a blend of the background and its inner neighbour
 
 
 def border_colour(rgb: np.ndarray) -> np.ndarray:
@@ -44,7 +48,12 @@ def without_background(image: np.ndarray, colour: np.ndarray) -> np.ndarray:
     out = np.array(image, np.float32, copy=True)
     background = background_mask(out[..., :3], colour)
     out[background, 3] = 0.0
-    rim = ~background & (cv2.dilate(background.astype(np.uint8), np.ones((3, 3), np.uint8)) > 0)
+    # beyond the canvas counts as background: a shape crossing the canvas's edge leaves
+    # blends there with no background pixel beside them (a logo tangent to the edge)
+    square = np.ones((3, 3), np.uint8)
+    beside = cv2.dilate(background.astype(np.uint8), square) > 0
+    beyond = np.pad(background, 1, constant_values=True).astype(np.uint8)
+    rim = ~background & (cv2.dilate(beyond, square)[1:-1, 1:-1] > 0)
     inner = ~background & ~rim
     if not rim.any() or not inner.any():
         return out
@@ -57,6 +66,11 @@ def without_background(image: np.ndarray, colour: np.ndarray) -> np.ndarray:
     bg = np.asarray(colour, np.float32)[:3]
     seen, towards = out[rim][:, :3] - bg, pure - bg
     coverage = (seen * towards).sum(1) / np.maximum((towards ** 2).sum(1), 1e-6)
-    out[rim, :3] = pure
+    # at the canvas's edge, away from any background pixel, only a blend is unmixed: a
+    # pixel of another colour than its inner neighbour's (a line along the edge) stays
+    blend = np.linalg.norm(seen - np.clip(coverage, 0.0, 1.0)[:, None] * towards, axis=1) <= EDGE_BLEND
+    keep = ~blend & ~beside[rim]
+    coverage = np.where(keep, 1.0, coverage)
+    out[rim, :3] = np.where(keep[:, None], out[rim][:, :3], pure)
     out[rim, 3] = np.clip(coverage, 0.0, 1.0) * out[rim, 3]
     return out
