@@ -528,7 +528,6 @@ def straighten(scene, measure, size: tuple[int, int], limit: float, tolerance: f
     return stats
 
 
-
 MAX_UNSEEN_CHECKS = 200  # subpaths checked by drop_unseen, the smallest first (two small renders each)
 UNSEEN_MARGIN = 2        # px around a subpath's box that its check renders
 
