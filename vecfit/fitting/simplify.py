@@ -447,6 +447,22 @@ def tidy(scene, measure, render_rgb, size: tuple[int, int], noise: float, max_er
             "mse_after": joins["mse_after"]}
 
 
+def _largest_within(count: int, within, coarse: int = 0) -> int:
+    """The largest k of 0..count for which ``within(k)`` holds (k = 0 is taken to, and not
+    asked): ``count`` first, then by bisection, which stops once its bounds are ``coarse``
+    apart or less and takes the lower (each ask is a render)."""
+    if count == 0 or within(count):
+        return count
+    lo, hi = 0, count - 1
+    while hi - lo > coarse:
+        mid = (lo + hi + 1) // 2
+        if within(mid):
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo
+
+
 STRAIGHT = 0.25  # px: a cubic that strays no further than this from its chord is tried as a line
 
 
@@ -512,17 +528,7 @@ def straighten(scene, measure, size: tuple[int, int], limit: float, tolerance: f
         stats["renders"] += 1
         return value <= limit
 
-    lo, hi = 0, len(found)
-    if within(hi):
-        lo = hi
-    else:
-        hi -= 1
-    while hi - lo > max(1, len(found) // 64):
-        mid = (lo + hi + 1) // 2
-        if within(mid):
-            lo = mid
-        else:
-            hi = mid - 1
+    lo = _largest_within(len(found), within, coarse=max(1, len(found) // 64))
     made(lo)
     stats["straightened"] = lo
     return stats
@@ -639,20 +645,12 @@ def drop_unseen(scene, render, target_rgb: np.ndarray, budget_db: float = 0.01) 
             break
         chosen.append((s, j))
         spent += max(cost, 0.0)
-    lo, hi = 0, len(chosen)
-    without(chosen)
-    if measure() <= limit:
-        lo = hi
-    else:
-        hi -= 1
-        while hi > lo:
-            mid = (lo + hi + 1) // 2
-            restore()
-            without(chosen[:mid])
-            if measure() <= limit:
-                lo = mid
-            else:
-                hi = mid - 1
+    def within(k):
+        restore()
+        without(chosen[:k])
+        return measure() <= limit
+
+    lo = _largest_within(len(chosen), within)
     restore()
     without(chosen[:lo])
     stats["dropped"] = lo
