@@ -109,17 +109,8 @@ def outline_density(scene: Scene, width: int, height: int) -> float:
     kitty and peppers: 0.20; vecfit's 3,000-path traces of skimage's photos: 0.45-0.91.
     The Monte Carlo backward's boundary samples are counted by this length."""
     scales = shape_pixel_scales(scene, width, height)
-    total = 0.0
-    for shape, scale in zip(scene.shapes, scales):
-        g = shape.geometry
-        if not isinstance(g, Path):
-            continue
-        p = np.asarray(to_numpy(g.points), np.float64)
-        for (first, count, closed), (p0, n) in zip(g.subpaths, g.subpath_point_ranges()):
-            q = p[p0:p0 + n]
-            if closed and n > 1:
-                q = np.concatenate([q, q[:1]])
-            total += scale * float(np.sqrt(((q[1:] - q[:-1]) ** 2).sum(1)).sum())
+    total = sum(scale * _outline_length(shape.geometry) for shape, scale in zip(scene.shapes, scales)
+                if isinstance(shape.geometry, Path))
     return total / max(width * height, 1)
 
 
