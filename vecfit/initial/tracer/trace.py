@@ -210,12 +210,9 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
             segments += sum(len(sp) for sp in subpaths)
             continue
         simplified = [straightened(sp, s.lines) for sp in subpaths]
-        if s.primitives and len(simplified) == 1 and sl.stop - sl.start == 1:
-            found = [as_primitive(outlines[sl.start], simplified[0], s.lines, ELLIPSE_TOLERANCE)]
-        elif s.primitives and spare > 0:
-            found = separate_primitives([outlines[k] for k in kept], simplified, s.lines, spare + 1)
-        else:
-            found = [None] * len(simplified)
+        # (a shape of one outline is one element either way: it may always be a primitive)
+        found = (separate_primitives([outlines[k] for k in kept], simplified, s.lines, max(spare, 0) + 1)
+                 if s.primitives else [None] * len(simplified))
         rest = [o for o, shape in zip(simplified, found) if shape is None]
         if rest:
             add_path(document, outline_path_data(rest), fill, evenodd=cut)
