@@ -63,7 +63,8 @@ def test_the_loop_uses_and_reports_the_rate_of_the_scene(count, rate):
     assert float(moved) == pytest.approx(rate, abs=1e-3)
 
 
-def test_the_boundary_budget_setting_reaches_the_renderer(monkeypatch):
+def budgets_seen(monkeypatch) -> list:
+    """The boundary budget of each render the loop makes from now on, in order."""
     seen = []
     real = loop.render
 
@@ -72,6 +73,11 @@ def test_the_boundary_budget_setting_reaches_the_renderer(monkeypatch):
         return real(*args, **kwargs)
 
     monkeypatch.setattr(loop, "render", spy)
+    return seen
+
+
+def test_the_boundary_budget_setting_reaches_the_renderer(monkeypatch):
+    seen = budgets_seen(monkeypatch)
     optimize(squares(4, 12.0), _target(), Settings.defaults(iterations=2, threads=1, boundary_budget=0.5))
     assert seen and set(seen) == {0.5}
 
@@ -116,14 +122,7 @@ def test_the_held_budget_is_the_lower_of_the_two_bounds(budget, growth, samples,
 ])
 def test_a_dense_scenes_boundary_samples_are_held_from_its_first_full_size_iteration(monkeypatch, count, growth,
                                                                                       expected):
-    seen = []
-    real = loop.render
-
-    def spy(*args, **kwargs):
-        seen.append(kwargs["boundary_budget"])
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(loop, "render", spy)
+    seen = budgets_seen(monkeypatch)
     optimize(squares(count, 12.0), _target(), Settings.defaults(iterations=3, threads=1, boundary_budget=2.0,
                                                                  boundary_samples=2.0, boundary_growth=growth))
     assert len(seen) == 4 and seen == pytest.approx([expected] * 4, rel=1e-5)
