@@ -40,6 +40,11 @@ _PROLOG_ITEM = re.compile(
     rb"\s+|<\?.*?\?>|<!--.*?-->|<!DOCTYPE(?:[^\[>]|\[.*?\])*>", re.DOTALL | re.IGNORECASE)
 
 
+def _has_declaration(data: bytes) -> bool:
+    """Whether the source opens with an XML declaration (after a byte-order mark)."""
+    return data.lstrip(b"\xef\xbb\xbf").startswith(b"<?xml")
+
+
 def _prolog(data: bytes) -> str:
     """What comes before the root element (comments, DOCTYPE), without the XML declaration,
     which ElementTree does not keep."""
@@ -105,10 +110,14 @@ class SvgDocument:
     against to write only what changed) and the root viewport's size in user units.
     """
 
-    def __init__(self, root: ET.Element, name, prolog: str = "", prefixes=()):
+    def __init__(self, root: ET.Element, name, prolog: str = "", prefixes=(), declaration: bool = False):
         self.root = root
         self.name = name
         self.prolog = prolog
+        # An XML declaration is written where the source had one; a generated document
+        # (a trace, a painting) has none: UTF-8 is XML's default, and the line is a tenth
+        # of a small icon's compressed bytes.
+        self.declaration = declaration
         self.prefixes = list(prefixes)
         self.handles = _handles(root)
         self._handle_of = {id(e): h for h, e in self.handles.items()}
@@ -153,7 +162,7 @@ class SvgDocument:
             raise SvgError(name, f"the root element <svg> is in the namespace {namespace!r}, not SVG's ({SVG_NS})")
         if local_name(root.tag) != "svg":
             raise SvgError(name, f"the root element is <{local_name(root.tag) or root.tag}>, not <svg>")
-        return cls(root, name, _prolog(data), builder.prefixes)
+        return cls(root, name, _prolog(data), builder.prefixes, _has_declaration(data))
 
     @classmethod
     def new(cls, width, height, name="<generated>") -> "NewDocument":
@@ -164,7 +173,7 @@ class SvgDocument:
     def copy(self) -> "SvgDocument":
         """An independent copy of the tree (for writing into), with its own handles and
         cascade; ``original`` and ``viewport`` are shared (they are never changed)."""
-        twin = SvgDocument(copy.deepcopy(self.root), self.name, self.prolog, self.prefixes)
+        twin = SvgDocument(copy.deepcopy(self.root), self.name, self.prolog, self.prefixes, self.declaration)
         twin.original, twin.viewport = self.original, self.viewport
         return twin
 
@@ -188,14 +197,16 @@ class SvgDocument:
     # ---------------------------------------------------------------- output
 
     def serialize(self) -> bytes:
-        """The document as UTF-8 SVG text: XML declaration, prolog, tree."""
+        """The document as UTF-8 SVG text: XML declaration (where the source had one),
+        prolog, tree."""
         for prefix, uri in self.prefixes:
             try:
                 ET.register_namespace(prefix, uri)
             except ValueError:
                 pass  # ns0-style prefixes: ElementTree makes its own
         text = ET.tostring(self.root, encoding="unicode")
-        return ('<?xml version="1.0" encoding="UTF-8"?>\n' + self.prolog + text + "\n").encode("utf-8")
+        head = '<?xml version="1.0" encoding="UTF-8"?>\n' if self.declaration else ""
+        return (head + self.prolog + text + "\n").encode("utf-8")
 
     def text(self) -> str:
         return self.serialize().decode("utf-8")

@@ -125,6 +125,16 @@ def test_new_document_handles_follow_the_reader():
         doc.add("rect", {"id": "a"})
 
 
+def test_xml_declaration_only_where_the_source_had_one():
+    generated = SvgDocument.new(10, 8).serialize()
+    assert generated.startswith(b"<svg")
+    assert SvgDocument.parse(SOURCE).serialize().startswith(b'<?xml version="1.0" encoding="UTF-8"?>\n<!-- drawn by hand -->')
+    bare = SvgDocument.parse(SOURCE.split("\n", 1)[1])
+    assert bare.serialize().startswith(b"<!-- drawn by hand -->") and bare.copy().serialize() == bare.serialize()
+    with_bom = SvgDocument.parse(b"\xef\xbb\xbf" + SOURCE.encode())
+    assert with_bom.copy().serialize().startswith(b"<?xml ")
+
+
 @pytest.mark.parametrize("d", ["M1 2 L5 1 L5 5 Z M6 6 Q7 7 8 6 C8 7 9 7 9 6 Z M2 8 L5 8",
                                "M0 0 C1 2 3 4 5 6 C7 8 9 9 0 0", "M3 3 C4 5 6 7 8 9 Z"])
 def test_path_data_round_trips(d):
