@@ -130,7 +130,7 @@ def render(inputs, output, out_dir, width, height, samples, mode, filter_, filte
     import vecfit
     from vecfit.errors import VecfitError
     from vecfit.io.colors import parse_background
-    from vecfit.io.images import save_png
+    from vecfit.io.png import save_png
     from vecfit.renderer.device import resolve as resolve_device
     from vecfit.renderer.forward import render_numpy
 

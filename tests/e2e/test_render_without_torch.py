@@ -15,7 +15,7 @@ import pytest
 
 import vecfit
 from vecfit.io.colors import parse_background
-from vecfit.io.images import save_png
+from vecfit.io.png import save_png
 from vecfit.renderer.forward import FLOAT_INPUTS, output_size, packed_for_core, render_numpy, renders_without_torch
 from vecfit.scene.arrays import numpy_arrays, to_numpy
 
@@ -41,11 +41,14 @@ def _render_command(*args, module: str = "torch") -> tuple[str, bool]:
     return out.stdout + out.stderr, (lines[-1] == "True") if lines else True
 
 
-def test_a_plain_render_imports_no_opencv(tmp_path):
-    """OpenCV's import is a tenth of a second, a fifth of the command: the reader and
-    the PNG writer have no use for it (issue 41: `vecfit render` within 3x resvg's)."""
-    output, cv2_loaded = _render_command(TIGER, "-o", tmp_path / "tiger.png", module="cv2")
-    assert "[1/1]" in output and not cv2_loaded, output
+@pytest.mark.parametrize("module", ["cv2", "PIL"])
+def test_a_plain_render_imports_no_image_library(tmp_path, module):
+    """OpenCV's import is a tenth of a second, a fifth of the command, and Pillow's image
+    plugins (which its PNG writer loads) another: the reader and the PNG writer have no
+    use for either (issue 41: `vecfit render` within 3x resvg's). Tiger writes its colours
+    in hex; a colour keyword would load Pillow's table of them."""
+    output, loaded = _render_command(TIGER, "-o", tmp_path / "tiger.png", module=module)
+    assert "[1/1]" in output and not loaded, output
 
 
 def _with_torch(svg, png, **options) -> bytes:

@@ -83,7 +83,7 @@ class TestWithoutCuda:
 
 
     def test_optimising_commands_refuse_cuda(self, tmp_path):
-        from vecfit.io.images import save_png
+        from vecfit.io.png import save_png
         save_png(torch.from_numpy(np.full((16, 16, 4), 0.5, np.float32)), tmp_path / "in" / "a.png")
         for args in (["trace", str(tmp_path / "in" / "a.png"), "-o", str(tmp_path / "a.svg")],
                      ["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--mode", "trace"]):

@@ -12,7 +12,7 @@ from urllib.parse import quote
 
 from PIL import Image
 
-from vecfit.io.images import atomic_write, atomic_write_text
+from vecfit.io.files import atomic_write, atomic_write_text
 from vecfit.io.orientation import upright_rgba
 from vecfit.io.report import GAP, save_report
 

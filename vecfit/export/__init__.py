@@ -74,7 +74,7 @@ def svg_to(svg, fmt: str, name: str = "the SVG", curves: str = "polyline") -> by
 
 def write(path, payload: bytes) -> None:
     """Bytes saved atomically (nothing half-written)."""
-    from vecfit.io.images import atomic_write
+    from vecfit.io.files import atomic_write
 
     def put(tmp):
         with open(tmp, "wb") as f:

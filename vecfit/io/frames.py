@@ -7,7 +7,8 @@ import numpy as np
 from PIL import Image
 
 from .compositing import composite
-from .images import atomic_write, to_uint8
+from .files import atomic_write
+from .png import to_uint8
 
 
 class FrameSaver:

@@ -1,10 +1,8 @@
-"""Reading and writing raster images; writes are atomic (temporary file, then rename),
-so an interrupted run never leaves a half-written output."""
+"""Reading raster images (files, bytes, PIL images, arrays), upright, as float RGBA; and
+scaling them to the working size. Writing: vecfit.io.png and vecfit.io.files."""
 from __future__ import annotations
 
 import os
-import sys
-import tempfile
 import warnings
 from pathlib import Path
 
@@ -15,46 +13,6 @@ from vecfit.errors import VecfitError
 from vecfit.limits import MAX_IMAGE_PIXELS
 
 from .orientation import upright_rgba
-
-
-def to_uint8(image: torch.Tensor | np.ndarray) -> np.ndarray:
-    torch = sys.modules.get("torch")  # (a tensor exists only once torch is imported)
-    is_tensor = torch is not None and isinstance(image, torch.Tensor)
-    a = image.detach().cpu().numpy() if is_tensor else np.asarray(image)
-    return (np.clip(a, 0, 1) * 255 + 0.5).astype(np.uint8)
-
-
-def atomic_write(path: str | os.PathLike, write) -> None:
-    """Calls write(tmp_path) for a temporary file next to path, then renames it over path."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        write(tmp)
-        # mkstemp makes the file private (0600); give it the permissions a plain open would
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
-def atomic_write_text(path: str | os.PathLike, text: str) -> None:
-    """Writes text (UTF-8, newlines as given) atomically, as atomic_write."""
-    def write(tmp):
-        with open(tmp, "w", encoding="utf-8", newline="") as f:
-            f.write(text)
-    atomic_write(path, write)
-
-
-def save_png(image, path: str | os.PathLike) -> None:
-    """Save an [H, W, 4] straight-RGBA float image as an 8-bit RGBA PNG."""
-    pixels = to_uint8(image)
-    atomic_write(path, lambda tmp: Image.fromarray(pixels, "RGBA").save(tmp, format="PNG"))
 
 
 def load_rgba(path: str | os.PathLike) -> np.ndarray:

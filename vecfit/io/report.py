@@ -9,7 +9,8 @@ import cv2
 import numpy as np
 from PIL import Image
 
-from .images import atomic_write, atomic_write_text, to_uint8
+from .files import atomic_write, atomic_write_text
+from .png import to_uint8
 
 PANEL_MAX = 512   # longest side of one panel of the comparison picture
 GAP = 4           # pixels between panels

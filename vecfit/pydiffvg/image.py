@@ -8,7 +8,7 @@ import torch
 
 from PIL import Image
 
-from vecfit.io.images import atomic_write
+from vecfit.io.files import atomic_write
 
 
 def imwrite(img, filename, gamma=2.2, normalize=False):

@@ -20,7 +20,7 @@ import warnings
 import numpy as np
 import torch
 
-from vecfit.io.images import atomic_write_text
+from vecfit.io.files import atomic_write_text
 from vecfit import scene as vs
 from vecfit.scene.geometry import local_bbox, rect_path
 from vecfit.svg.numbers import finite, fmt

@@ -8,19 +8,26 @@ Out-of-range components are clamped, as browsers and resvg do.
 from __future__ import annotations
 
 import colorsys
+import functools
 import math
 import re
-
-from PIL import ImageColor
 
 from .units import NUMBER
 
 RGBA = tuple[float, float, float, float]
 
-# Copied once: Pillow caches parsed tuples back into its own table.
-_NAMES = {name: tuple(c / 255.0 for c in ImageColor.getrgb(name)) + (1.0,)
-          for name in list(ImageColor.colormap)}
-_NAMES["transparent"] = (0.0, 0.0, 0.0, 0.0)
+
+@functools.cache
+def _names() -> dict[str, RGBA]:
+    """CSS's colour keywords, from Pillow's table, copied once (Pillow caches parsed tuples
+    back into its own table), at the first keyword met: importing Pillow costs `vecfit
+    render` a twentieth of a second, and many files write only hex colours."""
+    from PIL import ImageColor
+
+    names = {name: tuple(c / 255.0 for c in ImageColor.getrgb(name)) + (1.0,)
+             for name in list(ImageColor.colormap)}
+    names["transparent"] = (0.0, 0.0, 0.0, 0.0)
+    return names
 
 _HEX = re.compile(r"#([0-9a-fA-F]{3,8})$")
 # The function's name; its arguments are what lies between "(" and the closing ")",
@@ -47,7 +54,7 @@ def parse_color(text) -> RGBA | None:
         body = text[m.end():-1].strip()
         if "\n" not in body:  # (as the pattern before: a line break only beside the parentheses)
             return _function(m.group(1).lower(), body)
-    return _NAMES.get(text.lower())
+    return _names().get(text.lower())
 
 
 def _hex(digits: str) -> RGBA | None:

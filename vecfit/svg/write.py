@@ -22,7 +22,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from vecfit.errors import VecfitError
-from vecfit.io.images import atomic_write
+from vecfit.io.files import atomic_write
 from vecfit.scene.arrays import to_numpy
 from vecfit.scene import (Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect,
                                    Scene, Solid)
