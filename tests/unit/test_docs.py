@@ -59,6 +59,58 @@ def test_results_keep_no_dated_history():
     assert "not re-run since" not in results
 
 
+# Sections that other work is editing; the lead condenses them after merging (then drop them here).
+NOT_YET_CONDENSED = ("Long paths (", "The user's colours (", "GPU (")
+HISTORY_WORDS = re.compile(r"\b(before|after|tried|dropped|session \d+|branch|current)\b", re.I)
+DATE = re.compile(r"\b20\d\d-\d\d-\d\d\b")
+MEASURED = re.compile(r"\bMeasured 20\d\d-\d\d-\d\d\b")
+COMMAND = re.compile(r"`(?:python|make|vecfit|cd benchmarks)\b[^`]*`")
+
+
+def results_sections(text: str) -> dict:
+    """RESULTS.md's `## ` sections by heading, less those not condensed yet."""
+    sections = {part.splitlines()[0]: part for part in re.split(r"^## ", text, flags=re.M)[1:]}
+    return {h: body for h, body in sections.items() if not h.startswith(NOT_YET_CONDENSED)}
+
+
+def check_results_hold_current_tables(text: str) -> list:
+    """What keeps RESULTS.md from being one current table per benchmark: a `### ` heading
+    that dates a measurement or tells its history (before, after, a session, a branch), or a
+    benchmark's section (its heading names a script) with no paragraph that says when it was
+    "Measured YYYY-MM-DD" and gives the command that reproduces it."""
+    problems = []
+    for heading, body in results_sections(text).items():
+        for sub in re.findall(r"^### (.*)$", body, re.M):
+            if DATE.search(sub) or HISTORY_WORDS.search(sub):
+                problems.append(f"{heading}: ### {sub}")
+        if ".py`" in heading:
+            paragraphs = re.split(r"\n\s*\n", body)
+            if not any(MEASURED.search(p) and COMMAND.search(p[MEASURED.search(p).start():])
+                       for p in paragraphs):
+                problems.append(f"{heading}: no 'Measured <date> ... `command`' paragraph")
+    return problems
+
+
+def test_results_hold_one_current_table_per_benchmark():
+    results = (ROOT / "benchmarks" / "RESULTS.md").read_text(encoding="utf-8")
+    assert len(results_sections(results)) >= 25
+    assert check_results_hold_current_tables(results) == []
+
+
+def test_the_check_finds_dated_history_and_missing_provenance():
+    section = ("## Tracing (`trace.py`)\n\nMeasured 2026-11-26, the 2-core machine: "
+               "`python benchmarks/trace.py`.\n\n| a | b |\n")
+    assert check_results_hold_current_tables(section) == []
+    dated = section + "\n### The trace alone (2026-11-26)\n\ntext\n"
+    told = section + "\n### Colour counts, before and after\n\ntext\n"
+    bare = "## Tracing (`trace.py`)\n\nThe trace, 2026-11-26.\n\n| a | b |\n"
+    no_command = "## Tracing (`trace.py`)\n\nMeasured 2026-11-26 on the 2-core machine.\n"
+    for text in (dated, told, bare, no_command):
+        assert len(check_results_hold_current_tables(text)) == 1, text
+    kept = "## GPU (`gpu.py`)\n\n### Current (2026-11-28, session 15)\n"
+    assert check_results_hold_current_tables(kept) == []
+
+
 @pytest.mark.parametrize("doc", DOCS)
 def test_every_relative_link_and_anchor_leads_somewhere(doc):
     path = ROOT / doc
