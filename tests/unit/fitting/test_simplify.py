@@ -9,7 +9,7 @@ import pytest
 import torch
 
 import vecfit
-from vecfit.fitting.simplify import drop_unseen, fit_pairs, reduce_nodes, straighten
+from vecfit.fitting.simplify import _apart, drop_unseen, fit_pairs, reduce_nodes, straighten
 from vecfit.renderer.raster import render
 from vecfit.scene import Path, Scene, Shape, Solid
 from vecfit.scene.segments import layout_of, split_at
@@ -164,6 +164,27 @@ def test_a_sliver_and_a_hidden_piece_are_dropped_and_a_small_shape_kept():
     kept = speck_scene()
     stats = drop_unseen(kept, rgb_at, rgb(kept, 8))
     assert stats["dropped"] == 1 and len(kept.shapes[0].geometry.subpaths) == 3  # (the island went)
+
+
+def test_subpaths_whose_boxes_do_not_meet_are_judged_in_one_render():
+    """drop_unseen judges subpaths apart from one another together: their boxes are
+    grouped so that none in a group meets another (boxes that only touch do not meet)."""
+    boxes = [(0, 0, 10, 10), (5, 5, 15, 15), (10, 0, 20, 10), (12, 12, 30, 30), (40, 40, 50, 50)]
+    groups = _apart([(0.0, 0, k, box) for k, box in enumerate(boxes)])
+    assert [[c[2] for c in g] for g in groups] == [[0, 2, 3, 4], [1]]
+    for g in groups:
+        for a in g:
+            for b in g:
+                if a is not b:
+                    (ax0, ay0, ax1, ay1), (bx0, by0, bx1, by1) = a[3], b[3]
+                    assert ax1 <= bx0 or bx1 <= ax0 or ay1 <= by0 or by1 <= ay0
+    # the speck scene's three candidates lie apart: one render with everything, one
+    # without the three, then the whole picture's checks of the bisection
+    seen = []
+    target = rgb(speck_scene(sliver=False), 8)
+    stats = drop_unseen(speck_scene(), lambda s, w, h: seen.append((w, h)) or rgb_at(s, w, h), target)
+    assert stats["candidates"] == 3 and stats["renders"] == len(seen) <= 2 + 2
+    assert seen[:2] == [(64, 64), (64, 64)]
 
 
 def outline_scene(right: list, top_flat: bool = True) -> Scene:
