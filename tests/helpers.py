@@ -1,5 +1,6 @@
 """Small helpers the test modules share: the CLI runner, quiet SVG loading, skipping when
-shared data is missing, skimage photos as small PNG targets, and the core's test switches."""
+shared data is missing, skimage photos as small PNG targets, a shape tangent to the
+canvas's edges, and the core's test switches."""
 from __future__ import annotations
 
 import contextlib
@@ -61,6 +62,18 @@ def photo_png(tmp_path_factory, name: str, size: tuple[int, int]) -> Path:
     folder = tmp_path_factory.mktemp(name)
     Image.fromarray(getattr(skimage.data, name)()).resize(size, Image.LANCZOS).save(folder / f"{name}.png")
     return folder / f"{name}.png"
+
+
+def rounded_diamond(x, y, size=128, half=40.0, radius=24.0):
+    """Signed distance (px) to a square standing on its corner (its corners ``half`` from
+    the centre) rounded by ``radius``: at half + radius = size / 2 it touches the four
+    sides of a size x size canvas at their middles, as logos-005 does."""
+    import numpy as np
+
+    u, v = np.abs(x - size / 2), np.abs(y - size / 2)
+    t = np.clip((half - u + v) / (2 * half), 0, 1)
+    dist = np.hypot(u - half * (1 - t), v - half * t)
+    return np.where(u + v <= half, -dist, dist) - radius
 
 
 def two_shapes_png(path: Path):

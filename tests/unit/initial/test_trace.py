@@ -131,6 +131,37 @@ def test_circle_fit_within_tolerance(tolerance):
     assert np.abs(radius - 20).max() <= tolerance
 
 
+def test_an_outline_tangent_to_the_canvas_edge_is_fitted_closer():
+    """A loop without corners that touches the canvas's edge is fitted within
+    EDGE_TOLERANCE of the tolerance (its cubics as the fit at that tolerance gives them,
+    more of them, closer to the shape); a loop off the edge and one with corners on it
+    are fitted as without the canvas."""
+    from helpers import rounded_diamond
+    from vecfit.initial.tracer import bezier
+    from vecfit.initial.tracer.outlines import crack_outlines
+
+    ys, xs = np.mgrid[0:128, 0:128] + 0.5
+    tangent, = crack_outlines(rounded_diamond(xs, ys) <= 0)
+    off_edge, = crack_outlines(np.hypot(xs - 64, ys - 64) <= 30)
+    square = square_outline(0.0, 40.0, 30.0, 20.0)  # along the left edge, four corners
+    canvas = (128, 128)
+    fitted = bezier.fit_outlines([tangent, off_edge, square], 1.0, 135.0, canvas=canvas)
+    plain = bezier.fit_outlines([tangent, off_edge, square], 1.0, 135.0)
+    closer = bezier.fit_outlines([tangent], bezier.EDGE_TOLERANCE, 135.0)[0]
+    np.testing.assert_array_equal(fitted[0], closer)
+    assert len(fitted[0]) > len(plain[0])
+    for k in (1, 2):
+        np.testing.assert_array_equal(fitted[k], plain[k])
+
+    def error(segs):
+        curve = np.concatenate([bezier_at(c, np.linspace(0, 1, 64)) for c in segs])
+        return np.abs(rounded_diamond(curve[:, 0], curve[:, 1])).max()
+    assert error(fitted[0]) <= 0.35 < 0.45 <= error(plain[0])
+    # a canvas the loop does not reach: as without one
+    np.testing.assert_array_equal(bezier.fit_outlines([tangent + 2], 1.0, 135.0, canvas=(132, 132))[0],
+                                  bezier.fit_outlines([tangent + 2], 1.0, 135.0)[0])
+
+
 def test_path_budget_is_respected():
     image = small_photo("chelsea", (96, 64))
     full = trace_image(image)

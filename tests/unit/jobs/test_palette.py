@@ -10,7 +10,7 @@ import pytest
 from PIL import Image, ImageDraw
 
 import vecfit
-from helpers import run, two_shapes_png
+from helpers import rounded_diamond, run, two_shapes_png
 from vecfit.errors import VecfitError
 from vecfit.fitting.metrics import compare, to_rgb
 from vecfit.jobs.palette import auto_palette, from_lab, parse_palette, to_lab, written_colours
@@ -255,6 +255,30 @@ def test_remove_background_keeps_a_line_along_the_canvas_edge(tmp_path):
                              np.array([42, 157, 143]) / 255)
     assert np.abs(out[21:28, 0, :3] - np.array([230, 20, 20]) / 255).max() < 1e-6
     assert out[21:28, 0, 3].min() == 1.0
+
+
+def test_remove_background_fits_a_shape_tangent_to_the_canvas_edge_closer(tmp_path, monkeypatch):
+    """A rounded diamond touching the canvas's four sides (logos-005's shape): with the page
+    removed its outline is one loop without corners that touches the edge, fitted within
+    half the tolerance (bezier.EDGE_TOLERANCE); at the full tolerance, as before, its two
+    halves took fewer cubics and the unrefined trace scored 3 dB lower over the page."""
+    from vecfit.initial.tracer import bezier
+    off = (np.arange(8) + 0.5) / 8
+    ys = (np.arange(64)[:, None] + off).ravel()
+    cover = (rounded_diamond(ys[None, :], ys[:, None], 64, 20.0, 12.0) <= 0).reshape(64, 8, 64, 8).mean((1, 3))
+    page, blue = np.array([42, 157, 143]) / 255, np.array([41, 98, 255]) / 255
+    image = np.rint((cover[..., None] * blue + (1 - cover[..., None]) * page) * 255).astype(np.uint8)
+    Image.fromarray(image).save(tmp_path / "in.png")
+    target = np.concatenate([image / 255, np.ones((64, 64, 1))], 2)
+    settings = {**FAST, "optimize": {**FAST["optimize"], "iterations": 0}, "trace": {"remove_background": True}}
+    scores = {}
+    for closer in (1.0, 0.5):
+        monkeypatch.setattr(bezier, "EDGE_TOLERANCE", closer)
+        svg, report = vecfit.trace(tmp_path / "in.png", settings=settings)
+        assert paints(svg) == {"#2962ff"} and drawn(svg, 64, 64)[:4, :4, 3].max() < 0.01
+        scores[closer] = (psnr_over(svg, target, (*page, 1.0)), report["trace"]["segments"])
+    assert scores[0.5][1] > scores[1.0][1]
+    assert scores[0.5][0] > scores[1.0][0] + 2
 
 
 # ------------------------------------------------------------------ colour layers

@@ -24,6 +24,8 @@ NEWTON_STEPS = 4
 NEWTON_RANGE = 4.0  # try reparameterising only when the error is within this many tolerances
 MAX_TURN = np.radians(200)  # most a single cubic may turn (a half circle is 180)
 TANGENT_REACH = 2.0  # pixels either side from which a tangent is taken
+EDGE_REACH = 0.5  # an outline with a point this close to the canvas's edge (pixels) touches it
+EDGE_TOLERANCE = 0.5  # an outline without corners that touches the canvas's edge is fitted this much closer
 
 
 # ------------------------------------------------------- all outlines, cut at corners
@@ -232,6 +234,21 @@ def _fit_all(st: Stretches, s: np.ndarray, tangents: np.ndarray, t1, t2, tol: fl
                                f64(t1), f64(t2), options)
 
 
+def _fit_closer(st: Stretches, s: np.ndarray, tangents: np.ndarray, t1, t2, tol: float, closer: np.ndarray,
+                closer_tol: float):
+    """_fit_all of every stretch within tol, then of the stretches `closer` (a mask) within
+    closer_tol in place of theirs (the others' cubics are those of the fit of all, bit for
+    bit: a fit of fewer stretches rounds their arc lengths differently)."""
+    ctrl, stretch_of = _fit_all(st, s, tangents, t1, t2, tol)
+    k = np.flatnonzero(closer)
+    rows = np.flatnonzero(np.repeat(closer, st.lengths))
+    ctrl2, of2 = _fit_all(Stretches(s[rows], st.lengths[k]), s[rows], tangents[rows], t1[k], t2[k], closer_tol)
+    keep = ~closer[stretch_of]
+    stretch_of = np.concatenate([stretch_of[keep], k[of2]])
+    order = np.argsort(stretch_of, kind="stable")
+    return np.concatenate([ctrl[keep], ctrl2])[order], stretch_of[order]
+
+
 def _medians(values: np.ndarray, group: np.ndarray, valid: np.ndarray, wanted: np.ndarray) -> np.ndarray:
     """np.median of the valid values of each group in `wanted` (a mask over the groups),
     in group order, for groups with at least one value."""
@@ -240,7 +257,8 @@ def _medians(values: np.ndarray, group: np.ndarray, valid: np.ndarray, wanted: n
 
 
 def fit_outlines(outlines: list[np.ndarray], tolerance: float, corner_angle: float,
-                 smoothing: float = 1.0, corner_window: float = 3.0) -> list[np.ndarray]:
+                 smoothing: float = 1.0, corner_window: float = 3.0,
+                 canvas: tuple[float, float] | None = None) -> list[np.ndarray]:
     """Cubic segments [S, 4, 2] of each closed outline (each segment starts where the
     previous one ends, the last ends at the first's start). Outlines: [N, 2] points,
     evenly spaced and all alike (the tracer's have a vertex every half pixel).
@@ -248,7 +266,15 @@ def fit_outlines(outlines: list[np.ndarray], tolerance: float, corner_angle: flo
     The outline is smoothed (Gaussian, sigma `smoothing` pixels) to iron out the pixel
     staircase, and the fit is to the smoothed copy, so the staircase does not eat into
     the tolerance. corner_window (pixels) is how far either side the corner angle is
-    measured."""
+    measured.
+
+    canvas: the canvas's size (w, h). An outline without corners that touches its edge
+    (a logo tangent to it) is fitted within EDGE_TOLERANCE times the tolerance: over a
+    page, the page's pieces between it and the edge cut it at the tangent points into
+    stretches with corners, each fitted on its own; without them (the page removed, a
+    transparent image) its two halves took fewer cubics, too few for the refinement,
+    which adds no nodes, to follow where its arcs meet its straight runs. None: no
+    canvas, the tolerance for all."""
     result = [np.zeros((0, 4, 2)) for _ in outlines]
     if not outlines:
         return result
@@ -281,7 +307,16 @@ def fit_outlines(outlines: list[np.ndarray], tolerance: float, corner_angle: flo
     given = ~np.isnan(given1[:, 0])
     t1 = np.where(given[:, None], given1, _unit(s[first + m] - s[first]))
     t2 = np.where(given[:, None], given2, _unit(s[last - m] - s[last]))
-    ctrl, stretch_of = _fit_all(st, s, tangents, t1, t2, tolerance)
+    edge = np.zeros(len(used), bool)
+    if canvas is not None:
+        p = loops.points
+        near = np.minimum(np.minimum(p[:, 0], canvas[0] - p[:, 0]), np.minimum(p[:, 1], canvas[1] - p[:, 1]))
+        edge = np.bincount(loops.owner[near <= EDGE_REACH], minlength=len(used)) > 0
+    edge = edge[owner] & given  # (only an outline without corners has given tangents)
+    if edge.any():
+        ctrl, stretch_of = _fit_closer(st, s, tangents, t1, t2, tolerance, edge, EDGE_TOLERANCE * tolerance)
+    else:
+        ctrl, stretch_of = _fit_all(st, s, tangents, t1, t2, tolerance)
     outline_of = owner[stretch_of]  # sorted: stretches are in outline order
     bounds = np.searchsorted(outline_of, np.arange(len(used) + 1))
     for k, i in enumerate(used.tolist()):

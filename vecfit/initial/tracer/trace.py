@@ -182,7 +182,7 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
         outlines = smoothed_under_strokes(outlines, covered)
     report("fit", 0.7)
     # one batched fit of all outlines (see bezier.py)
-    fitted = fit_outlines(outlines, s.tolerance, s.corner_angle, s.smoothing)
+    fitted = fit_outlines(outlines, s.tolerance, s.corner_angle, s.smoothing, canvas=(w, h))
 
     if palette is not None:  # exactly the palette's colours
         palette_rgb = np.asarray(palette, np.float64).reshape(-1, 3) / 255.0
