@@ -77,6 +77,7 @@ def test_tiger_renders_without_torch_as_with_it(tmp_path, args, options):
     assert out.read_bytes() == _with_torch(TIGER, tmp_path / "expected.png", **options)
 
 
+@pytest.mark.slow
 def test_files_that_need_torch_render_as_before(tmp_path):
     """--out-dir with a file that needs torch (a gradient) among others: each PNG is
     vecfit.render's, and the reader's warning (a <text>) is said once."""
@@ -121,6 +122,7 @@ def test_render_numpy_packs_what_vecfit_render_packs(svg):
         assert np.array_equal(render_numpy(plain, **options), vecfit.render(tensors, **options).numpy())
 
 
+@pytest.mark.slow
 def test_ctrl_c_while_a_render_imports_torch(tmp_path):
     """A file that needs torch imports it once read, with Ctrl-C held until the import is
     done (cli/commands.py): exit 130, no traceback. (tests/e2e/test_interrupt.py's rect

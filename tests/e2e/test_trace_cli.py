@@ -18,6 +18,7 @@ def coffee(tmp_path_factory):
     return photo_png(tmp_path_factory, "coffee", (96, 64))
 
 
+@pytest.mark.slow
 def test_trace_and_refine(coffee, tmp_path):
     """A 96 x 64 photo, at most 60 paths: the trace parses, renders, keeps the budget, and
     30 iterations of refinement gain >= 1 dB (measured ~2.5 dB)."""

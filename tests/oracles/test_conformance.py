@@ -44,6 +44,7 @@ def test_case(case):
                       f"(need {conf.PASS_DB}); see tests/failures/conformance/{case.name}.png")
 
 
+@pytest.mark.slow
 def test_pass_rate():
     """At least 97% of all cases pass (known deviations count as failures). Below the bar
     the test fails, unless every failing case is a documented deviation of the reference

@@ -10,6 +10,8 @@ scale, vecfit does likewise but their pictures differ there), and dash lengths i
 failing cases are written to tests/failures/resvg-suites.txt."""
 from __future__ import annotations
 
+import pytest
+
 import resvg_suites as suites
 from shared_data import FAILURES
 
@@ -17,6 +19,7 @@ from shared_data import FAILURES
 # paths, masks, filters and dashes): a change that loses cases fails the test.
 FLOOR = 0.95
 
+@pytest.mark.slow
 def test_resvg_suites_render_as_resvg_draws_them():
     results = suites.score(suites.load_cases())
     assert results, "no cases found in tests/oracles/resvg_suites"

@@ -188,6 +188,7 @@ def _lineart_check(path: Path, curves: str):
     assert hausdorff(drawn, source) <= (0.05 if curves == "polyline" else 0.02), path.name
 
 
+@pytest.mark.slow
 def test_some_lineart_icons():
     for path in sorted(need(LINEART).glob("*.svg"))[::15]:
         for curves in ("polyline", "spline"):

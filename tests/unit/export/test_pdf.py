@@ -101,6 +101,7 @@ def test_filters_are_dropped_with_a_warning():
         svg_to(text, "pdf")
 
 
+@pytest.mark.slow
 def test_every_lineart_icon():
     """All 120 icons at 512 px: each >= 35 dB. (At their own 24 px nearly every inked pixel
     is an edge, and two renderers' anti-aliasing differs by more than the bar: PDFium and

@@ -37,6 +37,7 @@ def decimals(svg: str) -> int:
     return max((len(n) for n in numbers), default=0)
 
 
+@pytest.mark.slow
 def test_dense_photo_trace_has_no_crossed_outline():
     svg, report = vecfit.trace(small_photo("astronaut", 160),
                                settings={"trace": {"paths": 600}, "optimize": {"iterations": 25, "seed": 2}})

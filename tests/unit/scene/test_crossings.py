@@ -247,6 +247,7 @@ def test_random_polygons_match_the_brute_force_reference():
     assert total > 500  # the polygons did cross, a lot
 
 
+@pytest.mark.slow
 def test_degenerate_grid_polygons_agree_with_any_small_perturbation():
     """On a 4 x 4 grid, polygons touch and overlap themselves everywhere. A small perturbation
     turns each place where two passes meet into proper crossings: an odd number where they
