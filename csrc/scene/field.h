@@ -78,8 +78,8 @@ struct SampleGrid {
 // A stroke item's signed distance bounded from below, for the long stroke entries: the
 // tile's items are listed with their boxes, but where a long path's pieces crowd (30,000
 // curves across a 64 px canvas: 19,000 pieces listed in a tile, 2,000 of whose boxes
-// hold each pixel) reading each piece whose box holds a sample (384 bytes, scattered over
-// hundreds of megabytes) was most of the analytical pass. These records (64 bytes, one
+// hold each pixel) reading each piece whose box holds a sample (448 bytes, scattered over
+// hundreds of megabytes) was most of the analytical pass. These records (56 bytes, one
 // per stroke item, in item order, made once per pass) set aside the pieces that cannot
 // lower a sample's distance so far:
 //   * the sweep and the butt ends: farther than the distance from q to the box of the
