@@ -425,6 +425,7 @@ bool render_backward(const PreparedScene& prepared, const SceneArrays& a, const 
     };
     const bool fields = o.mode == MODE_ANALYTIC && !o.brute_force;
     std::optional<PhaseTimer> timer(PHASE_BACKWARD_INTERIOR);
+    const std::vector<StrokeBound> stroke_bound = fields ? stroke_bounds(sc, bins, lanes) : std::vector<StrokeBound>();
     ThreadPool::instance().parallel_for(lanes, lanes, [&](int lane, int) {
         const GradView g = grads[lane].view();
         LaneLists lists(sizes);
@@ -439,7 +440,8 @@ bool render_backward(const PreparedScene& prepared, const SceneArrays& a, const 
             FieldView view;
             if (fields && bins.count(tile) > 0 && !cancelled() && any_adjoint(plan.gpix.data(), W, x0, y0, x1, y1)) {
                 grid.build(bins, tile, W, H, plan.options.samples, plan.options.filter_radius);
-                tile_fields.compute(sc, bins, tile, grid, plan.options.filter_radius, true);
+                tile_fields.compute(sc, bins, tile, grid, plan.options.filter_radius, true,
+                                    stroke_bound.empty() ? nullptr : stroke_bound.data());
                 view = tile_fields.view();
             }
             for (int y = y0; y < y1 && !cancelled(); ++y)

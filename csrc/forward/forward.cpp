@@ -187,6 +187,8 @@ void render_forward(const PreparedScene& prepared, const RenderOptions& o, float
     std::vector<SampleGrid> grids(fields ? threads : 0);
     std::vector<TileFields> tile_fields(fields ? threads : 0);
     PhaseTimer timer(PHASE_FORWARD);
+    // (and its long stroke entries, with their items' bounds)
+    const std::vector<StrokeBound> stroke_bound = fields ? stroke_bounds(sc, bins, threads) : std::vector<StrokeBound>();
     ThreadPool::instance().parallel_for(bins.nx * bins.ny, threads, [&](int tile, int worker) {
         if (by_entry) {
             if (!cancelled()) tile_forward(sc, bins, s, plan.background, tile, out, scratch[worker]);
@@ -195,7 +197,8 @@ void render_forward(const PreparedScene& prepared, const RenderOptions& o, float
         FieldView view;
         if (fields && bins.count(tile) > 0 && !cancelled()) {
             grids[worker].build(bins, tile, W, H, s.samples, s.filter_radius);
-            tile_fields[worker].compute(sc, bins, tile, grids[worker], s.filter_radius, false);
+            tile_fields[worker].compute(sc, bins, tile, grids[worker], s.filter_radius, false,
+                                        stroke_bound.empty() ? nullptr : stroke_bound.data());
             view = tile_fields[worker].view();
         }
         int tx = tile % bins.nx, ty = tile / bins.nx;

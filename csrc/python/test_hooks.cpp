@@ -16,6 +16,7 @@
 #include "common/ellipse.h"
 #include "common/roots.h"
 #include "python/arrays.h"
+#include "python/scene_arrays.h"
 #include "scene/coverage.h"
 #include "scene/field.h"
 #include "scene/scene.h"
@@ -67,6 +68,36 @@ void register_test_hooks(py::module_& m) {
         field_min_items_ref() = n;
         return old;
     }, py::arg("n"));
+
+    m.def("stroke_bound_gaps", [](const py::dict& scene, Array<double> points) {
+        // For every stroke item of the scene (a packed scene dict, pack.py) and every point
+        // (pixel space, [n, 2]): its lower bound (scene/field.h, StrokeBound) less its signed
+        // distance (stroke_item_sdf with the sweep always measured, the least over limits),
+        // in stroke space. Returns the largest gap (> 0: a bound above a distance), the mean
+        // and the number of pairs at a finite distance.
+        if (points.ndim() != 2 || points.shape(1) != 2) throw std::invalid_argument("points must be [n, 2]");
+        python::SceneInput in = python::scene_input(scene);
+        const PreparedScene sc = prepare_scene(in.arrays());
+        double most = -INFINITY, sum = 0;
+        long n = 0;
+        for (const PreparedDraw& d : sc.draws) {
+            if (d.kind != DRAW_STROKE || d.is_ellipse) continue;
+            for (int k = d.first_item; k < d.first_item + d.n_items; ++k) {
+                const StrokeSegment& s = sc.stroke_items[k];
+                const StrokeBound b = make_stroke_bound(s);
+                for (py::ssize_t i = 0; i < points.shape(0); ++i) {
+                    const Vec2 q = to_stroke_space(d, {points.at(i, 0), points.at(i, 1)});
+                    const double v = stroke_item_sdf(sc.stroke_items.data(), s, q, 1e300);
+                    if (!(v < 1e299)) continue;
+                    const double gap = stroke_bound_below(b, q) - v;
+                    most = std::max(most, gap);
+                    sum += gap;
+                    ++n;
+                }
+            }
+        }
+        return py::make_tuple(most, n > 0 ? sum / n : 0.0, n);
+    }, py::arg("scene"), py::arg("points"));
 
     m.def("boundary_pixels", [](std::pair<double, double> p, std::pair<double, double> n, double R, int W, int H) {
         // The pixels a Monte Carlo boundary sample at p (outward normal n) counts for.

@@ -389,6 +389,7 @@ struct AllItems {
     VF_HD int size() const { return n; }
     VF_HD int operator[](int i) const { return i; }
     VF_HD bool may_reach(int, Vec2, double) const { return true; }
+    VF_HD bool may_beat(int, Vec2, double) const { return true; }
 };
 
 VF_HD Vec2 to_stroke_space(const PreparedDraw& d, Vec2 p) {
@@ -566,6 +567,9 @@ VF_HD double stroke_sdf(const SceneView& sc, const PreparedDraw& d, const Items&
             // sweep's gate bound an item's distance from below, whatever their sign.
             double reach = vmin(limit, sd * d.metric_scale);
             if (!items.may_reach(i, p, reach)) continue;
+            // (a bound of the item's signed distance below, where the items carry one: an
+            // item it puts at sd or farther cannot lower sd, and is not read)
+            if (!items.may_beat(i, q, sd)) continue;
             Box b = grown(all[items[i]].box, reach);
             if (p.x < b.x0 || p.x > b.x1 || p.y < b.y0 || p.y > b.y1) continue;
             double v = stroke_item_sdf(sc.stroke_items.data(), all[items[i]], q, reach / d.metric_scale,

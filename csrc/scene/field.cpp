@@ -6,6 +6,9 @@
 #include <cfloat>
 #include <cmath>
 
+#include "common/float_bounds.h"
+#include "common/thread_pool.h"
+
 namespace vf {
 
 int& field_min_items_ref() {
@@ -16,12 +19,6 @@ int& field_min_items_ref() {
 }
 
 namespace {
-
-// A double as a float no smaller.
-float float_above(double v) {
-    float f = (float)v;
-    return (double)f < v ? std::nextafter(f, INFINITY) : f;
-}
 
 // About how long a capsule is (pixels), and the most a sub-piece is cut into: a capsule a
 // pixel long lies within about 1 / (8 x radius of curvature) of its curve, which sets
@@ -36,6 +33,69 @@ double box_distance2(const Box& a, const Box& b) {
 
 }  // namespace
 
+StrokeBound make_stroke_bound(const StrokeSegment& s) {
+    StrokeBound b;
+    const Vec2 o = s.seg.p[0];
+    b.ox = o.x;
+    b.oy = o.y;
+    b.ux = (float)s.frame_u.x;
+    b.uy = (float)s.frame_u.y;
+    b.s0 = float_below(s.s_min);
+    b.s1 = float_above(s.s_max);
+    b.n0 = float_below(s.n_min);
+    b.n1 = float_above(s.n_max);
+    // the control points as the floats' frame sees them: off by up to about 2^-23 of their
+    // distance from o (the frame's rounding) each way
+    const double extent = 1.5 * (vmax(std::fabs(s.s_min), std::fabs(s.s_max)) + vmax(std::fabs(s.n_min), std::fabs(s.n_max)));
+    // An end piece's anchor (a point its reach is measured from) and reach (see StrokeBound).
+    auto piece = [](const StrokeEnd& e, Vec2& anchor) -> double {
+        switch (e.kind) {
+            case StrokeEnd::DISK: anchor = e.center; return e.hw;
+            case StrokeEnd::SQUARE: anchor = e.center; return e.hw * 1.41421357;
+            case StrokeEnd::POLYGON: {
+                anchor = e.poly[0];
+                double r = 0;
+                for (int i = 1; i < e.n_poly; ++i) r = vmax(r, distance(e.poly[i], anchor));
+                return r;
+            }
+            default: return -1;
+        }
+    };
+    double sweep = vmax(s.hw_max, vmax(s.start.hw, s.end.hw));
+    Vec2 anchor;
+    double reach = piece(s.start, anchor);
+    if (reach >= 0) sweep = vmax(sweep, reach + distance(anchor, o));  // (the anchor is o itself)
+    b.sweep = float_above(sweep + 2.5e-7 * extent);
+    reach = piece(s.end, anchor);
+    if (reach >= 0) {
+        const Vec2 a = anchor - o;
+        b.ex = (float)a.x;
+        b.ey = (float)a.y;
+        const double off = distance(Vec2{b.ex, b.ey}, a);  // the float anchor's rounding
+        b.end_reach = float_above(reach + off + 1e-7 * (std::fabs(a.x) + std::fabs(a.y)));
+    }
+    return b;
+}
+
+std::vector<StrokeBound> stroke_bounds(const SceneView& sc, const TileView& bins, int threads) {
+    std::vector<StrokeBound> out;
+    const int min_items = field_min_items_ref();
+    bool any = false;
+    for (size_t k = 0; k < bins.entries.size() && !any; ++k) {
+        const TileEntry& e = bins.entries[k];
+        const PreparedDraw& d = sc.draws[e.draw];
+        any = d.kind == DRAW_STROKE && !d.is_ellipse && e.winding == 0 && e.count >= min_items;
+    }
+    if (!any) return out;
+    const int n = (int)sc.stroke_items.size();
+    out.resize(n);
+    constexpr int CHUNK = 4096;
+    ThreadPool::instance().parallel_for((n + CHUNK - 1) / CHUNK, threads, [&](int c, int) {
+        for (int i = c * CHUNK; i < std::min(n, (c + 1) * CHUNK); ++i) out[i] = make_stroke_bound(sc.stroke_items[i]);
+    });
+    return out;
+}
+
 void SampleGrid::build(const TileView& bins, int tile, int width, int height, int samples, double R) {
     N = samples;
     const int tx = tile % bins.nx, ty = tile / bins.nx;
@@ -48,7 +108,7 @@ void SampleGrid::build(const TileView& bins, int tile, int width, int height, in
         int pixel, sub;
     };
     std::vector<Line> lines;
-    std::vector<int> pixel, sub, row_pixel, row_sub;
+    std::vector<int> sub, row_sub;
     auto axis = [&](int a0, int a1, std::vector<double>& pos, std::vector<int>& pixel, std::vector<int>& sub) {
         lines.clear();
         for (int a = a0; a < a1; ++a)
@@ -67,14 +127,14 @@ void SampleGrid::build(const TileView& bins, int tile, int width, int height, in
             sub[k] = lines[k].sub;
         }
     };
-    axis(x0, x1, col_x, pixel, sub);
+    axis(x0, x1, col_x, col_pixel, sub);
     axis(y0, y1, row_y, row_pixel, row_sub);
     const size_t cols = col_x.size();
     index.resize(cols * row_y.size());
     for (size_t row = 0; row < row_y.size(); ++row)
         for (size_t col = 0; col < cols; ++col)
             index[row * cols + col] =
-                ((row_pixel[row] - y0) * (x1 - x0) + (pixel[col] - x0)) * N * N + row_sub[row] * N + sub[col];
+                ((row_pixel[row] - y0) * (x1 - x0) + (col_pixel[col] - x0)) * N * N + row_sub[row] * N + sub[col];
     auto spacing = [](const std::vector<double>& v, double& v0, double& inv_step) {
         v0 = v.front();
         inv_step = v.size() > 1 && v.back() > v.front() ? (double)(v.size() - 1) / (v.back() - v.front()) : 1.0;
@@ -84,7 +144,7 @@ void SampleGrid::build(const TileView& bins, int tile, int width, int height, in
 }
 
 void TileFields::compute(const SceneView& sc, const TileView& bins, int tile, const SampleGrid& grid, double r,
-                         bool args) {
+                         bool args, const StrokeBound* bounds) {
     const int count = bins.count(tile);
     const TileEntry* es = bins.begin(tile);
     const int min_items = field_min_items_ref();
@@ -103,6 +163,8 @@ void TileFields::compute(const SceneView& sc, const TileView& bins, int tile, co
         const TileEntry& e = es[k];
         const PreparedDraw& d = sc.draws[e.draw];
         if (d.kind == DRAW_FILL && !d.is_ellipse && e.count >= min_items) slot_[k] = slots++;
+        if (bounds && d.kind == DRAW_STROKE && !d.is_ellipse && e.winding == 0 && e.count >= min_items)
+            slot_[k] = slots++;
         const PreparedPaint& paint = sc.paints[d.paint];
         const Box reach = grown(d.box, r);
         const bool covers_all = !d.is_ellipse && (d.kind == DRAW_STROKE ? e.winding != 0 :
@@ -115,10 +177,90 @@ void TileFields::compute(const SceneView& sc, const TileView& bins, int tile, co
     if (slots == 0) return;
     sd_.resize((size_t)slots * n_);
     if (args) arg_.assign((size_t)slots * n_, SdfArg{});
-    for (int k = 0; k < count; ++k)
-        if (slot_[k] >= 0)
-            compute_entry(sc, bins, tile, es[k], grid, r, args, sd_.data() + (size_t)slot_[k] * n_,
-                          args ? arg_.data() + (size_t)slot_[k] * n_ : nullptr);
+    for (int k = 0; k < count; ++k) {
+        if (slot_[k] < 0) continue;
+        double* sd = sd_.data() + (size_t)slot_[k] * n_;
+        SdfArg* arg = args ? arg_.data() + (size_t)slot_[k] * n_ : nullptr;
+        if (sc.draws[es[k].draw].kind == DRAW_STROKE) compute_stroke(sc, bins, es[k], grid, r, bounds, sd, arg);
+        else compute_entry(sc, bins, tile, es[k], grid, r, args, sd, arg);
+    }
+}
+
+// A long stroke entry: stroke_sdf at each sample, as entry_sdf measures it, over the
+// items of the sample's cell (CELL x CELL pixels) with their bounds (StrokeBound): the same
+// distances and args, the same items measured in the same order, less those that could
+// not have lowered the distance so far. A cell lists the items whose box, grown by r
+// (LocalItems::may_reach's test at its widest reach), holds some sample of the cell: a
+// sample scans about a quarter of the tile's list (19,000 pieces on issue 41's path), and
+// the cell's items and bounds stay at hand from sample to sample.
+void TileFields::compute_stroke(const SceneView& sc, const TileView& bins, const TileEntry& e, const SampleGrid& g,
+                                double r, const StrokeBound* bounds, double* sd, SdfArg* arg) {
+    constexpr int CELL = 2;
+    const PreparedDraw& d = sc.draws[e.draw];
+    const int rows = (int)g.row_y.size(), cols = (int)g.col_x.size();
+    const int ncx = (g.x1 - g.x0 + CELL - 1) / CELL, ncy = (g.y1 - g.y0 + CELL - 1) / CELL, cells = ncx * ncy;
+    // each cell column's (row's) samples' extent
+    cell_x0_.assign(ncx, INFINITY);
+    cell_x1_.assign(ncx, -INFINITY);
+    cell_y0_.assign(ncy, INFINITY);
+    cell_y1_.assign(ncy, -INFINITY);
+    for (int col = 0; col < cols; ++col) {
+        const int c = (g.col_pixel[col] - g.x0) / CELL;
+        cell_x0_[c] = vmin(cell_x0_[c], g.col_x[col]);
+        cell_x1_[c] = vmax(cell_x1_[c], g.col_x[col]);
+    }
+    for (int row = 0; row < rows; ++row) {
+        const int c = (g.row_pixel[row] - g.y0) / CELL;
+        cell_y0_[c] = vmin(cell_y0_[c], g.row_y[row]);
+        cell_y1_[c] = vmax(cell_y1_[c], g.row_y[row]);
+    }
+    // The items any sample may reach, and the cells each reaches (counted, then listed).
+    const LocalItem* li = bins.items.data() + e.first;
+    const StrokeBound* draw_bounds = bounds + d.first_item;
+    stroke_items_.clear();
+    stroke_bounds_.clear();
+    item_cells_.clear();  // per kept item: its cells' ranges, x0 x1 y0 y1
+    cell_start_.assign(cells + 1, 0);
+    for (int i = 0; i < e.count; ++i) {
+        const LocalItem& l = li[i];
+        // the cells some sample of which passes may_reach at reach r (the extents rise
+        // with the cell: a range; a sample outside them fails it at any reach <= r)
+        int a = 0, b = ncx - 1, c0 = 0, c1 = ncy - 1;
+        while (a <= b && cell_x1_[a] < l.x0 - r) ++a;
+        while (b >= a && cell_x0_[b] > l.x1 + r) --b;
+        while (c0 <= c1 && cell_y1_[c0] < l.y0 - r) ++c0;
+        while (c1 >= c0 && cell_y0_[c1] > l.y1 + r) --c1;
+        if (a > b || c0 > c1) continue;
+        stroke_items_.push_back({l.x0, l.y0, l.x1, l.y1, l.item});
+        item_cells_.insert(item_cells_.end(), {a, b, c0, c1});
+        for (int cy = c0; cy <= c1; ++cy)
+            for (int cx = a; cx <= b; ++cx) ++cell_start_[cy * ncx + cx + 1];
+    }
+    const int kept = (int)stroke_items_.size();
+    stroke_bounds_.resize(kept);
+    for (int k = 0; k < kept; ++k) {
+        if (k + 8 < kept) __builtin_prefetch(&draw_bounds[stroke_items_[k + 8].item]);  // (scattered)
+        stroke_bounds_[k] = draw_bounds[stroke_items_[k].item];
+    }
+    for (int c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
+    cell_index_.resize(cell_start_[cells]);
+    for (int k = 0; k < kept; ++k) {  // (in the entry's order within each cell)
+        const int* rg = item_cells_.data() + 4 * k;
+        for (int cy = rg[2]; cy <= rg[3]; ++cy)
+            for (int cx = rg[0]; cx <= rg[1]; ++cx) cell_index_[cell_start_[cy * ncx + cx]++] = k;
+    }
+    for (int c = cells; c > 0; --c) cell_start_[c] = cell_start_[c - 1];
+    cell_start_[0] = 0;
+    for (int row = 0; row < rows; ++row) {
+        const int cy = (g.row_pixel[row] - g.y0) / CELL;
+        for (int col = 0; col < cols; ++col) {
+            const int c = cy * ncx + (g.col_pixel[col] - g.x0) / CELL;
+            const CellItems items{cell_index_.data() + cell_start_[c], cell_start_[c + 1] - cell_start_[c],
+                                  stroke_items_.data(), stroke_bounds_.data()};
+            const int s = g.at(row, col);
+            sd[s] = stroke_sdf(sc, d, items, {g.col_x[col], g.row_y[row]}, r, arg ? arg + s : nullptr);
+        }
+    }
 }
 
 FieldView TileFields::view() const {

@@ -125,32 +125,58 @@ bool is_simple(const Segment& s, Vec2 u, double reach) {
     return min_proj * min_proj / max_second > len + reach;
 }
 
-// Stroke pieces of one subpath of a stroke draw, appended to out.
+// Segment g as draw d strokes it (stroke space; nearly straight curves straightened), or
+// false where it has no length (no sweep, no direction).
+bool stroke_source(const PreparedScene& sc, int g, const PreparedDraw& d, Segment& s) {
+    s = sc.segments[g].seg;
+    if (!d.metric_identity) s = transformed(s, d.metric);
+    if (is_point(s)) return false;
+    s = straightened(s, d.varying);
+    return true;
+}
+
+// How many stroke items a stroked segment becomes: curves are split into pieces of about
+// 8 units (exactly, by de Casteljau): their chord-frame bounds get tight, so far fewer
+// samples need the quintic. Measured on 256 random strokes: forward 4x (256 px) to 7x
+// (512 px) faster.
+int stroke_pieces(const Segment& s) {
+    double len = 0;
+    for (int i = 0; i < s.degree; ++i) len += distance(s.p[i], s.p[i + 1]);
+    return s.degree == 1 ? 1 : clamp_to_int(std::ceil(len / 8.0), 1, 16);
+}
+
+// The number of stroke items build_stroke_subpath appends for the subpath.
+size_t stroke_subpath_items(const PreparedScene& sc, int first, int count, const PreparedDraw& d) {
+    size_t n = 0;
+    Segment s;
+    for (int g = first; g < first + count; ++g)
+        if (stroke_source(sc, g, d, s)) n += stroke_pieces(s);
+    return n == 0 && d.cap != CAP_BUTT && count > 0 ? 1 : n;
+}
+
+// Stroke pieces of one subpath of a stroke draw, appended to out (built in place: a long
+// path's items are hundreds of megabytes, and building them in a vector of their own and
+// copying them over, each growing by doubling, spent most of the preparation in page
+// faults; the caller reserves room, stroke_subpath_items).
 void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool closed,
                           const PreparedDraw& d, std::vector<StrokeSegment>& out) {
     const bool var = d.varying;
     double hw = d.half_width;
     // Half width of point index k (per-point widths), or the draw's.
     auto point_hw = [&](int32_t k) { return var && k >= 0 ? std::max(0.0, sc.point_hw[k]) : hw; };
-    std::vector<StrokeSegment> segs;
+    const size_t base = out.size();
     for (int g = first; g < first + count; ++g) {
-        Segment s = sc.segments[g].seg;
-        if (!d.metric_identity) s = transformed(s, d.metric);
-        if (is_point(s)) continue;  // zero-length: no sweep, no direction
-        s = straightened(s, var);
+        Segment s;
+        if (!stroke_source(sc, g, d, s)) continue;
         // The width profile as a 1-D Bézier (x coordinates) split along with the curve.
         Segment w;
         w.degree = s.degree;
         const int32_t* idx = sc.segments[g].point_index;  // straightened(s, true) keeps the degree
         for (int i = 0; i <= s.degree; ++i) w.p[i] = {point_hw(var ? idx[i] : -1), 0};
-        // Curves are split into pieces of about 8 units (exactly, by de Casteljau): their
-        // chord-frame bounds get tight, so far fewer samples need the quintic. Measured on
-        // 256 random strokes: forward 4x (256 px) to 7x (512 px) faster.
-        double len = 0;
-        for (int i = 0; i < s.degree; ++i) len += distance(s.p[i], s.p[i + 1]);
-        int pieces = s.degree == 1 ? 1 : clamp_to_int(std::ceil(len / 8.0), 1, 16);
+        const int pieces = stroke_pieces(s);
         for (int k = 0; k < pieces; ++k) {
-            StrokeSegment ss;
+            out.emplace_back();
+            StrokeSegment& ss = out.back();
             ss.t0 = (double)k / pieces;
             ss.t1 = (double)(k + 1) / pieces;
             ss.seg = pieces == 1 ? s : seg_part(s, ss.t0, ss.t1);
@@ -161,9 +187,9 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
                 ss.hw_max = std::max(ss.hw_max, ss.hw[i]);
             }
             ss.source = g;
-            segs.push_back(ss);
         }
     }
+    StrokeSegment* segs = out.data() + base;  // (this subpath's; room was reserved)
     // Vertex widths at an item's start and end: the width of the point there.
     auto start_index = [&](const StrokeSegment& ss) { return sc.segments[ss.source].point_index[0]; };
     auto end_index = [&](const StrokeSegment& ss) {
@@ -174,7 +200,8 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
         e.hw = point_hw(k);
         e.width_index = var ? k : -1;
     };
-    if (segs.empty()) {
+    const int n_segs = (int)(out.size() - base);
+    if (n_segs == 0) {
         // A zero-length subpath: a dot with round caps, a square with square caps (aligned
         // with the stroke space's x axis, i.e. the user space), nothing with butt caps.
         if (d.cap == CAP_BUTT || count == 0) return;
@@ -192,9 +219,10 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
         ss.end = make_cap(s.p[0], {1, 0}, d.cap, h);
         set_width(ss.start, k);
         set_width(ss.end, k);
-        segs.push_back(ss);
+        out.push_back(ss);
+        segs = out.data() + base;
     } else {
-        int n = (int)segs.size();
+        int n = n_segs;
         for (int i = 0; i < n; ++i) {
             bool last = i + 1 == n;
             if (last && !closed) {
@@ -204,8 +232,8 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
                 segs[i].butt_end = d.cap == CAP_BUTT;
             } else {
                 StrokeSegment& next = segs[last ? 0 : i + 1];
-                segs[i].next = (int)out.size() + (last ? 0 : i + 1);
-                next.prev = (int)out.size() + i;
+                segs[i].next = (int)base + (last ? 0 : i + 1);
+                next.prev = (int)base + i;
                 if (var && !last && next.source == segs[i].source) {
                     // Pieces of one curve meet smoothly: no join (a disk of the local width
                     // could stick out of a sweep whose width changes fast).
@@ -229,7 +257,8 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
             segs[0].butt_start = d.cap == CAP_BUTT;
         }
     }
-    for (StrokeSegment& ss : segs) {
+    for (size_t i = base; i < out.size(); ++i) {
+        StrokeSegment& ss = out[i];
         const Segment& s = ss.seg;
         Vec2 u = normalized(seg_end(s) - s.p[0]);
         if (u.x == 0 && u.y == 0) u = {1, 0};
@@ -249,7 +278,6 @@ void build_stroke_subpath(const PreparedScene& sc, int first, int count, bool cl
         add_end_to_box(b, ss.start, ss.start.hw);
         add_end_to_box(b, ss.end, ss.end.hw);
         ss.box = d.metric_identity ? b : to_pixel_box(b, d.metric_inv);
-        out.push_back(ss);
     }
 }
 
@@ -394,6 +422,16 @@ PreparedScene prepare_scene(const SceneArrays& a) {
             check(shape[1] >= 0 && shape[2] >= 0 && shape[1] + shape[2] <= a.n_subpaths,
                   "shape subpaths out of range");
             d.first_item = d.kind == DRAW_FILL ? (int)sc.fill_items.size() : (int)sc.stroke_items.size();
+            if (d.kind == DRAW_STROKE) {  // room for the draw's items (growing by doubling, for many draws)
+                size_t n = sc.stroke_items.size();
+                for (int b = shape[1]; b < shape[1] + shape[2]; ++b) {
+                    const int32_t* sp = a.subpaths + SUBPATH_COLS * b;
+                    check(sp[0] >= 0 && sp[1] >= 0 && sp[0] + sp[1] <= a.n_segments, "subpath segments out of range");
+                    n += stroke_subpath_items(sc, sp[0], sp[1], d);
+                }
+                if (n > sc.stroke_items.capacity())
+                    sc.stroke_items.reserve(std::max(n, 2 * sc.stroke_items.capacity()));
+            }
             for (int b = shape[1]; b < shape[1] + shape[2]; ++b) {
                 const int32_t* sp = a.subpaths + SUBPATH_COLS * b;
                 int first = sp[0], count = sp[1];

@@ -148,6 +148,8 @@ struct LocalItems {
         const LocalItem& l = li[i];
         return p.y >= l.y0 - reach && p.y <= l.y1 + reach && p.x >= l.x0 - reach && p.x <= l.x1 + reach;
     }
+    // Whether item i may come below sd (stroke space, q): no bound here (see field.h's).
+    VF_HD bool may_beat(int, Vec2, double) const { return true; }
 };
 
 // Whether the entry's draw covers p (a point of the tile region): the Monte Carlo test.

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import random
 
+import numpy as np
 import pytest
 import torch
 
@@ -92,6 +93,61 @@ def test_wide_stroke_gradients_unchanged_inside(tmp_path, mode):
     assert torch.allclose(grads[0], grads[1], rtol=1e-5, atol=1e-5)
 
 
+# Strokes with every kind of end piece, for the stroke entries' bounds (scene/field.h).
+BOUND_SCENES = {
+    "joins-caps": f'<path d="{walk(60, 64, 40, "LQC", 11)}" fill="none" stroke="#800" stroke-width="1.5" '
+                  'stroke-opacity="0.5" stroke-linejoin="miter" stroke-miterlimit="10" stroke-linecap="square"/>'
+                  f'<path d="{walk(60, 64, 40, "LC", 12)}" fill="none" stroke="#080" stroke-width="1" '
+                  'stroke-opacity="0.5" stroke-linejoin="bevel" stroke-linecap="butt"/>'
+                  f'<path d="{walk(60, 64, 40, "QC", 13)}" fill="none" stroke="#008" stroke-width="2.5" '
+                  'stroke-opacity="0.5" stroke-linejoin="round" stroke-linecap="round"/>'
+                  f'<g transform="matrix(1.5 0.4 -0.2 0.7 3 2)"><path d="{walk(40, 40, 25, "LC", 6)} Z" fill="none" '
+                  'stroke="#088" stroke-width="2" stroke-opacity="0.5"/></g>',
+    "wide": f'<path d="{walk(30, 64, 25, "LLQC", 5)}" fill="none" stroke="#008" stroke-width="9" '
+            'stroke-linejoin="miter" stroke-linecap="square"/>'
+            f'<g transform="scale(0.3)"><path d="{walk(30, 200, 80, "QC", 8)}" fill="none" stroke="#800" '
+            'stroke-width="12" stroke-linecap="round"/></g>',
+}
+
+
+def packed_arrays(scene, size: int = 64) -> dict:
+    from vecfit.renderer.raster import FLOAT_INPUTS, packed_for_core
+
+    structure, floats = packed_for_core(scene, size, size)
+    return dict(structure, **{name: t.detach().numpy() for name, t in zip(FLOAT_INPUTS, floats)})
+
+
+def point_widths_scene():
+    from vecfit.scene import Path, Scene, Shape, Solid
+
+    r = random.Random(9)
+    pts = torch.tensor([[r.uniform(0, 64), r.uniform(0, 64)] for _ in range(31)])
+    path = Path(points=pts, degrees=np.array([3] * 10), subpaths=[(0, 10, False)],
+                widths=torch.tensor([r.uniform(0.5, 6) for _ in range(31)]))
+    return Scene(width=64, height=64, shapes=[Shape(geometry=path, stroke=Solid(torch.tensor([0.1, 0.2, 0.6, 1.0])),
+                                                    linejoin="miter", linecap="square")])
+
+
+@pytest.mark.parametrize("name", [*BOUND_SCENES, "point-widths"])
+def test_stroke_bounds_lie_below_the_distances(tmp_path, name):
+    """A stroke item's bound (what the analytical passes set items aside by) is at most its
+    signed distance, at points all over and around the canvas, and where the distance is
+    the sweep's along a straight side, within rounding of it: the sweep, butt ends, caps
+    and joins of every kind, a non-uniform transform, per-point widths."""
+    if name == "point-widths":
+        scene = point_widths_scene()
+    else:
+        svg = tmp_path / f"{name}.svg"
+        svg.write_text(f'<svg {NS} width="64" height="64">{BOUND_SCENES[name]}</svg>')
+        scene = quiet_load(svg)
+    grid = torch.arange(-3.0, 67.0, 1.37, dtype=torch.float64)
+    points = torch.stack(torch.meshgrid(grid, grid, indexing="xy"), -1).reshape(-1, 2).numpy()
+    most, mean, pairs = _core.stroke_bound_gaps(packed_arrays(scene), points)
+    assert pairs > 20_000
+    assert -1e-3 < most <= 0, most
+    assert mean < 0
+
+
 FIELD_SCENES = {
     **{k: SCENES[k] for k in ("cubics-across", "walk-mixed")},
     "stroke-1e7": SCENES["stroke-1e7"].replace('stroke="green"', 'stroke="green" stroke-opacity="0.5"'),
@@ -99,14 +155,18 @@ FIELD_SCENES = {
     # second segment), a self-crossing star (nonzero), curves meeting at their ends
     "edges": '<path d="M 8.5 8.5 H 40.5 V 40.5 H 8.5 Z M 20 4 L 36 60 L 4 24 L 60 24 L 12 60 Z" fill="#a50"/>'
              f'<path d="{walk(60, 64, 16, "QC", 7)} Z" fill="#05a" fill-opacity="0.6"/>',
+    # thin strokes crowding every tile (issue 41's kind, the stroke entries' bounds and
+    # cells): miter (long ones), bevel and round joins, square, butt and round caps, a
+    # stroke under a non-uniform transform, all translucent so that each is measured
+    "strokes-crowded": BOUND_SCENES["joins-caps"],
 }
 
 
 @pytest.mark.parametrize("name", list(FIELD_SCENES))
 @pytest.mark.parametrize("samples,filt", [(1, "box"), (2, "box"), (3, "tent")])
 def test_fields_match_per_sample(tmp_path, name, samples, filt):
-    """The analytical passes with every fill entry computed a tile at a time give the
-    per-sample images and gradients, bit for bit."""
+    """The analytical passes with every fill and stroke entry computed a tile at a time
+    give the per-sample images and gradients, bit for bit."""
     svg = tmp_path / f"{name}.svg"
     svg.write_text(f'<svg {NS} width="64" height="64">{GRADIENT}{FIELD_SCENES[name]}</svg>')
     results = []
