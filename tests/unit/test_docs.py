@@ -59,8 +59,6 @@ def test_results_keep_no_dated_history():
     assert "not re-run since" not in results
 
 
-# Sections that other work is editing; the lead condenses them after merging (then drop them here).
-NOT_YET_CONDENSED = ("Long paths (",)
 HISTORY_WORDS = re.compile(r"\b(before|after|tried|dropped|session \d+|branch|current)\b", re.I)
 DATE = re.compile(r"\b20\d\d-\d\d-\d\d\b")
 MEASURED = re.compile(r"\bMeasured 20\d\d-\d\d-\d\d\b")
@@ -68,9 +66,8 @@ COMMAND = re.compile(r"`(?:python|make|vecfit|cd benchmarks)\b[^`]*`")
 
 
 def results_sections(text: str) -> dict:
-    """RESULTS.md's `## ` sections by heading, less those not condensed yet."""
-    sections = {part.splitlines()[0]: part for part in re.split(r"^## ", text, flags=re.M)[1:]}
-    return {h: body for h, body in sections.items() if not h.startswith(NOT_YET_CONDENSED)}
+    """RESULTS.md's `## ` sections by heading."""
+    return {part.splitlines()[0]: part for part in re.split(r"^## ", text, flags=re.M)[1:]}
 
 
 def check_results_hold_current_tables(text: str) -> list:
@@ -107,10 +104,6 @@ def test_the_check_finds_dated_history_and_missing_provenance():
     no_command = "## Tracing (`trace.py`)\n\nMeasured 2026-11-26 on the 2-core machine.\n"
     for text in (dated, told, bare, no_command):
         assert len(check_results_hold_current_tables(text)) == 1, text
-    for name in NOT_YET_CONDENSED:  # a section not condensed yet is not checked
-        kept = f"## {name}`x.py`)\n\n### Current (2026-11-28, session 15)\n"
-        assert check_results_hold_current_tables(kept) == []
-        assert len(check_results_hold_current_tables(kept.replace(name, "Tracing ("))) == 2
 
 
 @pytest.mark.parametrize("doc", DOCS)
