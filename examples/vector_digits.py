@@ -35,7 +35,8 @@ import numpy as np
 import torch
 from torch import nn
 
-from vecfit.io.images import atomic_write_text, save_png
+from vecfit.io.files import atomic_write_text
+from vecfit.io.png import save_png
 from vecfit.scene import Path as CurvePath
 from vecfit.scene import Scene, Shape, Solid
 
