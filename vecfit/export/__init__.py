@@ -74,13 +74,10 @@ def svg_to(svg, fmt: str, name: str = "the SVG", curves: str = "polyline") -> by
 
 def write(path, payload: bytes) -> None:
     """Bytes saved atomically (nothing half-written)."""
-    from vecfit.io.files import atomic_write
+    from vecfit.io.files import atomic_write_bytes
 
-    def put(tmp):
-        with open(tmp, "wb") as f:
-            f.write(payload)
     try:
-        atomic_write(path, put)
+        atomic_write_bytes(path, payload)
     except OSError as e:
         raise VecfitError(f"{path}: cannot write ({e.strerror or e})") from None
 

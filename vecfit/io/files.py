@@ -26,6 +26,14 @@ def atomic_write(path: str | os.PathLike, write) -> None:
         raise
 
 
+def atomic_write_bytes(path: str | os.PathLike, payload: bytes) -> None:
+    """Writes bytes atomically, as atomic_write."""
+    def write(tmp):
+        with open(tmp, "wb") as f:
+            f.write(payload)
+    atomic_write(path, write)
+
+
 def atomic_write_text(path: str | os.PathLike, text: str) -> None:
     """Writes text (UTF-8, newlines as given) atomically, as atomic_write."""
     def write(tmp):

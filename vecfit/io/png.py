@@ -1,7 +1,7 @@
 """8-bit PNG files written with zlib alone. `vecfit render` writes its picture without
-importing Pillow, whose image plugins cost a tenth of a second of start-up; the file is
-what Pillow writes, as compact (no row filter: rendered vector art is flat colour, where
-the filters gain nothing)."""
+importing Pillow, whose image plugins cost a tenth of a second of start-up. No row filter:
+rendered vector art is mostly flat colour, where the filters gain little (tiger's render:
+49 KB, against Pillow's 65 KB)."""
 from __future__ import annotations
 
 import os
@@ -11,7 +11,7 @@ import zlib
 
 import numpy as np
 
-from .files import atomic_write
+from .files import atomic_write_bytes
 
 SIGNATURE = b"\x89PNG\r\n\x1a\n"
 COLOUR_TYPES = {1: 0, 2: 4, 3: 2, 4: 6}  # channels -> PNG colour type (grey, grey+alpha, RGB, RGBA)
@@ -49,9 +49,4 @@ def png_bytes(pixels: np.ndarray) -> bytes:
 
 def save_png(image, path: str | os.PathLike) -> None:
     """Save an [H, W, 4] straight-RGBA float image as an 8-bit RGBA PNG, atomically."""
-    data = png_bytes(to_uint8(image))
-
-    def write(tmp):
-        with open(tmp, "wb") as f:
-            f.write(data)
-    atomic_write(path, write)
+    atomic_write_bytes(path, png_bytes(to_uint8(image)))

@@ -22,7 +22,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from vecfit.errors import VecfitError
-from vecfit.io.files import atomic_write
+from vecfit.io.files import atomic_write_bytes
 from vecfit.scene.arrays import to_numpy
 from vecfit.scene import (Circle, Ellipse, LinearGradient, Path, RadialGradient, Rect,
                                    Scene, Solid)
@@ -198,12 +198,7 @@ def write_bytes(out_path, payload: bytes) -> None:
     """SVG bytes (svg_bytes) saved atomically at ``out_path``, gzip-compressed for .svgz."""
     if str(out_path).endswith(".svgz"):
         payload = gzip.compress(payload)
-
-    def write(tmp):
-        with open(tmp, "wb") as f:
-            f.write(payload)
-
-    atomic_write(out_path, write)
+    atomic_write_bytes(out_path, payload)
 
 
 def svg_bytes(scene: Scene, document, *, full: bool = False, background=None,
