@@ -624,8 +624,7 @@ def drop_unseen(scene, render, target_rgb: np.ndarray, budget_db: float = 0.01) 
     # Each subpath's cost is the change of the squared error in its box when it goes. A
     # subpath draws only within its box, so subpaths whose boxes do not meet are judged
     # together: one render of the whole picture without all of them, against one with
-    # everything (a render packs the whole scene however small its window: 200 checks of
-    # two window renders each took a minute on a 1,000-path photograph).
+    # everything (a render packs the whole scene, however small its window).
     costs = []
     before = (render(scene, w, h) - target_rgb) ** 2
     stats["renders"] += 1

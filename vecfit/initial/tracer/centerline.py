@@ -651,9 +651,10 @@ def _fits(chains, piece: np.ndarray, radius: np.ndarray, origin, widest: float, 
     over union)."""
     along = np.concatenate([c.points for c in chains]) - origin
     ix = np.clip(along.astype(int), 0, [piece.shape[1] - 1, piece.shape[0] - 1])
-    if 2 * float(np.quantile(radius[ix[:, 1], ix[:, 0]], WIDTH_QUANTILE[style])) - 1 > widest:
+    radii = radius[ix[:, 1], ix[:, 0]]
+    if 2 * float(np.quantile(radii, WIDTH_QUANTILE[style])) - 1 > widest:
         return False
-    if style == "mixed" and 2 * float(np.median(radius[ix[:, 1], ix[:, 0]])) - 1 < MIN_MIXED_WIDTH:
+    if style == "mixed" and 2 * float(np.median(radii)) - 1 < MIN_MIXED_WIDTH:
         return False
     # thinning stops short of a line's ends (a short line's skeleton is a fraction of it):
     # the ends are judged as the strokes draw them, moved on as _extended moves them
