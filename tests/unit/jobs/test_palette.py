@@ -226,6 +226,22 @@ def disc_at_the_edge_png(path, line=None):
     return np.asarray(image, np.float32) / 255
 
 
+def test_background_is_the_corners_colour_where_a_logo_covers_most_of_the_border():
+    """A rounded card that bleeds to every edge (tunein's logo) covers most of the
+    border, so the border's dominant colour is the card's; its four rounded corners show
+    the page, which is the background. Where the corners do not agree (two and two), the
+    border's dominant colour decides."""
+    from vecfit.initial.tracer.background import border_colour
+    page, card = (42, 157, 143), (20, 216, 204)
+    image = Image.new("RGB", (96, 64), page)
+    ImageDraw.Draw(image).rounded_rectangle((0, 0, 95, 63), radius=8, fill=card)
+    rgb = np.asarray(image, np.float64) / 255
+    assert np.rint(border_colour(rgb) * 255).astype(int).tolist() == list(page)
+    ImageDraw.Draw(image).rectangle((0, 0, 95, 31), fill=card)  # top corners square: two and two
+    rgb = np.asarray(image, np.float64) / 255
+    assert np.rint(border_colour(rgb) * 255).astype(int).tolist() == list(card)
+
+
 def test_remove_background_unmixes_a_shape_tangent_to_the_canvas_edge(tmp_path):
     """The disc's blends along the canvas's left column have no page pixel beside them
     (beyond the canvas counts as page): they are unmixed like any rim, so every pixel

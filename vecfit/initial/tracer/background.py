@@ -1,9 +1,11 @@
 """``trace --remove-background``: the flat background of an opaque image found and made
 transparent for the tracer, so that no shape covers it.
 
-The background colour is the border's dominant colour (the modal 4-bit bin of the
-pixels along the image's edges, then their median inside that bin: robust to JPEG noise
-and to shapes touching the border), or the colour the user gives (``--background``).
+The background colour is the colour of three or four of the image's corners where they
+agree (a logo that bleeds to the canvas's edges along most of the border still leaves its
+rounded corners on the page), else the border's dominant colour (the modal 4-bit bin of
+the pixels along the image's edges); either way the median of the border pixels of that
+colour, robust to JPEG noise. Or the colour the user gives (``--background``).
 Every pixel within BACKGROUND_DELTA_E (CIELAB) of it is background, enclosed or not (a
 logo's counters and holes show the page too; as a commercial tracer's "ignore white",
 a white eye on a white page goes with it). The anti-aliased rim around it is unmixed:
@@ -28,13 +30,28 @@ EDGE_BLEND = 0.05  # RGB distance within which an edge pixel is a blend of the b
 
 
 def border_colour(rgb: np.ndarray) -> np.ndarray:
-    """The dominant colour of the image's border: RGB float [3] in [0, 1], 8-bit exact."""
+    """The background colour the module's docstring describes: RGB float [3] in [0, 1],
+    8-bit exact."""
     b = BORDER
     edge = np.concatenate([rgb[:b].reshape(-1, 3), rgb[-b:].reshape(-1, 3),
                            rgb[:, :b].reshape(-1, 3), rgb[:, -b:].reshape(-1, 3)])
-    bins = np.clip((edge * 16).astype(np.int64), 0, 15) @ np.array([256, 16, 1])
-    modal = np.bincount(bins).argmax()
-    return np.rint(np.median(edge[bins == modal], axis=0) * 255) / 255
+    corners = _corners_colour(rgb)
+    if corners is not None:
+        chosen = background_mask(edge[None], corners)[0]
+    else:
+        bins = np.clip((edge * 16).astype(np.int64), 0, 15) @ np.array([256, 16, 1])
+        chosen = bins == np.bincount(bins).argmax()
+    return np.rint(np.median(edge[chosen], axis=0) * 255) / 255
+
+
+def _corners_colour(rgb: np.ndarray) -> np.ndarray | None:
+    """The colour that three or four of the image's corner pixels share (within
+    BACKGROUND_DELTA_E), or None where no three agree."""
+    corners = np.stack([rgb[0, 0], rgb[0, -1], rgb[-1, 0], rgb[-1, -1]])
+    lab = to_lab(corners)
+    near = np.linalg.norm(lab[:, None] - lab[None], axis=-1) < BACKGROUND_DELTA_E
+    best = int(near.sum(1).argmax())
+    return corners[best] if near[best].sum() >= 3 else None
 
 
 def background_mask(rgb: np.ndarray, colour: np.ndarray, delta_e: float = BACKGROUND_DELTA_E) -> np.ndarray:
