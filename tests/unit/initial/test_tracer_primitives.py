@@ -6,6 +6,7 @@ import re
 import numpy as np
 import pytest
 
+import vecfit
 from vecfit.initial.tracer import TraceSettings, trace_image
 from vecfit.initial.tracer.bezier import fit_closed
 from vecfit.initial.tracer.primitives import as_primitive, straightened
@@ -145,3 +146,28 @@ def test_a_disc_with_a_hole_beside_it_is_not_split(tmp_path):
     assert 'fill-rule="evenodd"' in result.svg and result.svg.count("z") == 2  # the ring: outline and hole
     out = render(result, w, h, tmp_path)
     assert psnr(over_white(image), out[..., :3]) > 30
+
+
+def test_a_rings_rims_are_exact_circles(tmp_path, monkeypatch):
+    """A ring is a path (its hole must stay cut out of it), but each of its rims is
+    written as the circle it is: four cubics on the true circle, closer than the free fit."""
+    import vecfit.initial.tracer.trace as tracer
+    w, h = 64, 64
+    ring = coverage(lambda x, y: ((x - 31.3) ** 2 + (y - 32.6) ** 2 < 21 ** 2) & ((x - 31.3) ** 2 + (y - 32.6) ** 2 > 11 ** 2), w, h)
+    image = paint([(ring, (0.1, 0.3, 0.8))], w, h)
+    result = trace_image(image, TraceSettings.defaults(paths=4))
+    assert "<circle" not in result.svg and result.segments == 8
+    (tmp_path / "ring.svg").write_text(result.svg)
+    path = vecfit.load_svg(tmp_path / "ring.svg").shapes[0].geometry
+    assert [int(d) for d in path.degrees] == [3] * 4 + [1] + [3] * 4 + [1]
+    for rim, radius in zip(np.split(path.points.numpy(), [13]), (21.0, 11.0)):
+        centre = rim[[0, 6]].mean(0)  # the rightmost and leftmost points
+        assert np.allclose(centre, (31.3, 32.6), atol=0.1)
+        on_curve = np.hypot(*(rim[::3] - centre).T)
+        assert np.abs(on_curve - radius).max() < 0.15
+    out = render(result, w, h, tmp_path)
+    monkeypatch.setattr(tracer, "elliptical", lambda edge, outline: outline)
+    free = trace_image(image, TraceSettings.defaults(paths=4))
+    assert free.svg != result.svg
+    before = render(free, w, h, tmp_path)
+    assert psnr(over_white(image), out[..., :3]) > psnr(over_white(image), before[..., :3]) + 1.0

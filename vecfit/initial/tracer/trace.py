@@ -26,7 +26,7 @@ from .quantize import OPAQUE, nearest_centre, palette_classes, prefilter, quanti
 from .regions import build_regions, majority_class, palette_colors
 from .settings import TraceResult, TraceSettings
 from .subpixel import refine_outlines
-from .primitives import as_primitive, straightened
+from .primitives import Outline, as_primitive, distance_rms, ellipse_outline, straightened
 from .tucked import tucked_hosts
 
 # Compound paths keep every region (specks and slivers merge away regardless): the
@@ -60,6 +60,21 @@ def separate_primitives(edges: list, simplified: list, lines: float, most: int) 
         last = max(k for k, f in enumerate(found) if f is not None)
         found[last] = None
     return found
+
+
+def elliptical(edge: np.ndarray, outline: Outline) -> Outline:
+    """A compound path's subpath that is no element of its own: the exact ellipse (as four
+    cubics) where its traced ``edge`` is one within ELLIPSE_TOLERANCE (as_primitive's
+    test) and the ellipse follows the edge at least as closely as the fitted ``outline``
+    does (a font's 'o' is near an ellipse, not one); else that outline."""
+    if 1 in outline.degrees[:-1]:
+        return outline
+    shape = as_primitive(edge, outline, 0.0, ELLIPSE_TOLERANCE)
+    if shape is None:
+        return outline
+    exact = ellipse_outline(shape, outline)
+    edge = np.asarray(edge, float)
+    return exact if distance_rms(edge, exact) <= distance_rms(edge, outline) else outline
 
 
 def check_image(image) -> np.ndarray:
@@ -213,7 +228,8 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
         # (a shape of one outline is one element either way: it may always be a primitive)
         found = (separate_primitives([outlines[k] for k in kept], simplified, s.lines, max(spare, 0) + 1)
                  if s.primitives else [None] * len(simplified))
-        rest = [o for o, shape in zip(simplified, found) if shape is None]
+        rest = [o if shape is not None or not s.primitives else elliptical(outlines[k], o)
+                for k, o, shape in zip(kept, simplified, found) if shape is None]
         if rest:
             add_path(document, outline_path_data(rest), fill, evenodd=cut)
             segments += sum(len(o.degrees) - 1 for o in rest)
