@@ -27,8 +27,8 @@ demo: install
 test: install
 	$(PY) -m pytest -q
 
-# The suites marked slow (over 30 s each: the wheel, interruptions, the fuzzer's quick run,
-# the conformance corpus, ...) left out: under a minute.
+# The tests marked slow left out (whole fits and traces, batches, the wheel, interruptions,
+# the fuzzer's quick run, the shared data, oracle sweeps past a few cases): under a minute.
 test-fast: install
 	$(PY) -m pytest -q -m "not slow"
 

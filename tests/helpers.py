@@ -1,6 +1,6 @@
 """Small helpers the test modules share: the CLI runner, quiet SVG loading, skipping when
 shared data is missing, skimage photos as small PNG targets, a shape tangent to the
-canvas's edges, and the core's test switches."""
+canvas's edges, the core's test switches, and a sweep's split into fast and slow."""
 from __future__ import annotations
 
 import contextlib
@@ -47,6 +47,16 @@ def gpu_lists():
         yield
     finally:
         _core.emulate_gpu_lists(old)
+
+
+def slow_unless(values, fast) -> list:
+    """A sweep's parameters for ``pytest.mark.parametrize``: those in ``fast`` run in `make
+    test-fast`, the others are marked slow (`make test` runs them all; ids are unchanged)."""
+    fast = list(fast)
+    missing = [v for v in fast if v not in values]
+    assert not missing, f"not among the parameters: {missing}"
+    return [v if v in fast else pytest.param(*(v if isinstance(v, tuple) else (v,)), marks=pytest.mark.slow)
+            for v in values]
 
 
 def need(path: Path) -> Path:

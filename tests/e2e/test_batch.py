@@ -146,6 +146,7 @@ def test_refine_folder_records_failures_and_writes_the_summary(folder, tmp_path)
     no_leftovers(out)
 
 
+@pytest.mark.slow
 def test_resume_skips_finished_images_and_redoes_changed_ones(folder, tmp_path):
     out = tmp_path / "out"
     cfg = config(tmp_path)
@@ -329,6 +330,7 @@ def test_trace_mode(tmp_path):
 
 # ------------------------------------------------------------------- Dask
 
+@pytest.mark.slow
 def test_dask_scheduler(folder, tmp_path):
     distributed = pytest.importorskip("distributed")
     import torch

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from helpers import run
+from helpers import run, slow_unless
 
 SQUARE = """<svg xmlns="http://www.w3.org/2000/svg" width="40" height="20" viewBox="0 0 40 20">
 <rect x="10" y="5" width="20" height="10" fill="#ff0000"/></svg>"""
@@ -111,7 +111,7 @@ def test_version_starts_without_torch(args):
     assert "vecfit 0" in output and not imported, output
 
 
-@pytest.mark.parametrize("name", ["tiger.svg", "golden"])
+@pytest.mark.parametrize("name", slow_unless(["tiger.svg", "golden"], ["golden"]))
 def test_info_runs_without_torch(name, tmp_path):
     """`vecfit info` reads the SVG into NumPy arrays (vecfit.scene.arrays): no torch."""
     if name == "golden":
@@ -130,6 +130,7 @@ def test_info_runs_without_torch(name, tmp_path):
     assert not imported, output
 
 
+@pytest.mark.slow
 def test_trace_without_refining_runs_without_torch(tmp_path):
     """`vecfit trace --no-refine` renders and writes the trace from NumPy arrays (no torch),
     and writes what the Python API writes for optimize.iterations 0."""

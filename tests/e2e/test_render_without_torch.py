@@ -19,6 +19,8 @@ from vecfit.io.png import save_png
 from vecfit.renderer.forward import FLOAT_INPUTS, output_size, packed_for_core, render_numpy, renders_without_torch
 from vecfit.scene.arrays import numpy_arrays, to_numpy
 
+from helpers import slow_unless
+
 ROOT = Path(__file__).resolve().parents[2]
 TIGER = ROOT / "examples" / "tiger.svg"
 GOLDEN = sorted((ROOT / "tests" / "oracles" / "golden").glob("*.svg"))
@@ -41,7 +43,7 @@ def _render_command(*args, module: str = "torch") -> tuple[str, bool]:
     return out.stdout + out.stderr, (lines[-1] == "True") if lines else True
 
 
-@pytest.mark.parametrize("module", ["cv2", "PIL"])
+@pytest.mark.parametrize("module", slow_unless(["cv2", "PIL"], ["PIL"]))
 def test_a_plain_render_imports_no_image_library(tmp_path, module):
     """OpenCV's import is a tenth of a second, a fifth of the command, and Pillow's image
     plugins (which its PNG writer loads) another: the reader and the PNG writer have no
@@ -61,6 +63,7 @@ def _with_torch(svg, png, **options) -> bytes:
     return png.read_bytes()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("args, options", [
     ([], {}),
     (["--mode", "analytic", "--width", "200"], dict(mode="analytic", width=200)),

@@ -12,7 +12,9 @@ import pytest
 
 import vecfit
 
-pytest.importorskip("sklearn", reason="the example's data comes with scikit-learn (the dev extras)")
+# Looked up, not imported: importing scikit-learn takes seconds of every run's collection.
+pytestmark = pytest.mark.skipif(importlib.util.find_spec("sklearn") is None,
+                                reason="the example's data comes with scikit-learn (the dev extras)")
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "vector_digits.py"
 
 

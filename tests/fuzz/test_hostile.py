@@ -213,6 +213,7 @@ FIT_OUTPUTS = ["out.svg", "out.report.json", "out.compare.png"]
 QUICK = ["--iterations", "2", "-q", "--threads", "1"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("args", [
     ["paint", "wide.png", "--paths", "4"],
     ["refine", "wide.png", "wide.svg"],
@@ -228,6 +229,7 @@ def test_wide_short_images_fit(runner, args):
     assert out["exit_code"] == 0, out["stderr"]
 
 
+@pytest.mark.slow
 def test_wide_short_images_batch(runner):
     case = Case(0, "fixed", "batch", ["batch", "in", "-o", "out", "--mode", "paint", "--config", "it.toml", "-q"],
                 {}, 60.0, [])

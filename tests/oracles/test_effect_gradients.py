@@ -18,6 +18,8 @@ from vecfit.scene import Circle, ClipPath, Filter, FilterStep, Mask, Rect, Scene
 from shared_data import SHARED
 from test_gradients import SIZE, background, check
 
+from helpers import slow_unless
+
 MODES = ["mc", "analytic"]
 # The analytical image curves within a pixel where a clip's edge and the content's meet
 # (a product of two prefiltered edges): differences there take a small step.
@@ -39,7 +41,7 @@ def clipped(corner, center, radius):
     return Scene(width=SIZE, height=SIZE, shapes=[background(), square(corner, 20.0, clip=clip)])
 
 
-@pytest.mark.parametrize("mode", MODES)
+@pytest.mark.parametrize("mode", slow_unless(MODES, ["analytic"]))
 def test_through_a_clip_to_the_content_and_the_clip(mode):
     # The square's corner sits inside the clip's circle, so both boundaries show.
     check(clipped, {"corner": torch.tensor([9.55, 10.45]), "center": torch.tensor([22.45, 21.55]),
@@ -53,7 +55,7 @@ def masked(corner, grey, mask_corner):
     return Scene(width=SIZE, height=SIZE, shapes=[background(), square(corner, 20.0, mask=mask)])
 
 
-@pytest.mark.parametrize("mode", MODES)
+@pytest.mark.parametrize("mode", slow_unless(MODES, ["analytic"]))
 def test_through_a_mask_to_the_content_and_the_mask(mode):
     check(masked, {"corner": torch.tensor([8.55, 9.45]), "grey": torch.tensor([0.7, 0.5, 0.3, 0.9]),
                    "mask_corner": torch.tensor([14.45, 12.55])},
@@ -67,7 +69,7 @@ def blurred(center, radius, color):
         background(), Shape(geometry=Circle(center=center, radius=radius), fill=Solid(color), filter=blur)])
 
 
-@pytest.mark.parametrize("mode", MODES)
+@pytest.mark.parametrize("mode", slow_unless(MODES, ["analytic"]))
 def test_through_a_blur(mode):
     check(blurred, {"center": torch.tensor([19.3, 21.2]), "radius": torch.tensor(9.4),
                     "color": torch.tensor([0.2, 0.6, 0.4, 0.8])},

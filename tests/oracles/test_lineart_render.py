@@ -37,6 +37,7 @@ def _psnr(a: np.ndarray, b: np.ndarray) -> float:
     return float(10 * np.log10(1 / np.mean((a - b) ** 2)))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ICONS)
 def test_tabler_icon_renders_as_resvg_converges(name):
     import vecfit

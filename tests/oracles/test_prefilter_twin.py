@@ -21,6 +21,8 @@ import torch
 import vecfit
 from vecfit.scene import Path, Scene, Shape, Solid
 
+from helpers import slow_unless
+
 SIZE = 24
 R = 0.5  # the box filter's kernel radius at 1 sample per pixel
 COLOR = (0.2, 0.4, 0.6)
@@ -248,7 +250,7 @@ FILLS = {
 }
 
 
-@pytest.mark.parametrize("kind", list(FILLS))
+@pytest.mark.parametrize("kind", slow_unless(list(FILLS), ["cubic"]))
 def test_fill_segments(kind):
     points, degrees = FILLS[kind]
     core_img, g_points, _ = core(points, degrees, closed=True)

@@ -63,6 +63,7 @@ def test_square_area_exact():
     assert area_of(sq, s=8) == pytest.approx(20.5 * 20, abs=1e-9)
 
 
+@pytest.mark.slow
 def test_rotated_square_area():
     a = math.radians(27.0)
     c, h = np.array([32.0, 32.0]), 14.0
@@ -101,6 +102,7 @@ def test_rounded_rect_area():
     assert area_of(plain, s=4) == pytest.approx(48 * 40, abs=1e-9)
 
 
+@pytest.mark.slow
 def test_cubic_blob_area_against_shoelace_of_dense_samples():
     ctrl = np.array([[10, 40], [5, 5], [55, 0], [50, 30], [45, 60], [20, 62]], dtype=np.float64)
     # two cubics: p0 c c p1 c c (back to p0)
@@ -121,6 +123,7 @@ def _pentagram(c, R):
     return np.array([[c[0] + R * math.cos(a), c[1] + R * math.sin(a)] for a in ang])
 
 
+@pytest.mark.slow
 def test_evenodd_vs_nonzero_star():
     c, R = (32.0, 33.0), 28.0
     star = _pentagram(c, R)
@@ -181,6 +184,7 @@ def test_straight_line_caps_axis_aligned(cap, extra):
     assert got == pytest.approx(expected, abs=tol)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("cap,extra", [("butt", 0.0), ("square", 0.5), ("round", math.pi / 8)])
 def test_straight_line_caps_diagonal(cap, extra):
     p, q, w = np.array([12.3, 15.1]), np.array([49.7, 44.2]), 5.0
@@ -189,6 +193,7 @@ def test_straight_line_caps_diagonal(cap, extra):
     assert got == pytest.approx(L * w + 2 * extra * w * w, abs=_area_tol(2 * L + 2 * w))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("join,miter_limit,expected_extra", [
     ("miter", 4.0, 0.0),                              # 2 L w: the miter square equals the overlap
     ("miter", 1.4, -1.0 / 8),                        # limit below sqrt(2): bevel
@@ -244,6 +249,7 @@ def test_closed_square_stroke_has_joins_everywhere_and_no_caps():
     assert area_of(open_sq) == pytest.approx((L + w) ** 2 - (L - w) ** 2 - w * w / 4, abs=1e-9)
 
 
+@pytest.mark.slow
 def test_circle_stroke_annulus_and_ellipse_sweep_agree():
     r, w = 16.0, 5.0
     circ = Shape(Circle(T([32.0, 32.0]), T(r)), stroke=BLACK(), stroke_width=T(w))
@@ -259,6 +265,7 @@ def test_stroke_wider_than_circle_fills_centre():
     assert area_of(circ) == pytest.approx(math.pi * 10.0 ** 2, abs=_area_tol(20 * math.pi))
 
 
+@pytest.mark.slow
 def test_curved_stroke_area_is_length_times_width():
     """Where the radius of curvature exceeds w / 2 and the sweep does not overlap itself, the
     normal sweep of a curve has area (arc length) x w exactly."""
@@ -270,6 +277,7 @@ def test_curved_stroke_area_is_length_times_width():
     assert area_of(sh) == pytest.approx(L * w, abs=_area_tol(2 * L))
 
 
+@pytest.mark.slow
 def test_stroke_under_nonuniform_scale_and_skew():
     """The stroke is defined in local space: a shape transform scales its area by |det|."""
     p, q, w = [4.0, 6.0], [20.3, 13.1], 3.0
@@ -536,6 +544,7 @@ def test_jitter_is_seeded_and_close_to_regular():
     assert abs(a[..., 3].sum() - c[..., 3].sum()) < 2.0
 
 
+@pytest.mark.slow
 def test_speed_64px_ten_shapes():
     rng = np.random.default_rng(0)
     shapes = []

@@ -37,6 +37,7 @@ import numpy as np
 import pytest
 import torch
 
+from helpers import slow_unless
 from reference_render import premultiply, render_reference
 from vecfit.scene import (Circle, Ellipse, Group, LinearGradient, Path, RadialGradient,
                                    Rect, Scene, Shape, Solid)
@@ -336,7 +337,7 @@ def test_mc_matches_reference(name):
     compare(f"{name}-mc", reference(name), actual, MC_MEAN, MC_MAX)
 
 
-@pytest.mark.parametrize("name", list(SCENES))
+@pytest.mark.parametrize("name", slow_unless(list(SCENES), ["circle", "cubic_blob", "joins", "transparency"]))
 def test_analytic_matches_reference(name):
     scene, w, h = SCENES[name]()
     actual = _render(scene, w, h, samples=1, mode="analytic")

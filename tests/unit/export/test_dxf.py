@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from vecfit.export import svg_to
-from helpers import need
+from helpers import need, slow_unless
 from shared_data import SHARED
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -90,7 +90,7 @@ def check_geometry(text: str, curves: str, tolerance_px: float):
     assert hausdorff(dxf_lines(doc, height), source) <= tolerance_px
 
 
-@pytest.mark.parametrize("name", sorted(set(CASES) - {"dashes"}))
+@pytest.mark.parametrize("name", slow_unless(sorted(set(CASES) - {"dashes"}), ["strokes"]))
 @pytest.mark.parametrize("curves", ["polyline", "spline"])
 def test_dxf_geometry_is_the_svgs(name, curves):
     """Polylines within 0.01 mm (0.038 px) of the curves; splines exact (what is left is

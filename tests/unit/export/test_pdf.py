@@ -112,6 +112,7 @@ def test_every_lineart_icon():
     assert worst[0] >= MIN_PSNR, worst
 
 
+@pytest.mark.slow
 def test_a_traced_photo():
     """chelsea traced as it is (hundreds of abutting filled regions) prints as it renders."""
     image = ROOT / "examples" / "chelsea.png"

@@ -13,7 +13,7 @@ from PIL import Image
 
 import vecfit
 from vecfit.fitting import losses
-from helpers import need, photo_png, quiet_load, run
+from helpers import need, photo_png, quiet_load, run, slow_unless
 from vecfit.io.colors import parse_background
 from vecfit.jobs.config import resolve
 from vecfit.errors import VecfitError
@@ -110,6 +110,7 @@ def test_written_svg_matches_resvg(small_peppers, tmp_path):
     assert psnr >= 28, psnr
 
 
+@pytest.mark.slow
 def test_background_rect_written_where_the_svg_leaves_canvas_bare(tmp_path):
     target = disc_image(tmp_path / "t.png", background=(0, 128, 0, 255))
     svg = circle_svg(tmp_path / "c.svg")
@@ -382,7 +383,7 @@ def test_ssim_loss_matches_scikit_image():
 
 
 # SSIM barely sees a flat colour's error (its luminance term is forgiving): a weaker bar
-@pytest.mark.parametrize("loss,factor", [("l1", 0.6), ("ssim", 0.9), ("pyramid", 0.6)])
+@pytest.mark.parametrize("loss,factor", slow_unless([("l1", 0.6), ("ssim", 0.9), ("pyramid", 0.6)], [("l1", 0.6)]))
 def test_other_losses_also_fit(loss, factor):
     scene = _circle_scene()
     result = optimize(scene, _disc_target(), Settings.defaults(iterations=25, lr_warmup=0, threads=1, loss=loss,
@@ -476,6 +477,7 @@ def test_coarse_to_fine_gains_like_full_size(small_trace, tmp_path, monkeypatch)
     assert rendered[0.5] == [(80, 53)] * 30 + [(160, 106)] * 31
 
 
+@pytest.mark.slow
 def test_coarse_needs_pixels_for_every_shape(small_peppers):
     """The 128-px peppers trace has 705 shapes: at 64 px they would get 6 pixels each, so
     it is fitted at full size throughout."""

@@ -98,6 +98,7 @@ def test_a_zero_budget_joins_only_what_costs_nothing():
     assert list(scene.shapes[1].geometry.degrees) == [1, 1, 1, 1]  # collinear lines join at no cost
 
 
+@pytest.mark.slow
 def test_trace_drops_nodes_within_a_tenth_of_a_db():
     """The job: a trace of a flat picture with the pass (the default) and without; the
     pass's report, fewer segments in the file, and the loss within the budget (the

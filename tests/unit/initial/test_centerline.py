@@ -206,6 +206,7 @@ def test_mixed_draws_areas_as_fills_under_their_outlines_without_a_warning():
     assert psnr(rendered(result.svg), image[..., :3]) > 24
 
 
+@pytest.mark.slow
 def test_mixed_keeps_an_emojis_face_and_mouth_as_fills():
     # an emoji as OpenMoji draws them, at 256 px: a face whose skeleton runs mostly through
     # its narrow parts round the eyes and mouth (its median width under max_stroke, so it

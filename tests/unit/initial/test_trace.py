@@ -162,6 +162,7 @@ def test_an_outline_tangent_to_the_canvas_edge_is_fitted_closer():
                                   bezier.fit_outlines([tangent + 2], 1.0, 135.0)[0])
 
 
+@pytest.mark.slow
 def test_path_budget_is_respected():
     image = small_photo("chelsea", (96, 64))
     full = trace_image(image)
@@ -305,6 +306,7 @@ def test_shape_leaves_what_is_drawn_below_showing():
     assert holes == [False, True, False]
 
 
+@pytest.mark.slow
 def test_overlap_closes_seams_on_a_photo(tmp_path):
     """Without overlap, neighbouring shapes that meet edge to edge let the white
     background through along their shared edges (measured: 2.4 dB here)."""

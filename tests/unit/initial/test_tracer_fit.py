@@ -17,6 +17,8 @@ from vecfit.initial.tracer.bezier import (MAX_TURN, NEWTON_RANGE, NEWTON_STEPS, 
 from vecfit.initial.tracer.outlines import crack_outlines
 from vecfit.initial.tracer.quantize import quantize_colors
 
+from helpers import slow_unless
+
 
 # ----------------------------------------------- the NumPy fit, as bezier.py had it
 
@@ -338,6 +340,7 @@ def assert_same_fits(outlines, **settings):
         np.testing.assert_array_equal(g, e)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("tolerance", [0.3, 1.0, 2.5])
 def test_the_fit_of_a_photos_outlines_is_the_numpy_fits(tolerance):
     outlines = outlines_of_a_photo()
@@ -345,7 +348,7 @@ def test_the_fit_of_a_photos_outlines_is_the_numpy_fits(tolerance):
     assert_same_fits(outlines, tolerance=tolerance, corner_angle=135.0)
 
 
-@pytest.mark.parametrize("seed", range(3))
+@pytest.mark.parametrize("seed", slow_unless(range(3), [0]))
 def test_the_fit_of_outlines_off_the_grid_is_the_numpy_fits(seed):
     """Outlines moved by up to half a pixel (as the sub-pixel placement moves them)."""
     rng = np.random.default_rng(seed)

@@ -149,6 +149,7 @@ def test_merges_as_the_python_merger_on_random_label_maps(seed):
             assert got.max() + 1 == len(got) - np.count_nonzero(inputs[2])  # only slivers merged
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("budget", [60, 1000])
 def test_merges_as_the_python_merger_on_a_photo(budget):
     """chelsea's colour classes as the tracer makes them: thousands of regions, some with

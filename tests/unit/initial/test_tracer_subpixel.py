@@ -144,6 +144,7 @@ def assert_same_moves(args):
     assert moved > 1000  # the edges did move
 
 
+@pytest.mark.slow
 def test_a_photos_outlines_move_as_numpy_moved_them():
     rgb = skimage.data.chelsea()[:200, :260].astype(np.float32) / 255
     image = np.concatenate([rgb, np.ones_like(rgb[..., :1])], 2)

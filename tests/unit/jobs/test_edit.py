@@ -234,6 +234,7 @@ def test_edit_config_is_checked():
         resolve("edit", overrides={"edit": {"changed_weight": 0.5}})
 
 
+@pytest.mark.slow
 def test_batch_edit_pairs_each_edited_image_with_its_svg(drawing, tmp_path):
     folder = tmp_path / "in"
     folder.mkdir()

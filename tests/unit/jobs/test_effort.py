@@ -81,6 +81,7 @@ def test_unknown_efforts_are_refused_clearly(tmp_path):
     assert r.exit_code == EXIT_USAGE and "fast" in r.output
 
 
+@pytest.mark.slow
 def test_normal_writes_the_same_bytes_as_no_effort_and_quick_the_same_as_python(tmp_path):
     image = tmp_path / "in.png"
     two_shapes_png(image)
@@ -117,6 +118,7 @@ def test_refine_from_python_is_the_commands_svg(tmp_path):
         assert report["optimized"]["mse"] < report["initial"]["mse"]
 
 
+@pytest.mark.slow
 def test_batch_takes_the_effort_to_every_image_and_resume_sees_it(tmp_path):
     d = tmp_path / "in"
     d.mkdir()

@@ -131,6 +131,7 @@ def test_a_traced_palette_writes_only_its_colours_exactly(tmp_path):
     assert psnr_over(svg, target) >= psnr_over(free, target) - 0.5 and psnr_over(svg, target) > 30
 
 
+@pytest.mark.slow
 def test_auto_palette_caps_the_distinct_colours(tmp_path):
     target = poster_png(tmp_path / "in.png")
     for n in (2, 3):
@@ -142,6 +143,7 @@ def test_auto_palette_caps_the_distinct_colours(tmp_path):
     assert len(paints(svg)) == 4 and psnr_over(svg, target) > 30
 
 
+@pytest.mark.slow
 def test_refine_and_paint_snap_free_colours_to_the_palette(tmp_path):
     two_shapes_png(tmp_path / "in.png")
     init = ('<svg xmlns="http://www.w3.org/2000/svg" width="48" height="36">'
@@ -174,6 +176,7 @@ def test_auto_palette_kmeans_weights_by_coverage():
 
 # ----------------------------------------------------------- background removal
 
+@pytest.mark.slow
 def test_remove_background_leaves_the_page_transparent_and_scores_as_before(tmp_path):
     target = poster_png(tmp_path / "in.png")
     kept, _ = vecfit.trace(tmp_path / "in.png", settings=FAST)
@@ -187,6 +190,7 @@ def test_remove_background_leaves_the_page_transparent_and_scores_as_before(tmp_
     assert psnr_over(svg, target, page) >= psnr_over(kept, target, page) - 0.5
 
 
+@pytest.mark.slow
 def test_remove_background_with_a_palette_scores_over_the_colour_removed(tmp_path):
     target = poster_png(tmp_path / "in.png")
     page = (240 / 255, 240 / 255, 235 / 255, 1.0)
@@ -347,6 +351,7 @@ def test_without_the_options_the_report_has_no_colour_entry(tmp_path):
     assert "colours" not in report and svg == same and "inkscape" not in svg
 
 
+@pytest.mark.slow
 def test_batch_takes_the_colour_options_and_summarises_them(tmp_path):
     import csv
     (tmp_path / "in").mkdir()

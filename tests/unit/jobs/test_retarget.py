@@ -113,6 +113,7 @@ def picture(tmp_path):
     return tmp_path
 
 
+@pytest.mark.slow
 def test_retarget_narrows_the_canvas_and_keeps_the_face_round(picture):
     out = picture / "narrow.svg"
     r = run("retarget", picture / "picture.svg", "--width", "70%", "-o", out, "--config",
@@ -198,6 +199,7 @@ def test_iterations_sets_the_whole_runs_adam_steps(picture):
     assert report["config"]["retarget"]["width"] == "70%"  # the size is part of the settings
 
 
+@pytest.mark.slow
 def test_batch_retargets_every_svg_of_a_folder(picture):
     folder = picture / "in"
     folder.mkdir()

@@ -4,6 +4,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 from PIL import Image, ImageDraw
 
 import vecfit
@@ -66,6 +67,7 @@ def test_refine_refuses_a_stroked_file_before_the_work(tmp_path):
     assert "Traceback" not in result.output and not (tmp_path / "out.svg").exists()
 
 
+@pytest.mark.slow
 def test_batch_passes_the_stacking_on(tmp_path):
     (tmp_path / "in").mkdir()
     poster_png(tmp_path / "in" / "a.png")

@@ -6,6 +6,7 @@ import json
 import re
 
 import numpy as np
+import pytest
 from PIL import Image
 
 import vecfit
@@ -32,6 +33,7 @@ def elements(svg: str) -> list[str]:
             if 'id="vecfit-background"' not in m.group(0)]
 
 
+@pytest.mark.slow
 def test_strokes_are_refined_and_written_without_fills(tmp_path):
     png = line_art(tmp_path / "art.png")
     svg, report = vecfit.trace(png, style="strokes", settings=FAST)
@@ -57,6 +59,7 @@ def test_the_command_takes_style_and_fills_stays_as_it_was(tmp_path):
     assert bad.exit_code == 2 and "Traceback" not in bad.output
 
 
+@pytest.mark.slow
 def test_batch_takes_style_for_trace_only(tmp_path):
     folder = tmp_path / "in"
     folder.mkdir()

@@ -19,6 +19,8 @@ import pydiffvg
 import vecfit
 from vecfit import scene as vs
 
+from helpers import slow_unless
+
 S = 40  # canvas and image size
 
 
@@ -77,6 +79,7 @@ def one(shape, fill=BLUE, **group):
 
 # ------------------------------------------------------------------------ shapes
 
+@pytest.mark.slow
 def test_circle():
     got = fit(lambda p: one(pydiffvg.Circle(p["r"], p["c"])),
               {"r": torch.tensor(10.0), "c": torch.tensor([20.0, 18.0])},
@@ -85,6 +88,7 @@ def test_circle():
     close(got["c"], [20.0, 18.0], 0.15)
 
 
+@pytest.mark.slow
 def test_ellipse():
     got = fit(lambda p: one(pydiffvg.Ellipse(p["r"], p["c"])),
               {"r": torch.tensor([12.0, 7.0]), "c": torch.tensor([20.0, 19.0])},
@@ -93,6 +97,7 @@ def test_ellipse():
     close(got["c"], [20.0, 19.0], 0.15)
 
 
+@pytest.mark.slow
 def test_rect():
     # The start is off the pixel lines: an edge exactly on one gets the one-sided derivative
     # towards +x / +y (DESIGN.md, boundary term), which is 0 where the pixel on that side
@@ -107,6 +112,7 @@ def test_rect():
 STAR = torch.tensor([[20.0, 4.0], [29.4, 33.0], [4.8, 15.1], [35.2, 15.1], [10.6, 33.0]])
 
 
+@pytest.mark.slow
 def test_self_intersecting_polygon_even_odd():
     # A pentagram: even-odd leaves the centre pentagon empty, which the fit must reproduce.
     make = lambda p: one(pydiffvg.Polygon(p["pts"], True), use_even_odd_rule=True)  # noqa: E731
@@ -124,6 +130,7 @@ BLOB = torch.tensor([[6.0, 8.0], [14.0, 2.0], [26.0, 4.0], [34.0, 12.0], [36.0, 
                      [18.0, 36.0], [8.0, 32.0], [2.0, 18.0]])
 
 
+@pytest.mark.slow
 def test_closed_cubic_path():
     # three cubics, the last wrapping round to points[0]
     make = lambda p: one(pydiffvg.Path(torch.tensor([2, 2, 2]), p["pts"], True))  # noqa: E731
@@ -154,6 +161,7 @@ def test_open_stroke():
     close(got["pts"], CURVE, 1.5)  # control points: less well determined by the image
 
 
+@pytest.mark.slow
 def test_per_point_thickness():
     line = torch.tensor([[6.0, 20.0], [34.0, 20.0]])
     make = lambda p: stroke_only(pydiffvg.Path(torch.tensor([0]), line, False, stroke_width=p["w"]))  # noqa: E731
@@ -193,6 +201,7 @@ def test_radial_gradient():
     close(got["r"], [14.0, 9.0], 0.3)
 
 
+@pytest.mark.slow
 def test_shape_to_canvas_2x3():
     square = pydiffvg.Rect(torch.tensor([-8.0, -8.0]), torch.tensor([8.0, 8.0]))
     truth = torch.tensor([[1.0, 0.4, 20.0], [-0.3, 0.8, 19.0]])
@@ -224,7 +233,8 @@ def test_pixel_filter_radius(ftype, prefiltering):
     close(got["r"], 1.5, 0.08)
 
 
-@pytest.mark.parametrize("ftype", [diffvg.FilterType.tent, diffvg.FilterType.parabolic, diffvg.FilterType.hann])
+@pytest.mark.parametrize("ftype", slow_unless([diffvg.FilterType.tent, diffvg.FilterType.parabolic, diffvg.FilterType.hann],
+                                      [diffvg.FilterType.hann]))
 @pytest.mark.parametrize("prefiltering", [False, True])
 def test_filter_radius_gradient_against_finite_differences(ftype, prefiltering):
     """dL/dr against a central difference of the loss (step 0.1 px, the same samples),
@@ -249,6 +259,7 @@ def test_filter_radius_gradient_against_finite_differences(ftype, prefiltering):
     assert abs(float(r.grad) - fd) <= tol * abs(fd), (float(r.grad), fd)
 
 
+@pytest.mark.slow
 def test_background_image():
     # A disk over a background image whose colour is fitted (visible around the disk).
     disk = pydiffvg.Circle(torch.tensor(10.0), torch.tensor([20.0, 20.0]))
@@ -297,6 +308,7 @@ def test_sdf_output():
         close(got[k], truth[k], 0.05)
 
 
+@pytest.mark.slow
 def test_sdf_at_eval_positions():
     """eval_positions: N x 1 distances at the given points; a circle fitted to the
     distances at 8 points comes back (0.05 px), and the points' own gradient is the
@@ -329,6 +341,7 @@ def test_sdf_at_eval_positions():
     close(p.grad, [[1.0, 0.0]], 1e-3)
 
 
+@pytest.mark.slow
 def test_colour_at_eval_positions():
     """Colour output at eval_positions: N x 4 straight RGBA at the points, and a linear
     gradient's end point fitted to the colours at 6 points comes back (0.05 px)."""

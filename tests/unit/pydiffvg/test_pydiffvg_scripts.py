@@ -2,6 +2,7 @@
 code that runs on diffvg must run to its end here too."""
 from __future__ import annotations
 
+import pytest
 import torch
 
 import diffvg
@@ -43,6 +44,7 @@ def test_filter_radius_at_or_below_zero_renders_as_diffvg_does():
     assert hann(shapes, groups, torch.tensor(1.0), seed=0)[..., 3].sum() > 100
 
 
+@pytest.mark.slow
 def test_optimize_pixel_filter_converges():
     """apps/optimize_pixel_filter.py at 64 px (the circle a quarter of the size, the same
     filter radii): Adam at lr 1.0 on a Hann filter's radius from 1.0 towards the target's
@@ -115,6 +117,7 @@ def test_eval_positions_gradients_match_differences():
                     (output, i, k, float(g.reshape(-1)[k]), float(fd))
 
 
+@pytest.mark.slow
 def test_eval_positions_script_fits_the_circle():
     """apps/test_eval_positions.py, shrunk (64-px canvas, 120 Adam steps of 300 positions):
     the circle's SDF at random points, against the target SDF image sampled there, brings

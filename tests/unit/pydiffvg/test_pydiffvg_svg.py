@@ -63,6 +63,7 @@ def test_round_trip(results):
     assert not bad, bad
 
 
+@pytest.mark.slow
 def test_reads_what_vecfit_reads(results):
     passed = [r for r in results if r["fidelity"] >= 30]
     assert len(passed) >= 0.85 * len(results), f"{len(passed)}/{len(results)}"

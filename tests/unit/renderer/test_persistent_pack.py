@@ -347,6 +347,7 @@ def test_loop_same_fit_either_way(tmp_path, monkeypatch):
     assert torch.allclose(points_a, points_b, atol=1e-4)
 
 
+@pytest.mark.slow
 def test_loop_same_seed_same_result(tmp_path):
     """The same seed gives the same fit: bit for bit on the same thread count, and to
     rounding on another (the core's gradients are summed per thread, DESIGN.md)."""

@@ -6,7 +6,7 @@ import pytest
 import torch
 
 import vecfit
-from helpers import brute_force
+from helpers import brute_force, slow_unless
 from vecfit.renderer.raster import output_size
 from vecfit.scene import Circle, LinearGradient, Path, Rect, Scene, Shape, Solid
 
@@ -106,7 +106,7 @@ def test_tiles_match_brute_force(mode, samples, filter):
     assert torch.equal(fast, brute)
 
 
-@pytest.mark.parametrize("mode", ["mc", "analytic"])
+@pytest.mark.parametrize("mode", slow_unless(["mc", "analytic"], ["mc"]))
 def test_tiles_independent_of_thread_count(mode):
     """The tiles are binned by runs of draws on as many threads as the render has and
     joined in draw order: the image (whose compositing order and windings come from the

@@ -231,6 +231,7 @@ def brute_force(points) -> list[tuple[int, Fraction, int, Fraction]]:
     return out
 
 
+@pytest.mark.slow
 def test_random_polygons_match_the_brute_force_reference():
     rng = np.random.default_rng(37)
     total = 0

@@ -148,6 +148,7 @@ def test_closest_point_on_segment(ctrl, p):
     _check_closest(at, basins, at(t_core), d_core, p, scale, well_conditioned)
 
 
+@pytest.mark.slow
 @SETTINGS
 @given(ctrl=bezier())
 def test_segment_bounds_hold_the_curve_tightly(ctrl):
@@ -222,6 +223,7 @@ def ellipse_case(draw):
     return c, A, p
 
 
+@pytest.mark.slow
 @SETTINGS
 @given(case=ellipse_case())
 def test_closest_point_on_ellipse(case):
@@ -466,6 +468,7 @@ def random_poly(draw):
     return c + [0.0] * lead_zeros, lo, hi
 
 
+@pytest.mark.slow
 @SETTINGS
 @given(case=random_poly())
 # Newton landed on the root, and the bisections towards it ran out 2e-8 short of it
@@ -494,6 +497,7 @@ def test_polynomial_roots_vs_numpy(case):
     _match(got, real, [_root_tol(c, r) for r in real])
 
 
+@pytest.mark.slow
 @SETTINGS
 @given(roots=st.lists(st.floats(-1.0, 2.0), min_size=1, max_size=5),
        k=st.floats(0.01, 100.0), sign=st.sampled_from([1.0, -1.0]))

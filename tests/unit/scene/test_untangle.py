@@ -119,6 +119,7 @@ def test_a_loop_crossed_at_its_own_start_is_cut_at_its_other_crossings():
         assert subpath_crossings(*layout_of(loop, True), True, 0.01) == []
 
 
+@pytest.mark.slow
 def test_an_outline_with_many_crossings_is_checked_in_a_few_batches(monkeypatch):
     # a coiled ribbon (a prolate trochoid, 40 loops, closed below): 40 crossings. Checking
     # the rest of the outline again after every cut made a gradient emoji's outline take

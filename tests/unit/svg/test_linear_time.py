@@ -20,6 +20,8 @@ from vecfit.scene.arrays import numpy_arrays
 from vecfit.svg.document import SvgDocument
 from vecfit.svg.read import scene_of
 
+from helpers import slow_unless
+
 N = 100_000
 READ_LIMIT = 0.1  # seconds over the trivial document's read
 
@@ -129,7 +131,7 @@ def best_of_two(data: bytes) -> float:
     return first if first <= READ_LIMIT / 2 else min(first, read_seconds(data))
 
 
-@pytest.mark.parametrize("kind, body", DOCUMENTS, ids=[k for k, _ in DOCUMENTS])
+@pytest.mark.parametrize("kind, body", slow_unless(DOCUMENTS, DOCUMENTS[::4]), ids=[k for k, _ in DOCUMENTS])
 def test_hostile_values_read_in_linear_time(kind, body):
     slow = {}
     for name, run in RUNS.items():
@@ -149,6 +151,7 @@ def test_documents_reach_their_parsers():
         assert scene.width == 20 or kind in ROOTS, kind
 
 
+@pytest.mark.slow
 def test_many_rules_and_elements_cascade_quickly():
     """Rules x elements: 5,000 rules with one selector and 2,000 elements each checked
     every rule (seconds); rules are looked up by the element's id, classes and tag, and a

@@ -457,6 +457,7 @@ def test_recursive_and_broken_uses_are_skipped(tmp_path):
 
 # ======================================================================= style
 
+@pytest.mark.slow
 def test_css_classes_of_an_adobe_trace():
     path = need(DATA / "photos" / "kitty.svg")
     scene = load_svg(path)

@@ -236,6 +236,7 @@ def _element(path, source):
     return [e for e in root.iter() if e.get("id") == source][0]
 
 
+@pytest.mark.slow
 def test_kitty_changes_written(tmp_path):
     src = need(KITTY)
     scene = quiet_load(src)
