@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import warnings
 
 import numpy as np
 
-from vecfit.errors import VecfitError
+from vecfit.errors import VecfitError, VecfitWarning
 from vecfit.initial.tracer import TraceSettings, trace_image
-from vecfit.initial.tracer.background import border_colour, without_background
+from vecfit.initial.tracer.background import border_colour, corners_rival, without_background
 from vecfit.io.colors import fitting_background
 from vecfit.scene import Rect, Solid
 from vecfit.scene.arrays import numpy_arrays
@@ -84,6 +85,13 @@ def _background_removed(config: dict, target, progress):
         progress.status("remove-background: the image already has transparency; nothing removed")
         return target, None
     given = config["optimize"]["background"].strip().lower()
-    colour = border_colour(target[..., :3]) if given in ("auto", "none") else \
-        np.array(fitting_background(given)[:3])
+    if given in ("auto", "none"):
+        colour = border_colour(target[..., :3])
+        rival = corners_rival(target[..., :3], colour)
+        if rival is not None:
+            warnings.warn(f"remove-background: the image's border is mostly {hex_color(colour)}, which is "
+                          f"removed, but two of its corners are {hex_color(rival)}; if that is the page, "
+                          f"give --background {hex_color(rival)}", VecfitWarning)
+    else:
+        colour = np.array(fitting_background(given)[:3])
     return without_background(target, colour), (*map(float, colour), 1.0)

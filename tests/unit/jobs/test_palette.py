@@ -235,7 +235,7 @@ def test_background_is_the_corners_colour_where_a_logo_covers_most_of_the_border
     border, so the border's dominant colour is the card's; its four rounded corners show
     the page, which is the background. Where the corners do not agree (two and two), the
     border's dominant colour decides."""
-    from vecfit.initial.tracer.background import border_colour
+    from vecfit.initial.tracer.background import border_colour, corners_rival
     page, card = (42, 157, 143), (20, 216, 204)
     image = Image.new("RGB", (96, 64), page)
     ImageDraw.Draw(image).rounded_rectangle((0, 0, 95, 63), radius=8, fill=card)
@@ -244,6 +244,23 @@ def test_background_is_the_corners_colour_where_a_logo_covers_most_of_the_border
     ImageDraw.Draw(image).rectangle((0, 0, 95, 31), fill=card)  # top corners square: two and two
     rgb = np.asarray(image, np.float64) / 255
     assert np.rint(border_colour(rgb) * 255).astype(int).tolist() == list(card)
+    # ... and the bottom corners' colour is named, for the job's warning
+    assert np.rint(corners_rival(rgb, border_colour(rgb)) * 255).astype(int).tolist() == list(page)
+    assert corners_rival(rgb, np.array(page) / 255) is not None  # (the card, two corners: the other guess)
+    solid = np.full((8, 8, 3), 0.5)
+    assert corners_rival(solid, border_colour(solid)) is None
+
+
+def test_remove_background_warns_where_the_corners_disagree_with_the_border(tmp_path):
+    """Two corners of the page's colour, the border mostly the frame's: the frame's colour
+    is removed, and the warning names the page's colour and the option that picks it."""
+    image = Image.new("RGB", (64, 48), (42, 157, 143))
+    ImageDraw.Draw(image).rectangle((0, 0, 40, 47), fill=(64, 209, 245))  # the left corners and most of the border
+    image.save(tmp_path / "in.png")
+    with pytest.warns(UserWarning, match="corners are #2a9d8f.*--background #2a9d8f"):
+        _, report = vecfit.trace(tmp_path / "in.png", settings={
+            **FAST, "optimize": {**FAST["optimize"], "iterations": 0}, "trace": {"remove_background": True}})
+    assert report["removed_background"] == "#40d1f5"
 
 
 def test_remove_background_unmixes_a_shape_tangent_to_the_canvas_edge(tmp_path):
