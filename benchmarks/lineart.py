@@ -34,6 +34,7 @@ import re
 import statistics
 import tempfile
 import time
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -155,7 +156,7 @@ def main():
                         if row == "vtracer":
                             written = vtracer.convert_raw_image_to_svg(png, img_format="png")
                         elif row == "scan strokes":
-                            written = trace(degraded(png, hash(name) % 2**32), "strokes")
+                            written = trace(degraded(png, zlib.crc32(name.encode())), "strokes")
                         else:
                             written = trace(png, row)
                         seconds = time.perf_counter() - start

@@ -32,6 +32,7 @@ from . import losses
 from .result import Result
 from .settings import PARAMETER_KINDS, Settings  # noqa: F401  (re-exported: the loop's settings)
 from .adam import Adam
+from .blur import gaussian_blur
 from .outline import OutlineCost
 from .opacity import colors_kept_opaque, translucency_wanted
 from .rates import boundary_length_density, dense_point_rate, held_boundary_budget, outline_density, parameter_kinds
@@ -169,6 +170,7 @@ class _Fit:
         self.scene, self.target, self.settings = scene, target, settings
         self.hooks, self.penalty = hooks, penalty
         self.loss_fn = losses.get(settings.loss)
+        self.blur = 0.0 if settings.target_blur == "auto" else float(settings.target_blur)
         height, width = target.image.shape[:2]
         self.fine_from, self.levels = _levels(target, settings, len(scene.shapes))
         self.density = outline_density(scene, width, height)
@@ -236,7 +238,10 @@ class _Fit:
                            device=settings.device,
                            packed=self.packed(w, h))
             self.image = image.detach()
-            loss = at.loss(self.loss_fn, settings.loss, at.rendered(image), goal)
+            compared = at.rendered(image)
+            if self.blur > 0:  # a scan's blur, put on the render (fitting/blur.py), at this level's scale
+                compared = gaussian_blur(compared, self.blur * w / self.target.image.shape[1])
+            loss = at.loss(self.loss_fn, settings.loss, compared, goal)
             return loss if self.penalty is None else loss + self.penalty()
 
     def regularised(self, loss: torch.Tensor) -> torch.Tensor:

@@ -9,6 +9,7 @@ from dataclasses import dataclass, fields
 from vecfit.errors import VecfitError
 from vecfit.io.colors import fitting_background
 from vecfit.io.configs import defaults
+from vecfit.fitting.blur import MAX_BLUR
 from vecfit.renderer import device as devices
 from vecfit.names import LOSSES, MODES
 ALPHA_MODES = ("auto", "free", "fixed")  # which colours' opacity may change (opacity.py)
@@ -46,6 +47,7 @@ class Settings:
     simplify: float  # after the fit, nodes dropped while the picture loses at most this many dB (0: never)
     simplify_iterations: int  # the brief refinement after those joins (vecfit/fitting/simplify.py)
     simplify_samples: int  # N x N samples of the renders that judge the joins (0: eval_samples')
+    target_blur: object  # "auto" | px: the render blurred alike before the loss (fitting/blur.py); the loop reads "auto" as 0
     lr: dict
 
     @classmethod
@@ -111,6 +113,10 @@ class Settings:
             raise VecfitError(f"simplify_samples must be 0 or more, not {self.simplify_samples}")
         if self.simplify_iterations < 0:
             raise VecfitError(f"simplify_iterations must be 0 or more, not {self.simplify_iterations}")
+        blur = self.target_blur
+        if not (blur == "auto" or (isinstance(blur, (int, float)) and not isinstance(blur, bool)
+                                   and math.isfinite(blur) and 0 <= blur <= MAX_BLUR)):
+            raise VecfitError(f'target_blur must be "auto" or a number of pixels from 0 to {MAX_BLUR:g}, not {blur!r}')
         if self.background.strip().lower() != "auto":
             fitting_background(self.background)
         for kind, value in self.lr.items():

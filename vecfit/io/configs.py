@@ -60,7 +60,17 @@ def merge(base: dict, changes: dict, schema: dict, source: str, prefix: str = ""
     return out
 
 
+# Settings whose default is "auto" and that take a number instead (their range is checked
+# with the other settings: vecfit/fitting/settings.py).
+AUTO_OR_NUMBER = {"optimize.target_blur"}
+
+
 def _checked(value, expected, name: str, source: str):
+    if name in AUTO_OR_NUMBER:
+        ok = value == "auto" or (isinstance(value, (int, float)) and not isinstance(value, bool))
+        if not ok:
+            raise VecfitError(f'{source}: {name} must be "auto" or a number, not {value!r}')
+        return value if value == "auto" else float(value)
     if isinstance(expected, bool):
         ok = isinstance(value, bool)
     elif isinstance(expected, float):

@@ -12,6 +12,7 @@ from vecfit.errors import VecfitError, VecfitWarning
 from vecfit.initial.tracer import TraceSettings, trace_image
 from vecfit.initial.tracer.background import border_colour, corners_rival, without_background
 from vecfit.io.colors import fitting_background
+from vecfit.io.compositing import composite
 from vecfit.scene import Rect, Solid
 from vecfit.scene.arrays import numpy_arrays
 from vecfit.svg.numbers import hex_color
@@ -66,6 +67,7 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
         # joins judged on 4 x 4 samples (refine.toml, simplify_samples)
         config = {**config, "optimize": {**config["optimize"], "alpha": "fixed", "coarse": 0.0,
                                          "simplify_samples": config["optimize"]["simplify_samples"] or 4,
+                                         "target_blur": _line_art_blur(config["optimize"], target),
                                          "lr": {**config["optimize"]["lr"], "colors": 0.0}}}
     return fit_and_write(scene, traced.document, target, config, outputs, progress, keep_alpha=backdrop, generated=True,
                          removed_background=removed, hooks=hooks,
@@ -75,6 +77,19 @@ def run(inputs: Inputs, config: dict, outputs: Outputs, progress=None) -> dict:
                                            "colors": traced.colors, "seconds": traced.seconds,
                                            "strokes": traced.strokes, "warnings": traced.warnings},
                                  **({} if removed is None else {"removed_background": hex_color(removed)})})
+
+
+def _line_art_blur(optimize: dict, target: np.ndarray) -> float:
+    """optimize.target_blur for line art: "auto" is the target's own blur (a scan's;
+    about 0 for a render: vecfit/fitting/blur.py) in pixels of the image the fit sees
+    (optimize.max_size), rounded to 0.05 px; a number is taken as given."""
+    if optimize["target_blur"] != "auto":
+        return optimize["target_blur"]
+    from vecfit.fitting.blur import BLUR_FLOOR, estimate_blur
+    h, w = target.shape[:2]
+    scale = min(1.0, optimize["max_size"] / max(h, w)) if optimize["max_size"] else 1.0
+    sigma = estimate_blur(composite(target, (1.0, 1.0, 1.0))) * scale
+    return round(sigma / 0.05) * 0.05 if sigma >= BLUR_FLOOR else 0.0
 
 
 def _background_removed(config: dict, target, progress):
