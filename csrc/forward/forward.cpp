@@ -109,10 +109,17 @@ void tile_forward(const SceneView& sc, const TileView& bins, const RenderOptions
             if (c[3] <= 0) continue;
         }
         const Box near = grown(d.box, R);
+        // Only the pixel rows whose samples (within R of their row's centre line) can lie in
+        // the draw's box are visited: the active samples are in row order, so theirs are one
+        // run, active[a0, a1). (A hair wider than the box: a sample on its edge is visited.)
+        const int nr0 = clamp_to_int(std::ceil(near.y0 - 0.5 - R - 1e-7) - y0, 0, rows);
+        const int nr1 = clamp_to_int(std::floor(near.y1 - 0.5 + R + 1e-7) - y0, -1, rows - 1);
+        if (nr0 > nr1) continue;
+        const int a0 = ts.row_begin[nr0], a1 = ts.row_begin[nr1 + 1];
+        if (a0 == a1) continue;
         const bool counted = d.kind == DRAW_FILL && !d.is_ellipse;  // windings counted here
-        const int n_active = (int)ts.active.size();
         if (counted) {
-            for (int a = 0; a < n_active; ++a) ts.winding[a] = e.winding;
+            for (int a = a0; a < a1; ++a) ts.winding[a] = e.winding;
             const PreparedSegment* segs = sc.fill_items.data() + d.first_item;
             const LocalItem* items = bins.items.data() + e.first;
             for (int li = 0; li < e.count; ++li) {
@@ -120,8 +127,8 @@ void tile_forward(const SceneView& sc, const TileView& bins, const RenderOptions
                 // Only the rows whose samples (within R of their row's centre line) can lie
                 // in the segment's height range can cross it. (Clamped as doubles: a
                 // coordinate can be 10^28 px.)
-                int r0 = clamp_to_int(std::ceil(item.y0 - 0.5 - R) - y0, 0, rows);
-                int r1 = clamp_to_int(std::floor(item.y1 - 0.5 + R) - y0, -1, rows - 1);
+                int r0 = std::max(nr0, clamp_to_int(std::ceil(item.y0 - 0.5 - R) - y0, 0, rows));
+                int r1 = std::min(nr1, clamp_to_int(std::floor(item.y1 - 0.5 + R) - y0, -1, rows - 1));
                 if (r0 <= r1) {
                     const PreparedSegment& seg = segs[item.item];
                     for (int a = ts.row_begin[r0]; a < ts.row_begin[r1 + 1]; ++a)
@@ -130,13 +137,13 @@ void tile_forward(const SceneView& sc, const TileView& bins, const RenderOptions
                 if (item.cross >= 0) {  // the vertical leg: every sample at or below
                     const LegCrossings& c = bins.crossings[item.cross];
                     for (int j = 0; j < c.n; ++j)
-                        for (int a = 0; a < n_active; ++a)
+                        for (int a = a0; a < a1; ++a)
                             if (c.y[j] <= ts.p[ts.active[a]].y) ts.winding[a] += c.dir[j];
                 }
             }
         }
-        int kept = 0;
-        for (int a = 0; a < n_active; ++a) {
+        int kept = a0;
+        for (int a = a0; a < a1; ++a) {
             const int si = ts.active[a];
             const Vec2 q = ts.p[si];
             bool opaque = false;
@@ -152,8 +159,8 @@ void tile_forward(const SceneView& sc, const TileView& bins, const RenderOptions
             }
             if (!opaque) ts.active[kept++] = si;
         }
-        if (kept < n_active) {
-            ts.active.resize(kept);
+        if (kept < a1) {  // samples turned opaque: drop them, the rest in order
+            ts.active.erase(ts.active.begin() + kept, ts.active.begin() + a1);
             index_rows();
         }
     }

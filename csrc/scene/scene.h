@@ -65,7 +65,7 @@ struct SegmentSource {
 };
 
 // A segment ready for sampling, with where its control points came from (for gradients).
-// (384 bytes: ranges are floats rounded outwards, the power basis is computed where a
+// (576 bytes: ranges are floats rounded outwards, the power basis is computed where a
 // root needs it; a path of 300,000 segments holds one of these per segment.)
 struct PreparedSegment {
     Segment seg;
@@ -79,8 +79,9 @@ struct PreparedSegment {
     // lines keep one; see sub_t), with their y (sub_y) and x ranges: a ray crossing is
     // decided by the one sub-piece at the ray's height, whose x range is a few times
     // narrower than the piece's (no root to solve for most samples) and whose parameter
-    // range brackets the root tightly (ray_crossings).
-    static constexpr int SUB = 4;
+    // range brackets the root tightly (ray_crossings). Eight, not four: a fit lengthens its
+    // curves, widening the ranges, and the root solves grew with them (DESIGN.md).
+    static constexpr int SUB = 8;
     int n_sub = 1;
     double sub_cut[3][SUB - 1];  // y at the cuts inside each piece
     float sub_x0[3][SUB], sub_x1[3][SUB];

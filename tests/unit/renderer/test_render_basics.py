@@ -106,6 +106,28 @@ def test_tiles_match_brute_force(mode, samples, filter):
     assert torch.equal(fast, brute)
 
 
+def test_translucent_stack_matches_brute_force():
+    """A dense translucent scene, as a fit of a photograph ends (small shapes, every one
+    translucent, over a translucent page): no sample turns opaque, so the CPU's
+    draw-by-draw forward pass visits each entry's samples by the pixel rows its draw's box
+    reaches; the image is still the sample-by-sample one (pixel_forward, which brute force
+    runs), bit for bit, and every shape shows through."""
+    rng = np.random.default_rng(7)
+    shapes = [square(-2, -2, 50, 42, [0.2, 0.3, 0.4, 0.999])]
+    for _ in range(150):
+        x, y = rng.uniform(-3, 47, 2)
+        w, h = rng.uniform(0.7, 9, 2)
+        shapes.append(square(x, y, x + w, y + h, [*rng.uniform(0, 1, 3), rng.uniform(0.3, 0.95)]))
+    scene = Scene(width=48, height=40, shapes=shapes)
+    for samples in (2, 3):
+        fast = vecfit.render(scene, 48, 40, samples=samples, seed=3)
+        with brute_force():
+            brute = vecfit.render(scene, 48, 40, samples=samples, seed=3)
+        assert torch.equal(fast, brute)
+    # (no sample is opaque: the page's alpha shows in every pixel's)
+    assert float(fast[..., 3].max()) < 1
+
+
 @pytest.mark.parametrize("mode", slow_unless(["mc", "analytic"], ["mc"]))
 def test_tiles_independent_of_thread_count(mode):
     """The tiles are binned by runs of draws on as many threads as the render has and
