@@ -567,11 +567,16 @@ def colour_and_style_args(rng: random.Random, command: str) -> list[str]:
         args += ["--stacking", rng.choice(["cutouts", "cutouts", "stacked"])]
     if rng.random() < 0.2:
         args.append("--gap-filler")
+    if rng.random() < 0.2:  # a scan's blur fitted through (optimize.target_blur), in a config file
+        args += ["--config", rng.choice(sorted(k for k in PALETTE_FILES if k.startswith("blur")))]
     return args
 
 
 PALETTE_FILES = {"palette.txt": b"#ff0000\n00ff00\n  \nblue\n12 34 56\n",
-                 "palette.gpl": b"GIMP Palette\nName: x\n#\n255 0 0 red\n0 0 255\tblue\n"}
+                 "palette.gpl": b"GIMP Palette\nName: x\n#\n255 0 0 red\n0 0 255\tblue\n",
+                 **{f"blur-{k}.toml": b"[optimize]\ntarget_blur = " + v + b"\n" for k, v in
+                    {"auto": b'"auto"', "none": b"0", "some": b"1.5", "most": b"8", "past": b"9.5", "below": b"-1",
+                     "word": b'"sharp"', "yes": b"true", "nan": b"nan"}.items()}}
 
 
 @dataclass
