@@ -53,6 +53,20 @@ def test_a_plain_render_imports_no_image_library(tmp_path, module):
     assert "[1/1]" in output and not loaded, output
 
 
+def test_a_plain_render_imports_nothing_it_does_not_use(tmp_path):
+    """Tiger's transform list (a scale and a translation) is multiplied by the reader, the
+    PNG's temporary file made with os.open, the dash lengths' quadrature rule made when
+    dashes are: svgelements, tempfile (with shutil and random) and numpy.polynomial were a
+    fifth of the command's imports after NumPy's and click's."""
+    modules = ["svgelements", "tempfile", "shutil", "random", "numpy.polynomial"]
+    code = ("import sys\nfrom vecfit.cli.commands import main\n"
+            f"sys.argv = ['vecfit', 'render', {str(TIGER)!r}, '-o', {str(tmp_path / 't.png')!r}]\n"
+            "try:\n    main()\nexcept SystemExit:\n    pass\n"
+            f"print(','.join(m for m in {modules!r} if m in sys.modules) or '-')")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert "[1/1]" in out.stderr and out.stdout.split()[-1:] == ["-"], out.stdout + out.stderr
+
+
 def _with_torch(svg, png, **options) -> bytes:
     """The PNG that vecfit.render makes of ``svg`` (a Scene of tensors), as the command
     made it before."""
