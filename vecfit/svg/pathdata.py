@@ -157,20 +157,25 @@ def parse_path_data(d: str, max_segments: int | None = None) -> list[Subpath]:
                 raise ValueError("number without a command")
             if cmd in "Aa":
                 args, i = _arc_args(tokens, i)
-            else:
-                count = _ARG_COUNT[cmd]
+                _APPLY[cmd](b, args)
+                if len(b.subpaths) + b.segments > budget:
+                    raise PathDataError([], too_long=True)
+                continue
+            # The command's groups of arguments, up to the next command letter (tiger's
+            # paths are a C and dozens of curves each).
+            count, apply = _ARG_COUNT[cmd], _APPLY[cmd]
+            while True:
                 if i + count > n:
                     raise ValueError("missing arguments")
-                args = list(map(float, tokens[i:i + count]))
+                apply(b, list(map(float, tokens[i:i + count])))
                 i += count
-            _APPLY[cmd](b, args)
-            if len(b.subpaths) + b.segments > budget:
-                raise PathDataError([], too_long=True)
-            # After a moveto, further coordinate pairs are implicit linetos.
-            if cmd == "M":
-                cmd = "L"
-            elif cmd == "m":
-                cmd = "l"
+                if len(b.subpaths) + b.segments > budget:
+                    raise PathDataError([], too_long=True)
+                if cmd in "Mm":  # after a moveto, further coordinate pairs are implicit linetos
+                    cmd = "L" if cmd == "M" else "l"
+                    apply = _APPLY[cmd]
+                if i >= n or tokens[i] in _COMMANDS:
+                    break
     except PathDataError:
         raise
     except (ValueError, IndexError, OverflowError):
