@@ -5,6 +5,7 @@ with render_numpy where that draws it as vecfit.render does
 filters, dashes, gradients, rotations) import torch and render as before."""
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import warnings
@@ -156,3 +157,17 @@ def test_ctrl_c_while_a_render_imports_torch(tmp_path):
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130 and "interrupted" in err and "Traceback" not in err, err
     assert not (tmp_path / "g.png").exists()
+
+
+@pytest.mark.parametrize("given, expected", [(None, "4"), ("12", "12")])
+def test_importing_vecfit_lets_openblas_idle_threads_sleep(given, expected):
+    """OpenBLAS's worker threads, started as NumPy loads, spin for 2^28 cycles before they
+    sleep: a tenth of a second of a core taken from the command's start-up on a busy
+    2-core machine. vecfit sets OPENBLAS_THREAD_TIMEOUT (2^4 cycles) before NumPy loads,
+    unless the user set it."""
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_THREAD_TIMEOUT"}
+    if given is not None:
+        env["OPENBLAS_THREAD_TIMEOUT"] = given
+    code = "import os, vecfit, numpy\nprint(os.environ.get('OPENBLAS_THREAD_TIMEOUT'))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=60)
+    assert out.stdout.split() == [expected], out.stdout + out.stderr
