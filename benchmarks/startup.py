@@ -11,10 +11,21 @@ render of tiger as a command (a `python -c` around resvg_py) is the one to beat 
 `vecfit render`. "torch" says whether the command's process imported it (checked by
 running the command line's main in-process, in a fresh interpreter, and looking at
 sys.modules).
+
+    python benchmarks/startup.py --alternate 11 [--baseline DIR]
+
+times `vecfit render` of tiger and resvg's command alternated, 11 rounds, in shuffled order
+each round (on a shared machine, a ratio is only worth what was measured in one run): the
+medians and the ratio of the render's to resvg's. --baseline adds the same render by
+another checkout (DIR, a tree with its vecfit/ and cli/ in place, run with PYTHONPATH=DIR
+and byte-compiled as this one is), to compare commits.
 """
 from __future__ import annotations
 
 import argparse
+import compileall
+import os
+import random
 import statistics
 import subprocess
 import sys
@@ -50,7 +61,13 @@ def imports_torch(args: list[str]) -> bool:
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=7)
+    ap.add_argument("--alternate", type=int, metavar="ROUNDS",
+                    help="Only `vecfit render` of tiger against resvg's command, alternated.")
+    ap.add_argument("--baseline", type=Path, help="With --alternate: also this checkout's render.")
     args = ap.parse_args()
+    if args.alternate:
+        alternate(args.alternate, args.baseline)
+        return
     tiger = str(ROOT / "examples" / "tiger.svg")
     emoji = Path(tempfile.mkdtemp()) / "emoji.png"  # a 512-px emoji as `trace --no-refine` gets it
     emoji.write_bytes(bytes(resvg_py.svg_to_bytes(svg_path=str(EMOJI), width=512)))
@@ -77,6 +94,37 @@ def main():
     for label, argv, cli in rows:
         torch = "" if cli is None else ("yes" if imports_torch(cli) else "no")
         print(f"| {label} | {in_r(wall(argv, args.repeats), unit)} | {torch} |", flush=True)
+
+
+def alternate(rounds: int, baseline: Path | None) -> None:
+    """`vecfit render` of tiger (this checkout's; the baseline's) and resvg's command in
+    shuffled order each round, from a folder outside either checkout (so that PYTHONPATH
+    decides which vecfit runs): medians and the render's ratio to resvg's."""
+    tiger, out = str(ROOT / "examples" / "tiger.svg"), Path(tempfile.mkdtemp())
+    env = user_environment()
+    runs = {"vecfit render tiger.svg": ([sys.executable, "-m", "vecfit", "render", tiger, "-o", str(out / "new.png")], env),
+            "resvg_py render tiger.svg": ([sys.executable, "-c", f"import resvg_py; open({str(out / 'r.png')!r}, 'wb')"
+                                           f".write(bytes(resvg_py.svg_to_bytes(svg_path={tiger!r})))"], env)}
+    if baseline is not None:
+        for folder in ("vecfit", "cli"):
+            if (baseline / folder).is_dir():
+                compileall.compile_dir(str(baseline / folder), quiet=1)
+        runs["baseline's vecfit render"] = ([sys.executable, "-m", "vecfit", "render", tiger, "-o", str(out / "old.png")],
+                                            dict(env, PYTHONPATH=str(baseline.resolve())))
+    times = {label: [] for label in runs}
+    for r in range(rounds):
+        order = list(runs)
+        random.Random(r).shuffle(order)
+        for label in order:
+            argv, run_env = runs[label]
+            start = time.perf_counter()
+            subprocess.run(argv, capture_output=True, check=True, env=run_env, cwd=out)
+            times[label].append(time.perf_counter() - start)
+    resvg = statistics.median(times["resvg_py render tiger.svg"])
+    print(f"{rounds} rounds alternated, load {os.getloadavg()[0]:.1f}\n")
+    print("| command | median wall | x resvg_py's |\n|---|---|---|")
+    for label, values in times.items():
+        print(f"| {label} | {statistics.median(values):.3f} s | {statistics.median(values) / resvg:.2f} |")
 
 
 if __name__ == "__main__":

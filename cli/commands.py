@@ -17,6 +17,12 @@ from vecfit.names import (EFFORTS, FILTERS, FORMATS, GROUP_BY, JOBS, LOSSES, MAX
                           STACKINGS, STYLES)
 from vecfit.renderer.options import RenderOptions
 
+# Path types, shared by the options: click looks up its translation of the type's name for
+# each one made (file-system look-ups, three dozen types a start).
+FILE = click.Path(dir_okay=False)
+FOLDER = click.Path(file_okay=False)
+EXISTING_FOLDER = click.Path(exists=True, file_okay=False)
+
 DEVICE_OPTION = dict(metavar="auto|cpu|cuda[:N]",
                      help="Where pixels are shaded: auto (a GPU when vecfit was built with CUDA and "
                           "one is present), cpu, or cuda (GPU N with cuda:N).")
@@ -105,10 +111,10 @@ def main():
 
 
 @main.command()
-@click.argument("inputs", nargs=-1, required=True, type=click.Path(dir_okay=False))
-@click.option("-o", "--output", type=click.Path(dir_okay=False),
+@click.argument("inputs", nargs=-1, required=True, type=FILE)
+@click.option("-o", "--output", type=FILE,
               help="Output PNG (one input); OUT.pdf or OUT.dxf converts the SVG to that format.")
-@click.option("--out-dir", type=click.Path(file_okay=False), help="Folder for outputs, NAME.svg -> NAME.png.")
+@click.option("--out-dir", type=FOLDER, help="Folder for outputs, NAME.svg -> NAME.png.")
 @click.option("--width", type=click.IntRange(min=1), help="Width in pixels (default: the SVG's).")
 @click.option("--height", type=click.IntRange(min=1), help="Height in pixels (default: the SVG's).")
 @click.option("--samples", type=click.IntRange(1, 64), default=RenderOptions.samples, show_default=True,
@@ -204,7 +210,7 @@ def _scene_to_render(src):
 
 
 @main.command()
-@click.argument("svg", required=False, type=click.Path(dir_okay=False))
+@click.argument("svg", required=False, type=FILE)
 @click.option("--build", is_flag=True, help="Say how this vecfit was built (compiler, CUDA, devices).")
 def info(svg, build):
     """List the shapes, segments and paints of an SVG, and what was skipped; or, with
@@ -236,16 +242,16 @@ def info(svg, build):
 def optimize_options(f):
     """Options shared by refine, trace and paint; each overrides the config's value."""
     options = [
-        click.option("-o", "--output", type=click.Path(dir_okay=False),
+        click.option("-o", "--output", type=FILE,
                      help="Output SVG, or PDF or DXF by its suffix (default: NAME.vecfit.svg next to the target)."),
         click.option("--format", "output_format", type=click.Choice(FORMATS),
                      help="Write the result as SVG, PDF (print) or DXF (plotters, cutters). "
                           "[default: -o's suffix, else svg]"),
-        click.option("--report", type=click.Path(dir_okay=False),
+        click.option("--report", type=FILE,
                      help="JSON report (default: the output's name + .report.json)."),
-        click.option("--comparison", type=click.Path(dir_okay=False),
+        click.option("--comparison", type=FILE,
                      help="Comparison PNG (default: the output's name + .compare.png)."),
-        click.option("--config", "config_file", type=click.Path(dir_okay=False),
+        click.option("--config", "config_file", type=FILE,
                      help="TOML file overriding the defaults in configs/."),
         click.option("--effort", type=click.Choice(EFFORTS),
                      help="quick: a short refinement; normal: the defaults; best: longer "
@@ -433,8 +439,8 @@ def _summarise(report) -> None:
 
 
 @main.command()
-@click.argument("target", type=click.Path(dir_okay=False))
-@click.argument("init_svg", type=click.Path(dir_okay=False))
+@click.argument("target", type=FILE)
+@click.argument("init_svg", type=FILE)
 @optimize_options
 @colour_options
 @stacking_options
@@ -449,7 +455,7 @@ def refine(target, init_svg, output, report, comparison, config_file, quiet, **o
 
 
 @main.command()
-@click.argument("target", type=click.Path(dir_okay=False))
+@click.argument("target", type=FILE)
 @click.option("--preset", help="A preset of configs/trace.toml: photo, poster or bw.")
 @click.option("--paths", type=click.IntRange(min=1), help="Path budget: at most this many shapes.")
 @click.option("--colors", type=click.IntRange(min=1), help="Colours of the k-means quantisation.")
@@ -483,12 +489,12 @@ def trace(target, preset, paths, colors, min_area, tolerance, style, refine, rem
 
 
 @main.command()
-@click.argument("target", type=click.Path(dir_okay=False))
+@click.argument("target", type=FILE)
 @click.option("--paths", type=click.IntRange(min=1), help="Number of strokes or shapes.")
 @click.option("--kind", type=click.Choice(PAINT_KINDS),
               help="Open cubic strokes or closed filled shapes.")
 @click.option("--preset", help="A preset of configs/paint.toml.")
-@click.option("--frames", type=click.Path(file_okay=False),
+@click.option("--frames", type=FOLDER,
               help="Save the optimisation as frame_NNNNN.png and optimization.gif in this folder.")
 @optimize_options
 @colour_options
@@ -505,9 +511,9 @@ def paint(target, paths, kind, preset, frames, output, report, comparison, confi
 
 
 @main.command()
-@click.argument("init_svg", type=click.Path(dir_okay=False))
-@click.argument("edited", type=click.Path(dir_okay=False))
-@click.option("--mask", type=click.Path(dir_okay=False),
+@click.argument("init_svg", type=FILE)
+@click.argument("edited", type=FILE)
+@click.option("--mask", type=FILE,
               help="PNG of EDITED's size, white where the edit is (default: where EDITED differs "
                    "from INIT_SVG's render).")
 @optimize_options
@@ -523,7 +529,7 @@ def edit(init_svg, edited, mask, output, report, comparison, config_file, quiet,
     _run_job("edit", inputs, config, _outputs(inputs.main, output, report, comparison, options), quiet)
 
 @main.command()
-@click.argument("svg", type=click.Path(dir_okay=False))
+@click.argument("svg", type=FILE)
 @click.option("--width", required=True, metavar="W|P%",
               help="New width: pixels (120) or a percentage of the SVG's (70%).")
 @click.option("--height", metavar="H|P%", help="New height (default: unchanged).")
@@ -548,21 +554,21 @@ def retarget(svg, width, height, output, report, comparison, config_file, quiet,
 # ------------------------------------------------------------------------------ batch
 
 @main.command()
-@click.argument("in_dir", type=click.Path(exists=True, file_okay=False))
-@click.option("-o", "--out-dir", required=True, type=click.Path(file_okay=False),
+@click.argument("in_dir", type=EXISTING_FOLDER)
+@click.option("-o", "--out-dir", required=True, type=FOLDER,
               help="Folder for the outputs and the summary (not IN_DIR).")
 @click.option("--mode", required=True, type=click.Choice(JOBS),
               help="The command run on each image (retarget: on each SVG).")
 @click.option("--width", metavar="W|P%", help="retarget: the new width, pixels or a percentage (70%).")
 @click.option("--height", metavar="H|P%", help="retarget: the new height (default: unchanged).")
-@click.option("--config", "config_file", type=click.Path(dir_okay=False),
+@click.option("--config", "config_file", type=FILE,
               help="TOML file overriding the defaults in configs/.")
 @click.option("--preset", help="A preset of the mode's file in configs/.")
 @click.option("--effort", type=click.Choice(EFFORTS),
               help="Every image's effort (as the mode's --effort).  [default: normal]")
 @click.option("--style", type=click.Choice(STYLES),
               help="trace: every image's style (as trace's --style).")
-@click.option("--init-dir", type=click.Path(exists=True, file_okay=False),
+@click.option("--init-dir", type=EXISTING_FOLDER,
               help="refine, edit: the folder of the SVGs (default: IN_DIR).")
 @click.option("-j", "--jobs", type=click.IntRange(min=0), default=1, show_default=True,
               help="Worker processes (0: one per core); 1 works in this process.")

@@ -16,6 +16,10 @@ from .errors import SvgError, VecfitError
 # small per-iteration operations (a refine iteration of peppers took 1.9x as long with
 # them spinning, on 2 busy cores; see benchmarks/RESULTS.md). A user's own setting wins.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+# Before NumPy loads OpenBLAS: its worker threads, started as it loads, sleep when idle
+# instead of spinning for their first 2^28 cycles (a tenth of a second of a core, taken
+# from the command's own start-up and the core's render threads on a busy machine).
+os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
 
 __version__ = "0.1.0"
 

@@ -1,4 +1,5 @@
 """`python -m vecfit ...` and the `vecfit` script run the vecfit command line."""
+import gc
 import sys
 
 from vecfit.errors import EXIT_INTERRUPTED
@@ -13,7 +14,13 @@ def run() -> None:
     except KeyboardInterrupt:
         sys.stderr.write("interrupted\n")
         sys.exit(EXIT_INTERRUPTED)
-    main(prog_name="vecfit")
+    try:
+        main(prog_name="vecfit")
+    finally:
+        # The command is done (its files written and closed) and the process ends: the
+        # collector need not traverse what is left (NumPy's, click's and the command's
+        # objects) in the interpreter's final collections, a tenth of `vecfit render`.
+        gc.freeze()
 
 
 if __name__ == "__main__":

@@ -5,6 +5,7 @@ with render_numpy where that draws it as vecfit.render does
 filters, dashes, gradients, rotations) import torch and render as before."""
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import warnings
@@ -51,6 +52,20 @@ def test_a_plain_render_imports_no_image_library(tmp_path, module):
     in hex; a colour keyword would load Pillow's table of them."""
     output, loaded = _render_command(TIGER, "-o", tmp_path / "tiger.png", module=module)
     assert "[1/1]" in output and not loaded, output
+
+
+def test_a_plain_render_imports_nothing_it_does_not_use(tmp_path):
+    """Tiger's transform list (a scale and a translation) is multiplied by the reader, the
+    PNG's temporary file made with os.open, the dash lengths' quadrature rule made when
+    dashes are: svgelements, tempfile (with shutil and random) and numpy.polynomial were a
+    fifth of the command's imports after NumPy's and click's."""
+    modules = ["svgelements", "tempfile", "shutil", "random", "numpy.polynomial"]
+    code = ("import sys\nfrom vecfit.cli.commands import main\n"
+            f"sys.argv = ['vecfit', 'render', {str(TIGER)!r}, '-o', {str(tmp_path / 't.png')!r}]\n"
+            "try:\n    main()\nexcept SystemExit:\n    pass\n"
+            f"print(','.join(m for m in {modules!r} if m in sys.modules) or '-')")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert "[1/1]" in out.stderr and out.stdout.split()[-1:] == ["-"], out.stdout + out.stderr
 
 
 def _with_torch(svg, png, **options) -> bytes:
@@ -142,3 +157,30 @@ def test_ctrl_c_while_a_render_imports_torch(tmp_path):
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130 and "interrupted" in err and "Traceback" not in err, err
     assert not (tmp_path / "g.png").exists()
+
+
+@pytest.mark.parametrize("given, expected", [(None, "4"), ("12", "12")])
+def test_importing_vecfit_lets_openblas_idle_threads_sleep(given, expected):
+    """OpenBLAS's worker threads, started as NumPy loads, spin for 2^28 cycles before they
+    sleep: a tenth of a second of a core taken from the command's start-up on a busy
+    2-core machine. vecfit sets OPENBLAS_THREAD_TIMEOUT (2^4 cycles) before NumPy loads,
+    unless the user set it."""
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_THREAD_TIMEOUT"}
+    if given is not None:
+        env["OPENBLAS_THREAD_TIMEOUT"] = given
+    code = "import os, vecfit, numpy\nprint(os.environ.get('OPENBLAS_THREAD_TIMEOUT'))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=60)
+    assert out.stdout.split() == [expected], out.stdout + out.stderr
+
+
+def test_the_command_leaves_its_objects_out_of_the_final_collections():
+    """The `vecfit` script and `python -m vecfit` freeze the collector's objects once the
+    command is done: the interpreter's final collections then skip NumPy's, click's and
+    the command's objects (a tenth of `vecfit render` on a busy machine), and the command's
+    output is the same."""
+    code = ("import atexit, gc, sys\n"
+            "atexit.register(lambda: print('frozen', gc.get_freeze_count() > 0))\n"
+            "sys.argv = ['vecfit', '--version']\nfrom vecfit.__main__ import run\nrun()")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0 and out.stdout.startswith("vecfit ") and out.stdout.split()[-2:] == ["frozen", "True"], \
+        out.stdout + out.stderr

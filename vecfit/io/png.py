@@ -23,7 +23,12 @@ def to_uint8(image) -> np.ndarray:
     torch = sys.modules.get("torch")  # (a tensor exists only once torch is imported)
     is_tensor = torch is not None and isinstance(image, torch.Tensor)
     a = image.detach().cpu().numpy() if is_tensor else np.asarray(image)
-    return (np.clip(a, 0, 1) * 255 + 0.5).astype(np.uint8)
+    if a.dtype.kind != "f":
+        a = a.astype(np.float64)
+    out = np.clip(a, 0, 1)  # (then in place: a fresh array per step cost more than the arithmetic)
+    out *= 255
+    out += 0.5
+    return out.astype(np.uint8)
 
 
 def _chunk(tag: bytes, data: bytes) -> bytes:
@@ -43,7 +48,7 @@ def png_bytes(pixels: np.ndarray) -> bytes:
     rows[:, 0] = 0  # filter type: none
     rows[:, 1:] = a.reshape(height, -1)
     header = struct.pack(">IIBBBBB", width, height, 8, COLOUR_TYPES[channels], 0, 0, 0)
-    return (SIGNATURE + _chunk(b"IHDR", header) + _chunk(b"IDAT", zlib.compress(rows.tobytes(), LEVEL))
+    return (SIGNATURE + _chunk(b"IHDR", header) + _chunk(b"IDAT", zlib.compress(rows, LEVEL))
             + _chunk(b"IEND", b""))
 
 

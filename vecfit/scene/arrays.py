@@ -51,8 +51,13 @@ def zeros(n: int):
     return floats(np.zeros(n))
 
 
+_EYE32 = np.eye(3, dtype=np.float32)
+
+
 def identity():
     """The 3x3 identity matrix."""
+    if _NUMPY.get():
+        return _EYE32.copy()  # (the reader makes one per shape)
     return floats(np.eye(3))
 
 

@@ -26,6 +26,7 @@ Ends clipped to a subpath's start or end are fixed parameters (0 or 1).
 """
 from __future__ import annotations
 
+import functools
 import math
 
 from typing import TYPE_CHECKING
@@ -40,9 +41,14 @@ from .model import Circle, Ellipse, Path, Rect
 if TYPE_CHECKING:
     import torch
 
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
-_GL_X = (_GL_X + 1) / 2   # nodes on [0, 1]
-_GL_W = _GL_W / 2
+
+
+@functools.cache
+def _gauss_legendre() -> tuple[np.ndarray, np.ndarray]:
+    """The 8-point Gauss-Legendre rule on [0, 1]: nodes and weights (made on first use:
+    numpy.polynomial is a hundredth of a second of `vecfit render`'s start-up)."""
+    x, w = np.polynomial.legendre.leggauss(8)
+    return (x + 1) / 2, w / 2
 _MAX_HALVINGS = 12        # the shortest sub-interval: 1/4096 of a segment's parameter
 _TOLERANCE = 1e-8        # per unit of parameter, relative to the control polygon's length
 _NEWTON_STEPS = 12
@@ -143,9 +149,10 @@ class _Segments:
 
     def _gl(self, seg: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Length of segments seg over parameters [a, b] (arrays of one shape), one GL rule."""
-        t = a[..., None] + (b - a)[..., None] * _GL_X
+        gl_x, gl_w = _gauss_legendre()
+        t = a[..., None] + (b - a)[..., None] * gl_x
         s = self._speed(self.quartic[seg][..., None, :], t)
-        return (b - a) * (s @ _GL_W)
+        return (b - a) * (s @ gl_w)
 
     def _lengths(self) -> None:
         """Per segment, its length and a table of sub-intervals of its parameter (sorted,
@@ -186,7 +193,8 @@ class _Segments:
 
     def length_gradient(self, seg: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """d(length over [a, b])/d(cubic control points) of segments seg: [k, 4, 2]."""
-        t = a[:, None] + (b - a)[:, None] * _GL_X          # [k, 8]
+        gl_x, gl_w = _gauss_legendre()
+        t = a[:, None] + (b - a)[:, None] * gl_x           # [k, 8]
         h = self.hodograph[seg]                            # [k, 3, 2]
         u = 1 - t
         basis2 = np.stack([u * u, 2 * u * t, t * t], -1)   # [k, 8, 3]
@@ -196,7 +204,7 @@ class _Segments:
         # d/dt of the cubic Bernstein basis: 3 (b2_{i-1} - b2_i)
         db = 3 * (np.concatenate([np.zeros_like(basis2[..., :1]), basis2], -1)
                   - np.concatenate([basis2, np.zeros_like(basis2[..., :1])], -1))  # [k, 8, 4]
-        w = (b - a)[:, None, None] * _GL_W[:, None]          # [k, 8, 1]
+        w = (b - a)[:, None, None] * gl_w[:, None]           # [k, 8, 1]
         return db.transpose(0, 2, 1) @ (w * unit)
 
     def part_at(self, seg: np.ndarray, t: np.ndarray) -> np.ndarray:

@@ -40,9 +40,10 @@ def _clamp01(v: float) -> float:
     return 0.0 if v < 0 else 1.0 if v > 1 else v
 
 
+@functools.lru_cache(maxsize=1024)
 def parse_color(text) -> RGBA | None:
     """A colour value, or None when ``text`` is not one (``currentColor`` included: the
-    caller resolves it)."""
+    caller resolves it). (Cached: files repeat a few colours over thousands of shapes.)"""
     if text is None:
         return None
     text = text.strip()

@@ -9,6 +9,7 @@ to the first error instead of rejecting it).
 """
 from __future__ import annotations
 
+import itertools
 import math
 import re
 from dataclasses import dataclass, field
@@ -21,6 +22,7 @@ from .units import NUMBER
 _TOKEN = re.compile(rf"[MmZzLlHhVvCcSsQqTtAa]|{NUMBER}|[^\s,]")
 _COMMANDS = frozenset("MmZzLlHhVvCcSsQqTtAa")
 _ARG_COUNT = {"m": 2, "l": 2, "h": 1, "v": 1, "c": 6, "s": 4, "q": 4, "t": 2, "a": 7}
+_ARG_COUNT.update({c.upper(): n for c, n in _ARG_COUNT.items()})
 
 
 @dataclass
@@ -69,25 +71,41 @@ class _Builder:
     def _forget(self):
         self.last_cubic_ctrl = self.last_quad_ctrl = None
 
-    def segment(self, degree, pts):
-        self.segments += 1
-        self._open()
-        self.current.points.extend(pts)
-        self.current.degrees.append(degree)
-        self.point = pts[-1]
-
+    # (line, cubic and quad are the parser's inner loop: each does the work of _open and
+    # _forget itself rather than call them)
     def line(self, p):
-        self.segment(1, [p])
-        self._forget()
+        self.segments += 1
+        current = self.current
+        if current is None or current.closed:
+            self.move(self.start)
+            current = self.current
+        current.points.append(p)
+        current.degrees.append(1)
+        self.point = p
+        self.last_cubic_ctrl = self.last_quad_ctrl = None
 
     def cubic(self, c1, c2, p):
-        self.segment(3, [c1, c2, p])
-        self._forget()
+        self.segments += 1
+        current = self.current
+        if current is None or current.closed:
+            self.move(self.start)
+            current = self.current
+        current.points += (c1, c2, p)
+        current.degrees.append(3)
+        self.point = p
+        self.last_quad_ctrl = None
         self.last_cubic_ctrl = c2
 
     def quad(self, c, p):
-        self.segment(2, [c, p])
-        self._forget()
+        self.segments += 1
+        current = self.current
+        if current is None or current.closed:
+            self.move(self.start)
+            current = self.current
+        current.points += (c, p)
+        current.degrees.append(2)
+        self.point = p
+        self.last_cubic_ctrl = None
         self.last_quad_ctrl = c
 
     def close(self):
@@ -137,22 +155,27 @@ def parse_path_data(d: str, max_segments: int | None = None) -> list[Subpath]:
                     raise ValueError("path data must start with a moveto")
             elif cmd is None or cmd in "Zz":
                 raise ValueError("number without a command")
-            count = _ARG_COUNT[cmd.lower()]
             if cmd in "Aa":
                 args, i = _arc_args(tokens, i)
-            else:
+                _APPLY[cmd](b, args)
+                if len(b.subpaths) + b.segments > budget:
+                    raise PathDataError([], too_long=True)
+                continue
+            # The command's groups of arguments, up to the next command letter (tiger's
+            # paths are a C and dozens of curves each).
+            count, apply = _ARG_COUNT[cmd], _APPLY[cmd]
+            while True:
                 if i + count > n:
                     raise ValueError("missing arguments")
-                args = [float(t) for t in tokens[i:i + count]]
+                apply(b, list(map(float, tokens[i:i + count])))
                 i += count
-            _apply(b, cmd, args)
-            if len(b.subpaths) + b.segments > budget:
-                raise PathDataError([], too_long=True)
-            # After a moveto, further coordinate pairs are implicit linetos.
-            if cmd == "M":
-                cmd = "L"
-            elif cmd == "m":
-                cmd = "l"
+                if len(b.subpaths) + b.segments > budget:
+                    raise PathDataError([], too_long=True)
+                if cmd in "Mm":  # after a moveto, further coordinate pairs are implicit linetos
+                    cmd = "L" if cmd == "M" else "l"
+                    apply = _APPLY[cmd]
+                if i >= n or tokens[i] in _COMMANDS:
+                    break
     except PathDataError:
         raise
     except (ValueError, IndexError, OverflowError):
@@ -180,6 +203,39 @@ def _arc_args(tokens, i):
             i += 1
     args += [float(tokens[i]), float(tokens[i + 1])]
     return args, i + 2
+
+
+# One function per command: ``a`` its arguments, absolute coordinates added to 0.0 as
+# relative ones to the current point (so -0.0 reads as 0.0 either way).
+def _m_abs(b, a):
+    b.move((0.0 + a[0], 0.0 + a[1]))
+
+
+def _m_rel(b, a):
+    ox, oy = b.point
+    b.move((ox + a[0], oy + a[1]))
+
+
+def _l_abs(b, a):
+    b.line((0.0 + a[0], 0.0 + a[1]))
+
+
+def _l_rel(b, a):
+    ox, oy = b.point
+    b.line((ox + a[0], oy + a[1]))
+
+
+def _c_abs(b, a):
+    b.cubic((0.0 + a[0], 0.0 + a[1]), (0.0 + a[2], 0.0 + a[3]), (0.0 + a[4], 0.0 + a[5]))
+
+
+def _c_rel(b, a):
+    ox, oy = b.point
+    b.cubic((ox + a[0], oy + a[1]), (ox + a[2], oy + a[3]), (ox + a[4], oy + a[5]))
+
+
+_APPLY = {"M": _m_abs, "m": _m_rel, "L": _l_abs, "l": _l_rel, "C": _c_abs, "c": _c_rel,
+          **{cmd: (lambda b, a, cmd=cmd: _apply(b, cmd, a)) for cmd in "HhVvSsQqTtAa"}}
 
 
 def _apply(b: _Builder, cmd: str, a: list[float]) -> None:
@@ -280,9 +336,10 @@ def to_arrays(subpaths: list[Subpath]):
     points, degrees, table = [], [], []
     for s in subpaths:
         table.append((len(degrees), len(s.degrees), s.closed))
-        points.extend(s.points)
-        degrees.extend(s.degrees)
-    pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        points += s.points
+        degrees += s.degrees
+    # (from a flat iterator: NumPy reads a list of pairs several times slower)
+    pts = np.fromiter(itertools.chain.from_iterable(points), np.float64, 2 * len(points)).reshape(-1, 2)
     return pts, np.asarray(degrees, dtype=np.int64), table
 
 

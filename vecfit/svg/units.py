@@ -9,7 +9,6 @@ import math
 import re
 
 import numpy as np
-import svgelements
 
 # Larger magnitudes overflow float32 or make the renderer's arithmetic lose all precision.
 LIMIT = 1e7
@@ -79,6 +78,8 @@ def clamp(value: float) -> float:
 
 def clamp_array(values) -> tuple[np.ndarray, bool]:
     """float64 array with NaN set to 0 and magnitudes limited; and whether any changed."""
+    if type(values) is float and -LIMIT <= values <= LIMIT:  # (a shape's stroke width: no min, max)
+        return np.array(values), False
     a = np.asarray(values, dtype=np.float64)
     if a.size == 0 or (-LIMIT <= a.min() and a.max() <= LIMIT):  # False for NaN too
         return a, False
@@ -88,18 +89,25 @@ def clamp_array(values) -> tuple[np.ndarray, bool]:
 def parse_transform(text) -> np.ndarray | None:
     """A transform attribute as a 3x3 float64 matrix; None for an empty or invalid one.
 
-    svgelements reads the transform list (it accepts SVG 1.1 and 2 syntax, whitespace from
-    character references included); we only check the result is finite.
+    Lists of matrix, translate and scale are multiplied here as svgelements multiplies
+    them; svgelements reads the others (rotations, skews); we only check the result is
+    finite.
     """
     if text is None or not text.strip():
         return None
-    if not _valid_transform_list(text):
+    items = _transform_items(text)
+    if items is None:
         return None  # as resvg: a list with any error is no transform at all
-    try:
-        m = svgelements.Matrix(text)
-    except Exception:  # svgelements raises assorted errors on malformed lists
-        return None
-    out = np.array([[m.a, m.c, m.e], [m.b, m.d, m.f], [0.0, 0.0, 1.0]], dtype=np.float64)
+    m = _product(items)
+    if m is None:
+        import svgelements  # (rotations and skews; imported here: a tenth of `vecfit render`'s imports)
+        try:
+            m = svgelements.Matrix(text)
+        except Exception:  # svgelements raises assorted errors on malformed lists
+            return None
+        m = (m.a, m.b, m.c, m.d, m.e, m.f)
+    a, b, c, d, e, f = m
+    out = np.array([[a, c, e], [b, d, f], [0.0, 0.0, 1.0]], dtype=np.float64)
     if not np.isfinite(out).all():
         return None
     return out
@@ -115,20 +123,49 @@ _TRANSFORM_ITEM = re.compile(rf"{_WSP}*+([A-Za-z]++){_WSP}*+\({_WSP}*+((?:{NUMBE
                              rf"{_WSP}*+\)(?:{_WSP}*+,?+{_WSP}*+)")
 
 
-def _valid_transform_list(text: str) -> bool:
-    """Whether ``text`` is a transform list by SVG's grammar: known functions with their
-    numbers of arguments, separated by commas or whitespace (svgelements reads more: it
-    takes "translate(0,5, 0,5)" and "scale(2,,2)", where browsers and resvg take none)."""
-    pos = 0
+def _transform_items(text: str) -> list[tuple[str, list[str]]] | None:
+    """The items of ``text`` (function, its numbers as written) when it is a transform list
+    by SVG's grammar: known functions with their numbers of arguments, separated by commas
+    or whitespace; else None (svgelements reads more: it takes "translate(0,5, 0,5)" and
+    "scale(2,,2)", where browsers and resvg take none)."""
+    pos, items = 0, []
     while pos < len(text):
         m = _TRANSFORM_ITEM.match(text, pos)
         if m is None or m.end() == pos:
-            return not text[pos:].strip(" \t\r\n\f")
+            return None if text[pos:].strip(" \t\r\n\f") else items
         numbers = _NUMBER_RE.findall(m.group(2))
         if m.group(1) not in _TRANSFORM_ARITY or len(numbers) not in _TRANSFORM_ARITY[m.group(1)]:
-            return False
+            return None
+        items.append((m.group(1), numbers))
         pos = m.end()
-    return True
+    return items
+
+
+# A number as svgelements splits it too ("5." and "5.e3" it reads otherwise).
+_PLAIN_NUMBER = re.compile(r"[-+]?+(?:\d++(?:\.\d++)?+|\.\d++)(?:[eE][-+]?+\d++)?+")
+
+
+def _product(items) -> tuple[float, ...] | None:
+    """The matrix (a, b, c, d, e, f) of a list of matrix, translate and scale items, by
+    svgelements' arithmetic (Matrix.pre_cat, matrix_multiply), so that its values are the
+    same to the bit; None for a list with a rotation, a skew or a number written in a form
+    svgelements splits otherwise (svgelements then reads the list)."""
+    ma, mb, mc, md, me, mf = 1.0, 0.0, 0.0, 1.0, 0.0, 0.0
+    for name, numbers in items:
+        if name not in ("matrix", "translate", "scale") or not all(_PLAIN_NUMBER.fullmatch(t) for t in numbers):
+            return None
+        v = [float(t) for t in numbers]
+        if name == "matrix":
+            sa, sb, sc, sd, se, sf = v
+        elif name == "translate":
+            sa, sb, sc, sd, se, sf = 1.0, 0.0, 0.0, 1.0, v[0], (v[1] if len(v) == 2 else 0.0)
+        else:
+            sa, sb, sc, sd, se, sf = v[0], 0, 0, (v[1] if len(v) == 2 else v[0]), 0, 0
+        # (svgelements' matrix_multiply(item, so far), term for term)
+        ma, mb, mc, md, me, mf = (ma * sa + mc * sb + me * 0, mb * sa + md * sb + mf * 0,
+                                  ma * sc + mc * sd + me * 0, mb * sc + md * sd + mf * 0,
+                                  ma * se + mc * sf + me * 1, mb * se + md * sf + mf * 1)
+    return ma, mb, mc, md, me, mf
 
 
 def translate(x: float, y: float) -> np.ndarray:

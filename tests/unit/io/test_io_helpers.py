@@ -12,6 +12,7 @@ from vecfit.errors import VecfitError
 from vecfit.io.colors import fitting_background, parse_background
 from vecfit.io.compositing import composite, composite_torch
 from vecfit.io.files import atomic_write, atomic_write_bytes, atomic_write_text
+from vecfit.io.png import to_uint8
 from vecfit.io.images import downscaled, downscaled_weight, working_scale
 from vecfit.io.report import GAP, error_map, panels_image, side_by_side
 from vecfit.io.tone import flat_share, is_flat_art
@@ -122,3 +123,12 @@ def test_panels_and_error_map():
     right, wrong = error_map(a, a), error_map(b[:, :, :] * 0 + 1, np.zeros((5, 10, 3), np.float32))
     assert right.shape == (10, 20, 3) and right.max() < 0.05  # inferno's dark end
     assert wrong.mean() > 0.5  # full scale: inferno's light end
+
+
+def test_to_uint8_rounds_clamps_and_leaves_its_input_alone():
+    image = np.array([[-0.5, 0.0, 0.5 / 255, 1.5 / 255, 0.2, 1.0, 7.0]], np.float32)
+    before = image.copy()
+    assert to_uint8(image).tolist() == [[0, 0, 1, 2, 51, 255, 255]]  # (+0.5, then truncated)
+    assert (image == before).all()  # (converted in place in a copy, not in the caller's array)
+    assert to_uint8(np.array([0, 1, 2])).tolist() == [0, 255, 255]  # integers: as floats
+    assert to_uint8(image.astype(np.float64)).tolist() == to_uint8(image).tolist()
