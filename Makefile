@@ -29,8 +29,10 @@ test: install
 
 # The tests marked slow left out (whole fits and traces, batches, the wheel, interruptions,
 # the fuzzer's quick run, the shared data, oracle sweeps past a few cases): under a minute.
+# Bytecode is cached even where the shell says not to (PYTHONDONTWRITEBYTECODE): the loop a
+# developer reruns then compiles nothing twice (8 s of its minute).
 test-fast: install
-	$(PY) -m pytest -q -m "not slow"
+	PYTHONDONTWRITEBYTECODE= $(PY) -m pytest -q -m "not slow"
 
 # A long fuzzing campaign (tests/fuzz/fuzzing.py): N cases from SEED, a summary table; failures
 # are kept under tests/failures/fuzz/.

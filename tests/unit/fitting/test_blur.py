@@ -54,6 +54,7 @@ def test_a_bad_target_blur_is_refused(bad):
         Settings.defaults(target_blur=bad)
 
 
+@pytest.mark.slow
 def test_a_blurred_drawing_is_fitted_as_the_sharp_one(tmp_path):
     """A scan's blur (sigma 1.2 px, noise) traced as strokes: fitted through the blur
     estimated from it, the lines come back sharp, closer to the clean drawing than a fit

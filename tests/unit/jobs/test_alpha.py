@@ -85,6 +85,7 @@ def test_every_format_reads_as_straight_rgba(fmt):
     assert np.abs(image[..., :3] * image[..., 3:] - expected[..., :3] * expected[..., 3:]).max() < tolerance
 
 
+@pytest.mark.slow
 def test_a_soft_edged_translucent_target_is_traced_with_its_alpha(tmp_path):
     source = soft_disc()
     svg, report = vecfit.trace(encoded(source, "png"), settings={"optimize": {"iterations": 250, "threads": 1}})

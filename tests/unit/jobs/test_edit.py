@@ -171,6 +171,7 @@ def drawing(tmp_path_factory):
     return d
 
 
+@pytest.mark.slow
 def test_edit_brings_the_edit_into_the_svg(drawing, tmp_path):
     """resvg's render of the result matches the edited image >= 8 dB better than the
     unedited SVG (measured: ~+13 dB), with the same elements and ids; the untouched ones
