@@ -89,7 +89,7 @@ def _line_art_blur(optimize: dict, target: np.ndarray) -> float:
     h, w = target.shape[:2]
     scale = min(1.0, optimize["max_size"] / max(h, w)) if optimize["max_size"] else 1.0
     sigma = estimate_blur(composite(target, (1.0, 1.0, 1.0))) * scale
-    return round(sigma / 0.05) * 0.05 if sigma >= BLUR_FLOOR else 0.0
+    return round(round(sigma / 0.05) * 0.05, 2) if sigma >= BLUR_FLOOR else 0.0
 
 
 def _background_removed(config: dict, target, progress):

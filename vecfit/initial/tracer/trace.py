@@ -228,7 +228,7 @@ def trace_image(image: np.ndarray, settings: TraceSettings | None = None,
         # (a shape of one outline is one element either way: it may always be a primitive)
         found = (separate_primitives([outlines[k] for k in kept], simplified, s.lines, max(spare, 0) + 1)
                  if s.primitives else [None] * len(simplified))
-        rest = [o if shape is not None or not s.primitives else elliptical(outlines[k], o)
+        rest = [elliptical(outlines[k], o) if s.primitives else o
                 for k, o, shape in zip(kept, simplified, found) if shape is None]
         if rest:
             add_path(document, outline_path_data(rest), fill, evenodd=cut)
