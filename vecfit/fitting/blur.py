@@ -58,19 +58,14 @@ def estimate_blur(rgb: np.ndarray) -> float:
 
 def gaussian_blur(image, sigma: float):
     """A torch image [H, W, C] blurred by a Gaussian of ``sigma`` px (edges replicated),
-    differentiable; the image itself where sigma is 0."""
-    import torch
+    differentiable; the image itself where sigma is 0. The SSIM loss's separable blur
+    (losses.py), on the image padded by the window's reach."""
     import torch.nn.functional as F
+
+    from .losses import _blur, _gaussian_window
 
     if sigma <= 0:
         return image
     reach = max(int(np.ceil(3 * sigma)), 1)
-    x = torch.arange(-reach, reach + 1, dtype=image.dtype, device=image.device)
-    k = torch.exp(-x * x / (2 * sigma * sigma))
-    k = k / k.sum()
-    t = image.permute(2, 0, 1)[None]
-    c = t.shape[1]
-    t = F.pad(t, (reach, reach, reach, reach), mode="replicate")
-    t = F.conv2d(t, k.view(1, 1, 1, -1).expand(c, 1, 1, -1), groups=c)
-    t = F.conv2d(t, k.view(1, 1, -1, 1).expand(c, 1, -1, 1), groups=c)
-    return t[0].permute(1, 2, 0)
+    padded = F.pad(image.permute(2, 0, 1)[None], (reach, reach, reach, reach), mode="replicate")
+    return _blur(padded, _gaussian_window(2 * reach + 1, sigma).to(image.device))[0].permute(1, 2, 0)

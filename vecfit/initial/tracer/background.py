@@ -48,22 +48,26 @@ def corners_rival(rgb: np.ndarray, colour: np.ndarray) -> np.ndarray | None:
     """A colour that two or more of the image's corners show (within BACKGROUND_DELTA_E)
     other than ``colour``, the background found: which of them is the page is then a
     guess (a frame bleeding to the canvas on two sides); None where there is none."""
-    corners = np.stack([rgb[0, 0], rgb[0, -1], rgb[-1, 0], rgb[-1, -1]])
-    lab = to_lab(corners)
-    near = np.linalg.norm(lab[:, None] - lab[None], axis=-1) < BACKGROUND_DELTA_E
+    corners, agree = _corners(rgb)
     other = ~background_mask(corners[None], colour)[0]
-    rivals = [k for k in range(4) if other[k] and near[k].sum() >= 2]
+    rivals = [k for k in range(4) if other[k] and agree[k] >= 2]
     return corners[rivals[0]] if rivals else None
 
 
 def _corners_colour(rgb: np.ndarray) -> np.ndarray | None:
-    """The colour that three or four of the image's corner pixels share (within
-    BACKGROUND_DELTA_E), or None where no three agree."""
+    """The colour that three or four of the image's corner pixels share, or None where no
+    three agree."""
+    corners, agree = _corners(rgb)
+    best = int(agree.argmax())
+    return corners[best] if agree[best] >= 3 else None
+
+
+def _corners(rgb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The four corner pixels [4, 3] and, for each, how many of the four (itself included)
+    lie within BACKGROUND_DELTA_E of it."""
     corners = np.stack([rgb[0, 0], rgb[0, -1], rgb[-1, 0], rgb[-1, -1]])
     lab = to_lab(corners)
-    near = np.linalg.norm(lab[:, None] - lab[None], axis=-1) < BACKGROUND_DELTA_E
-    best = int(near.sum(1).argmax())
-    return corners[best] if near[best].sum() >= 3 else None
+    return corners, (np.linalg.norm(lab[:, None] - lab[None], axis=-1) < BACKGROUND_DELTA_E).sum(1)
 
 
 def background_mask(rgb: np.ndarray, colour: np.ndarray, delta_e: float = BACKGROUND_DELTA_E) -> np.ndarray:
