@@ -30,7 +30,7 @@ from .config import loop_settings, output_precision
 from .palette import colour_entry, nearest_colour, parse_palette
 from .protocol import Outputs, listener
 from .report import job_report
-from .scoring import refuse_non_finite, render_for_scoring, rendered_rgb, score_written
+from .scoring import judging_samples, refuse_non_finite, render_for_scoring, rendered_rgb, score_written
 
 OPAQUE = 0.999  # a target whose every alpha is at least this is treated as opaque
 ASPECT_TOLERANCE = 0.01
@@ -192,11 +192,14 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
                 background = nearest_colour(background, used / 255.0)
         if settings.simplify > 0 and result.iterations > 0:  # fewer nodes (fitting/simplify.py)
             from vecfit.fitting.simplify import simplify_fitted
-            # (judged at simplify_samples where set: strokes' thin lines need more than quick's 2x2)
-            judged = dataclasses.replace(settings, eval_samples=settings.simplify_samples or settings.eval_samples)
+            # (judged at simplify_samples where set: strokes' thin lines need more than quick's 2x2;
+            # else at 2x2 where their noise is small beside the error: a photo's)
+            samples = judging_samples(scene, sw, sh, settings, background, target_rgb)
+            judged = dataclasses.replace(settings, eval_samples=samples)
             render_rgb = lambda s, seed=0: rendered_rgb(s, sw, sh, judged, background, seed)  # noqa: E731
             simplified = simplify_fitted(scene, goal, settings, render_rgb, target_rgb, float(settings.simplify),
                                          int(settings.simplify_iterations), hooks, keep_alpha)
+            simplified["judged_samples"] = samples  # N of the N x N samples a pixel the joins were judged at
     else:
         progress.start(0)
         result = _not_optimised(scene, settings)
