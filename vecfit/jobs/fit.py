@@ -128,6 +128,20 @@ def cut_crossed_outlines(scene: Scene, keep: set, config: dict, pixels=None) -> 
     return untangle(scene, keep=keep, decimals=shape_decimals(scene, pixels, output_precision(config)))
 
 
+def _as_fitted(final_rgb: np.ndarray, target_rgb: np.ndarray, settings: Settings) -> dict:
+    """Where the render was blurred before the loss (optimize.target_blur: a scan fitted as
+    the sharp drawing that blurs to it), the figures of the result blurred alike against the
+    target: what the fit reached. The report's "optimized" compares the sharp result with
+    the blurred target, which reads lower however right the lines are."""
+    blur = 0.0 if settings.target_blur == "auto" else float(settings.target_blur)
+    if blur <= 0:
+        return {}
+    import torch
+    from vecfit.fitting.blur import gaussian_blur
+    blurred = gaussian_blur(torch.from_numpy(np.ascontiguousarray(final_rgb, np.float32)), blur).numpy()
+    return {"as_fitted": {"target_blur": blur, **compare(blurred.astype(final_rgb.dtype), target_rgb)}}
+
+
 def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, config: dict, outputs: Outputs,
                   progress=None, inputs: dict | None = None, hooks=(), keep_alpha=(),
                   generated: bool = False, removed_background: tuple | None = None) -> dict:
@@ -238,6 +252,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
     if outputs.comparison is not None:
         save_comparison(outputs.comparison, target_rgb, initial_rgb, final_rgb)
     outcome = {
+        **_as_fitted(final_rgb, target_rgb, settings),  # a blurred target (a scan): the figures the fit saw
         "simplified": simplified,  # nodes dropped after the fit (fitting/simplify.py), or None
         "untangled_outlines": untangled,  # outlines the fit made cross themselves, cut into simple loops
         **({} if cut is None else {"cutouts": cut}),  # --stacking cutouts: pieces, chains, and the file's score

@@ -71,3 +71,21 @@ def test_batch_takes_style_for_trace_only(tmp_path):
     assert report["style"] == "strokes"
     refused = run("batch", folder, "-o", tmp_path / "out2", "--mode", "paint", "--style", "strokes", "-q")
     assert refused.exit_code == EXIT_USAGE and "--style" in refused.output
+
+
+def test_a_blurred_drawing_reports_the_figures_the_fit_reached(tmp_path):
+    # fitted through a 1.5-px blur, the sharp lines written score low against the blurred
+    # image; "as_fitted" scores them blurred alike, which is what the fit compared
+    import cv2
+
+    png = line_art(tmp_path / "art.png")
+    blurred = cv2.GaussianBlur(np.asarray(Image.open(png), np.float32), (0, 0), 1.5)
+    Image.fromarray(np.clip(blurred + 0.5, 0, 255).astype(np.uint8)).save(png)
+    settings = {"optimize": {**FAST["optimize"], "target_blur": 1.5}}
+    _, report = vecfit.trace(png, style="strokes", settings=settings)
+    fitted = report["as_fitted"]
+    assert fitted["target_blur"] == 1.5
+    assert fitted["psnr"] > report["optimized"]["psnr"] + 5 and fitted["ssim"] > report["optimized"]["ssim"]
+    _, sharp = vecfit.trace(line_art(tmp_path / "sharp.png"), style="strokes",
+                            settings={"optimize": {**FAST["optimize"], "target_blur": 0}})
+    assert "as_fitted" not in sharp  # no blur: the figures are the fit's own
