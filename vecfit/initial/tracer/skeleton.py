@@ -15,7 +15,7 @@ junction; edges left unpaired end there.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import cv2
 import numpy as np
@@ -37,9 +37,13 @@ OFFSETS = [(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1)]
 
 @dataclass
 class Chain:
-    """A centerline: pixel centres [N, 2] (x, y) in order, and whether it closes."""
+    """A centerline: pixel centres [N, 2] (x, y) in order, and whether it closes;
+    ``junctions`` [J, 3]: the centre (x, y) and the line's half width there (the distance
+    to the outline) of each junction the chain runs through or ends at, where its skeleton
+    bends towards the other lines."""
     points: np.ndarray
     closed: bool
+    junctions: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
 
 THINNINGS = {"zhang-suen": cv2.ximgproc.THINNING_ZHANGSUEN, "guo-hall": cv2.ximgproc.THINNING_GUOHALL}
@@ -162,6 +166,7 @@ def centerlines(mask: np.ndarray, radius: np.ndarray, thinning: str = "zhang-sue
     for p, j in junction_of.items():
         members.setdefault(j, []).append(p)
     centre = {j: np.mean([xy(p) for p in ps], axis=0) for j, ps in members.items()}
+    half_width = {j: max(float(flat_radius[p]) for p in ps) for j, ps in members.items()}
     ends_at: dict[int, list[tuple[int, int]]] = {}
     for e, path in enumerate(edges):
         for which, p in ((0, path[0]), (1, path[-1])):
@@ -230,5 +235,7 @@ def centerlines(mask: np.ndarray, radius: np.ndarray, thinning: str = "zhang-sue
             j = junction_of.get(pixels[k])
             if j is not None:
                 points[k] = centre[j]
-        out.append(Chain(points, closed))
+        passed = sorted({junction_of[p] for p in pixels if p in junction_of})
+        junctions = np.array([[*centre[j], half_width[j]] for j in passed], np.float64).reshape(-1, 3)
+        out.append(Chain(points, closed, junctions))
     return out
