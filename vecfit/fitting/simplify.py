@@ -404,12 +404,6 @@ def _limit(base: float, noise: float, budget_db: float) -> float:
     return base + max(base - noise, 0.0) * (10 ** (budget_db / 10) - 1)
 
 
-def _limit(base: float, noise: float, budget_db: float) -> float:
-    """The MSE a pass may reach from ``base``: ``budget_db`` of the part that is not the
-    renderer's sampling noise."""
-    return base + max(base - noise, 0.0) * (10 ** (budget_db / 10) - 1)
-
-
 def simplify_fitted(scene, goal, settings, render_rgb, target_rgb: np.ndarray, budget_db: float = 0.1,
                     iterations: int = 30, hooks=(), keep_alpha=(), max_error: float = 0.5,
                     lines: float = 0.25) -> dict:

@@ -1,15 +1,16 @@
 """Straight runs of a fitted centerline written as one line each (``--style strokes``).
 
-Where lines cross or meet (a junction) a skeleton bends towards the other lines, so a
-straight line through a junction is fitted as several segments that wobble there by a pixel
-or more (the slash of an "-off" icon: 9 segments for the designer's 1), and the refinement
-keeps every one of them: only a line stays a line. A run of consecutive segments is one
-line where, clear of the junctions it passes (a disk of JUNCTION_REACH times the line's
-half width there), it lies within NEAR pixels of the line fitted to it, and nearer the
-junctions it runs through within the stroke's half width (the wobble stays inside the ink;
-at its ends no slack: the run may turn into another line past a junction). The run's ends
-go onto that line (where two runs meet, to where their lines cross), and the neighbouring
-segments follow their ends.
+Where lines cross, a skeleton bends towards the other line, so a straight line through a
+crossing is fitted as several segments that wobble there by a pixel or more (the slash of
+an "-off" icon: 9 segments for the designer's 1), and the refinement keeps every one of
+them: only a line stays a line. A run of consecutive segments is one line where, clear of
+the crossings it passes (skeleton.Chain.junctions: a disk of JUNCTION_REACH times the
+line's half width there), it lies within NEAR pixels of the line fitted to it, and nearer
+the crossings it runs through within the stroke's half width (the wobble stays inside the
+ink; at its ends no slack: the run may turn into another line past a crossing). The run's
+ends go onto that line (where two runs meet, to where their lines cross), and the
+neighbouring segments follow their ends. (Only crossings: at a T the bar may bend for
+real, a book's cover dipping to its spine.)
 """
 from __future__ import annotations
 
@@ -17,14 +18,13 @@ import numpy as np
 
 from .primitives import line_like
 
-# px: how far the run's points clear of junctions may lie from its line
+# px: how far the run's points clear of crossings may lie from its line
 NEAR = 1.0
-# The skeleton bends towards the other lines within this many half widths of a junction's
-# centre (its half width: the distance to the outline there, more than the line's own where
-# lines cross).
+# The skeleton bends towards the other line within this many half widths of a crossing's
+# centre (its half width: the distance to the outline there, more than the line's own).
 JUNCTION_REACH = 2.0
-# At least this share of a run's length lies clear of junctions (a run that is mostly
-# junction says nothing about its direction).
+# At least this share of a run's length lies clear of crossings (a run that is mostly
+# crossing says nothing about its direction).
 MIN_CLEAR = 0.5
 SAMPLES = 16  # per segment
 
@@ -77,10 +77,10 @@ def straight_runs(segs: np.ndarray, junctions: np.ndarray, width: float, closed:
     """The cubics [S, 4, 2] of one centerline (in order, each starting where the last
     ends; ``closed``: the last ends where the first starts) with each straight run (see the
     module docstring) as one straight cubic (control points at thirds of its chord).
-    ``junctions`` [J, 3]: the centre and half width of each junction the centerline
+    ``junctions`` [J, 3]: the centre and half width of each crossing the centerline
     passes; ``width``: the stroke's. Each segment of a run is a line on its own (within
-    ``tolerance`` of its chord: primitives.line_like, the fit's test) or passes a junction:
-    a curve that runs into a corner clear of junctions (a rounded corner drawn tight) stays
+    ``tolerance`` of its chord: primitives.line_like, the fit's test) or passes a crossing:
+    a curve that runs into a corner clear of crossings (a rounded corner drawn tight) stays
     a curve."""
     count = len(segs)
     if count == 0:
@@ -96,8 +96,8 @@ def straight_runs(segs: np.ndarray, junctions: np.ndarray, width: float, closed:
         p, w, ok = points[a:b + 1].reshape(-1, 2), lengths[a:b + 1].reshape(-1), clear[a:b + 1].reshape(-1)
         if w[ok].sum() < MIN_CLEAR * w.sum() or w[ok].sum() <= 0:
             return None
-        # only a junction the run passes through is let off: at its ends the run may turn
-        # into another line (a tail past the junction)
+        # only a crossing the run passes through is let off: at its ends the run may turn
+        # into another line (a tail past the crossing)
         inside = np.flatnonzero(ok)
         ok = ok.copy()
         ok[:inside[0]] = True
