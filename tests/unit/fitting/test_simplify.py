@@ -9,7 +9,8 @@ import pytest
 import torch
 
 import vecfit
-from vecfit.fitting.simplify import _apart, drop_unseen, fit_pairs, reduce_nodes, straighten
+from vecfit.fitting.simplify import (_apart, _subpath_segments, drop_unseen, fit_pairs, join_straight_runs, reduce_nodes,
+                                     straight_run_candidates, straighten)
 from vecfit.renderer.raster import render
 from vecfit.scene import Path, Scene, Shape, Solid
 from vecfit.scene.segments import layout_of, split_at
@@ -234,3 +235,44 @@ def test_a_pair_under_a_later_shape_joins_beyond_the_error_allowed():
         return len(scene.shapes[0].geometry.degrees), stats["segments_after"]
 
     assert joined(0.0) == (5, 9) and joined(3.0) == (4, 8)  # (the blue square: 4 lines)
+
+
+def stroked_scene(filled: bool = False) -> Scene:
+    """A black stroke (3 px wide) along y = 20, its 4 segments a hair off one line (as a
+    refined trace's are where lines crossed), then a corner down to (56, 50); or the same
+    outline filled."""
+    segs = [np.array([[8, 20], [20, 20.2]]), np.array([[20, 20.2], [26, 20.3], [32, 19.9], [38, 19.9]]),
+            np.array([[38, 19.9], [48, 20]]), np.array([[48, 20], [56, 20]]), np.array([[56, 20], [56, 50]])]
+    points, degrees = layout_of([np.asarray(c, float) for c in segs], False)
+    path = Path(points=torch.tensor(points, dtype=torch.float32), degrees=np.array(degrees), subpaths=[(0, 5, False)])
+    black = Solid(torch.tensor([0.0, 0.0, 0.0, 1.0]))
+    shape = Shape(path, fill=black) if filled else Shape(path, stroke=black, stroke_width=torch.tensor(3.0))
+    return Scene(64, 64, [shape])
+
+
+def test_a_strokes_straight_run_is_one_line_and_its_corner_stays():
+    scene = stroked_scene()
+    found = straight_run_candidates(scene, {0: _subpath_segments(scene.shapes[0].geometry)}, (64, 64))
+    assert [(a, b) for _, _, _, a, b in found] == [(0, 3)]  # the run of 4; not round the corner
+    stats = join_straight_runs(scene, (64, 64))
+    assert stats == {"candidates": 1, "joined": 1, "segments_removed": 3}
+    g = scene.shapes[0].geometry
+    assert list(g.degrees) == [1, 1]
+    assert np.allclose(g.points.numpy(), [[8, 20], [56, 20], [56, 50]])  # the run's ends kept
+
+
+def test_a_filled_outline_has_no_straight_runs_to_join():
+    scene = stroked_scene(filled=True)  # (fills: the pairwise joins within the budget only)
+    assert join_straight_runs(scene, (64, 64))["candidates"] == 0
+    assert len(scene.shapes[0].geometry.degrees) == 5
+
+
+def test_a_stroke_a_hair_off_its_line_is_not_joined_beyond_the_tolerance():
+    scene = stroked_scene()
+    g = scene.shapes[0].geometry
+    points = g.points.clone()
+    points[1, 1] = 21.0  # the first line's end 1 px off: beyond STRAIGHT_RUN (0.5)
+    scene.shapes[0].geometry = Path(points=points, degrees=g.degrees, subpaths=g.subpaths)
+    found = straight_run_candidates(scene, {0: _subpath_segments(scene.shapes[0].geometry)}, (64, 64))
+    runs = [(a, b) for _, _, _, a, b in found]
+    assert runs and all(a >= 1 for a, _ in runs)  # the line off the others joins none of them

@@ -268,6 +268,39 @@ def test_a_ts_bar_runs_straight_through_and_its_stem_ends_on_it():
     assert np.hypot(*(top - (64, 40))) < 1.5, top
 
 
+def test_chains_carry_the_crossings_they_pass_and_not_a_ts_junction():
+    # a plus: both lines pass one crossing at (64, 64); a T: its bar may bend where the
+    # stem meets it (a book's spine), so its junction is no crossing
+    for chain in _chains_of('<path d="M20 64 H108 M64 20 V108" stroke-width="12"/>'):
+        assert chain.junctions.shape == (1, 3)
+        assert np.hypot(*(chain.junctions[0, :2] - (64, 64))) < 2.0
+        assert 6 <= chain.junctions[0, 2] <= 10  # the half width there (6), and more where lines cross
+    for chain in _chains_of('<path d="M20 40 H108 M64 40 V110" stroke-width="12"/>'):
+        assert chain.junctions.shape == (0, 3)
+
+
+def test_a_crossing_at_45_degrees_that_thinning_splits_is_one_crossing():
+    # thinning splits a slash over a line into two forks 28 px apart (each a T): together
+    # they are the crossing, and the horizontal line (through both) carries both
+    chains = _chains_of('<path d="M40 40 L216 216" stroke-width="21.33"/><path d="M30 150 H226" '
+                        'stroke-width="21.33"/>', 256)
+    across = max(chains, key=lambda c: np.ptp(c.points[:, 0]) - np.ptp(c.points[:, 1]))
+    assert len(across.junctions) == 2
+    assert np.abs(across.junctions[:, :2].mean(0) - (150, 150)).max() < 3
+
+
+def test_a_slash_across_a_line_comes_back_with_fewer_segments():
+    # the line's centerline wobbles where the slash crosses it: the stretch through the
+    # crossing is one line (14 segments before, in 3 paths)
+    image = drawn('<path d="M40 40 L216 216" stroke-width="21.33"/><path d="M30 150 H226" stroke-width="21.33"/>',
+                  256)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", VecfitWarning)
+        result = trace_image(image, TraceSettings.defaults(style="strokes"))
+    assert result.segments <= 11, result.svg
+    assert psnr(rendered(result.svg, 256), image[..., :3]) > 20
+
+
 def test_a_plus_sign_is_two_straight_lines_crossing_where_drawn():
     chains = _chains_of('<path d="M20 64 H108 M64 20 V108" stroke-width="12"/>')
     assert len(chains) == 2

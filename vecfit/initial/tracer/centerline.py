@@ -7,7 +7,8 @@ is then a blend of the background and its nearest ink (its coverage: how far alo
 line from one to the other it lies), and a pixel at least half covered is that ink's.
 Each ink's connected pieces are skeletonised and joined into paths (skeleton.py), the
 paths fitted with cubic Béziers (the tracer's own fitter, bezier.py; straight runs as
-lines, closed circles as circles: primitives.py), stroked with twice the median distance
+lines, closed circles as circles: primitives.py; a line through a junction, where the
+skeleton wobbles, as one line: straight_runs.py), stroked with twice the median distance
 from centerline to outline and the ink's colour. Caps and joins are chosen by rendering
 the strokes with each and comparing with the image.
 
@@ -36,6 +37,7 @@ from .primitives import _continues, as_primitive, open_outline, straightened
 from .quantize import OPAQUE, to_lab
 from .settings import TraceResult, TraceSettings
 from .skeleton import Chain, centerlines
+from .straight_runs import straight_runs
 from .svgtext import DECIMALS, add_rect, new_document
 
 # A pixel is ink where it differs from the background by more than this (CIELAB units).
@@ -411,6 +413,7 @@ def fitted_strokes(chains, radius: np.ndarray, ink: np.ndarray, color: str, s: T
         fitted = fit_open([c.points for c in runs], s.tolerance, s.corner_angle, s.smoothing,
                           [widths[id(c)] / 2 for c in runs])
         for c, segs in zip(runs, fitted):
+            segs = straight_runs(segs, c.junctions, widths[id(c)], c.closed, s.lines)
             points, degrees = open_outline(segs, s.lines)
             if c.closed:
                 points, degrees = _closed_layout(points, degrees, s.lines)
@@ -556,13 +559,13 @@ def trace_strokes(image: np.ndarray, settings: TraceSettings, progress=None) -> 
             r = np.where(piece, radius[ys, xs], 0)
             chains = centerlines(piece, r) or _dot(piece)
             for c in chains:
-                c.points += (xs.start, ys.start)
+                _moved(c, (xs.start, ys.start))
             fits = bool(chains) and _fits(chains, piece, r, (xs.start, ys.start), widest, s.style)
             if chains and not fits:
                 # the other thinning, where Zhang-Suen's skeleton misses part of the piece
                 other = centerlines(piece, r, "guo-hall")
                 for c in other:
-                    c.points += (xs.start, ys.start)
+                    _moved(c, (xs.start, ys.start))
                 if other and _fits(other, piece, r, (xs.start, ys.start), widest, s.style):
                     chains, fits = other, True
             if fits:
@@ -626,6 +629,12 @@ def trace_strokes(image: np.ndarray, settings: TraceSettings, progress=None) -> 
                        colors=colors + len({st.color for st in strokes}),
                        segments=segments + sum(st.segments for st in strokes),
                        seconds=time.perf_counter() - start, strokes=len(strokes), warnings=warnings_given)
+
+
+def _moved(chain: Chain, origin) -> None:
+    """A piece's chain (points and junctions) moved from the piece's box into the image."""
+    chain.points += origin
+    chain.junctions[:, :2] += origin
 
 
 def _dot(piece: np.ndarray) -> list:
