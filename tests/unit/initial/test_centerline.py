@@ -239,6 +239,19 @@ def test_a_round_dot_comes_back_as_a_dot_stroke():
     assert abs(x - 40.3) < 0.75 and abs(y - 60.6) < 0.75
 
 
+def test_a_dot_twice_as_wide_as_the_widest_line_is_still_a_dot_stroke():
+    # Tabler draws its dots twice as wide as its lines (a circle of radius 1 stroked 2 wide):
+    # with lines near max_stroke, the dot is past it, yet a dot, not an area to fill
+    widest = TraceSettings.defaults().max_stroke * SIZE
+    line, dot_width = 0.8 * widest, 1.6 * widest
+    _, result = traced(f'<path d="M40 60 v.01" stroke-width="{dot_width:.2f}"/>'
+                       f'<path d="M75 20 V108" stroke-width="{line:.2f}"/>')
+    found = strokes_of(result.svg)
+    assert all(f.get("fill") == "none" and "stroke" in f for f in found) and len(found) == 2
+    dot = max(found, key=lambda f: float(f["stroke-width"]))
+    assert abs(float(dot["stroke-width"]) - dot_width) < 1.5
+
+
 # ----------------------------------------------------------------------------- junctions
 
 def _chains_of(elements: str, size: int = SIZE):

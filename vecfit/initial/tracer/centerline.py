@@ -68,6 +68,11 @@ LINE_TOLERANCE = 1.0
 # its narrow parts between holes and the outline (an emoji's face round its eyes and mouth:
 # median 59 px, 90% 110 px at 512 px; its outlines 13-15 px).
 WIDTH_QUANTILE = {"strokes": 0.5, "mixed": 0.9}
+# A dot (a round blob: a piece whose centerline is a dot) may be this many times as wide
+# as the widest line with --style strokes: line art draws its dots twice as wide as its
+# lines (Tabler's: a circle of radius 1 stroked 2 wide), and a dot of that size traced as
+# a fill left an icon drawn by strokes but for one path. In mixed an eye is an area.
+DOT_WIDEST = 2.0
 # With mixed, line work is at least this wide (px, the median): a thinner piece of an area's
 # colour is a sliver between outlines (an emoji's tongue where the outline crosses it) or a
 # rim, which the refinement thins to nothing while it holds a path of the budget; the fills
@@ -661,7 +666,9 @@ def _fits(chains, piece: np.ndarray, radius: np.ndarray, origin, widest: float, 
     along = np.concatenate([c.points for c in chains]) - origin
     ix = np.clip(along.astype(int), 0, [piece.shape[1] - 1, piece.shape[0] - 1])
     radii = radius[ix[:, 1], ix[:, 0]]
-    if 2 * float(np.quantile(radii, WIDTH_QUANTILE[style])) - 1 > widest:
+    width = 2 * float(np.quantile(radii, WIDTH_QUANTILE[style])) - 1
+    dot = style == "strokes" and len(chains) == 1 and is_dot(chains[0], width)
+    if width > widest * (DOT_WIDEST if dot else 1.0):
         return False
     if style == "mixed" and 2 * float(np.median(radii)) - 1 < MIN_MIXED_WIDTH:
         return False
