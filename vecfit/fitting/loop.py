@@ -170,7 +170,7 @@ class _Fit:
         self.scene, self.target, self.settings = scene, target, settings
         self.hooks, self.penalty = hooks, penalty
         self.loss_fn = losses.get(settings.loss)
-        self.blur = 0.0 if settings.target_blur == "auto" else float(settings.target_blur)
+        self.blur = settings.blur_px
         height, width = target.image.shape[:2]
         self.fine_from, self.levels = _levels(target, settings, len(scene.shapes))
         self.density = outline_density(scene, width, height)

@@ -50,6 +50,11 @@ class Settings:
     target_blur: object  # "auto" | px: the render blurred alike before the loss (fitting/blur.py); the loop reads "auto" as 0
     lr: dict
 
+    @property
+    def blur_px(self) -> float:
+        """target_blur in pixels: "auto" (which the trace job resolves for line art) is 0."""
+        return 0.0 if self.target_blur == "auto" else float(self.target_blur)
+
     @classmethod
     def defaults(cls, **changes) -> "Settings":
         """configs/refine.toml's [optimize] settings, with ``changes`` (``lr`` replaces the

@@ -205,6 +205,19 @@ def _subpath_segments(path: Path) -> list[tuple[list[np.ndarray], bool]]:
     return out
 
 
+def _limit(base: float, noise: float, budget_db: float) -> float:
+    """The MSE a pass may reach from ``base``: ``budget_db`` of the part that is not the
+    renderer's sampling noise."""
+    return base + max(base - noise, 0.0) * (10 ** (budget_db / 10) - 1)
+
+
+def _path_segments(scene) -> dict[int, list[tuple[list[np.ndarray], bool]]]:
+    """Shape index -> _subpath_segments of each of ``scene``'s paths of one width (what the
+    joins may change)."""
+    return {i: _subpath_segments(sh.geometry) for i, sh in enumerate(scene.shapes)
+            if isinstance(sh.geometry, Path) and sh.geometry.widths is None}
+
+
 def _with_segments(path: Path, subs: list[tuple[list[np.ndarray], bool]]) -> Path:
     points, degrees, table = [], [], []
     for segs, closed in subs:
@@ -337,7 +350,7 @@ def _apply(shapes: dict[int, list], chosen: list[_Candidate]):
 
 def reduce_nodes(scene, measure, image: np.ndarray, size: tuple[int, int], budget_db: float = 0.1,
                  max_error: float = 0.5, lines: float = 0.25, rounds: int = 2, noise: float = 0.0,
-                 base: float | None = None, hidden_error: float = 0.0) -> dict:
+                 base: float | None = None, hidden_error: float = 0.0, current: float | None = None) -> dict:
     """Join segments of ``scene``'s paths (in place) while ``measure(scene)`` (the MSE of
     its render against the target) stays within ``budget_db`` of where it started.
     ``image``: the current render, RGB [H, W, 3] at ``size`` (width, height). ``noise``:
@@ -346,15 +359,16 @@ def reduce_nodes(scene, measure, image: np.ndarray, size: tuple[int, int], budge
     pixel is a fifth of what they measure, and of 4 two thirds). ``base``: the MSE the
     budget is counted from, where it is not the scene's now (a pass before this one spent
     some of it). ``hidden_error``: how far (px) a join may stray from a pair that shows
-    nowhere in ``image`` (nor does the join): under a later shape. Returns counts."""
+    nowhere in ``image`` (nor does the join): under a later shape. ``current``: the
+    scene's MSE now where the caller has it (``image``'s: no render to measure it again).
+    Returns counts."""
     started = time.perf_counter()
-    now = measure(scene)
+    now = measure(scene) if current is None else current
     base = now if base is None else base
-    limit = base + max(base - noise, 0.0) * (10 ** (budget_db / 10) - 1)
-    shapes = {i: _subpath_segments(sh.geometry) for i, sh in enumerate(scene.shapes)
-              if isinstance(sh.geometry, Path) and sh.geometry.widths is None}
+    limit = _limit(base, noise, budget_db)
+    shapes = _path_segments(scene)
     before = sum(len(segs) for subs in shapes.values() for segs, _ in subs)
-    renders, joined, mse = 1, 0, now
+    renders, joined, mse = int(current is None), 0, now
     originals = {i: scene.shapes[i].geometry for i in shapes}
     changed = None
     for _ in range(rounds):
@@ -398,15 +412,9 @@ def reduce_nodes(scene, measure, image: np.ndarray, size: tuple[int, int], budge
             "mse_before": base, "mse_after": mse, "seconds": time.perf_counter() - started}
 
 
-def _limit(base: float, noise: float, budget_db: float) -> float:
-    """The MSE a pass may reach from ``base``: ``budget_db`` of the part that is not the
-    renderer's sampling noise."""
-    return base + max(base - noise, 0.0) * (10 ** (budget_db / 10) - 1)
-
-
 def simplify_fitted(scene, goal, settings, render_rgb, target_rgb: np.ndarray, budget_db: float = 0.1,
                     iterations: int = 30, hooks=(), keep_alpha=(), max_error: float = 0.5,
-                    lines: float = 0.25) -> dict:
+                    lines: float = 0.25, rendered: tuple | None = None) -> dict:
     """The pass after a fit: ``reduce_nodes`` against ``target_rgb`` (RGB [H, W, 3], the
     size ``render_rgb(scene, seed=0)`` renders at; seed: added to the renderer's), then
     ``iterations`` of the loop (``settings`` but for the count, at a fifth of its rates, the
@@ -419,6 +427,9 @@ def simplify_fitted(scene, goal, settings, render_rgb, target_rgb: np.ndarray, b
     its render tells at once, and the joins' budget of 0.1 dB was gone after a join or two:
     the brief run puts the strokes back.)
 
+    ``rendered``: (``render_rgb(scene)``, the sampling noise) where the caller has them
+    (jobs/scoring.judging_samples measured both), else rendered here.
+
     Returns reduce_nodes' counts with the runs' ("straight_runs"; "undone" where the bolder
     try was) and the brief run's ("mse_refined", "seconds_refine")."""
     import copy
@@ -428,12 +439,14 @@ def simplify_fitted(scene, goal, settings, render_rgb, target_rgb: np.ndarray, b
     def measure(s):
         return float(((render_rgb(s) - target_rgb) ** 2).mean())
 
-    image = render_rgb(scene)
+    if rendered is None:
+        image = render_rgb(scene)
+        # the sampling noise's share of the MSE: half the mean squared difference of two
+        # renders with different seeds
+        rendered = image, 0.5 * float(((render_rgb(scene, 1) - image) ** 2).mean())
+    image, noise = rendered
     h, w = image.shape[:2]
-    # the sampling noise's share of the MSE: half the mean squared difference of two renders
-    # with different seeds
-    noise = 0.5 * float(((render_rgb(scene, 1) - image) ** 2).mean())
-    base = measure(scene)
+    base = float(((image - target_rgb) ** 2).mean())
 
     def joined_and_refined(bolder: bool) -> dict:
         runs, now = {"candidates": 0, "joined": 0, "segments_removed": 0}, image
@@ -442,7 +455,7 @@ def simplify_fitted(scene, goal, settings, render_rgb, target_rgb: np.ndarray, b
             if runs["joined"]:
                 now = render_rgb(scene)
         stats = reduce_nodes(scene, measure, now, (w, h), STROKE_JOINS_DB if bolder else budget_db, max_error,
-                             lines, noise=noise, base=base)
+                             lines, noise=noise, base=base, current=float(((now - target_rgb) ** 2).mean()))
         stats["straight_runs"] = runs
         stats["mse_refined"] = stats["mse_after"]
         stats["seconds_refine"] = 0.0
@@ -486,7 +499,7 @@ def tidy(scene, measure, render_rgb, size: tuple[int, int], noise: float, max_er
     lines going on in one direction and pairs under a later shape (up to HIDDEN_ERROR px
     from where they were); ``budget_db`` for both, measured as reduce_nodes measures."""
     base = measure(scene)
-    limit = base + max(base - noise, 0.0) * (10 ** (budget_db / 10) - 1)
+    limit = _limit(base, noise, budget_db)
     straight = straighten(scene, measure, size, limit, lines)
     joins = reduce_nodes(scene, measure, render_rgb(scene), size, budget_db, max_error, lines, rounds=1,
                          noise=noise, base=base, hidden_error=HIDDEN_ERROR)
@@ -550,8 +563,7 @@ def straighten(scene, measure, size: tuple[int, int], limit: float, tolerance: f
     MSE of a render, the same samples every call) within ``limit``, cheapest first (by
     bisection). A line is four numbers fewer in the file, and lines that go on in one
     direction join into one (reduce_nodes). Returns counts."""
-    shapes = {i: _subpath_segments(sh.geometry) for i, sh in enumerate(scene.shapes)
-              if isinstance(sh.geometry, Path) and sh.geometry.widths is None}
+    shapes = _path_segments(scene)
     found = straight_candidates(scene, shapes, size, tolerance)
     stats = {"candidates": len(found), "straightened": 0, "renders": 0}
     if not found:
@@ -642,8 +654,7 @@ def join_straight_runs(scene, size: tuple[int, int], tolerance: float = STRAIGHT
     centerline comes back from the fit as several segments along one line (the slash of an
     "-off" icon), which pairwise joins leave: each moves the line by a hair, which its
     render tells. Returns counts."""
-    shapes = {i: _subpath_segments(sh.geometry) for i, sh in enumerate(scene.shapes)
-              if isinstance(sh.geometry, Path) and sh.geometry.widths is None}
+    shapes = _path_segments(scene)
     found = straight_run_candidates(scene, shapes, size, tolerance)
     new: dict[int, list] = {}
     for _, s, j, a, b in sorted(found, key=lambda r: -r[3]):  # later runs first: the indices hold

@@ -133,7 +133,7 @@ def _as_fitted(final_rgb: np.ndarray, target_rgb: np.ndarray, settings: Settings
     the sharp drawing that blurs to it), the figures of the result blurred alike against the
     target: what the fit reached. The report's "optimized" compares the sharp result with
     the blurred target, which reads lower however right the lines are."""
-    blur = 0.0 if settings.target_blur == "auto" else float(settings.target_blur)
+    blur = settings.blur_px
     if blur <= 0:
         return {}
     import torch
@@ -208,12 +208,13 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
             from vecfit.fitting.simplify import simplify_fitted
             # (judged at simplify_samples where set: strokes' thin lines need more than quick's 2x2;
             # else at 2x2 where their noise is small beside the error: a photo's)
-            samples = judging_samples(scene, sw, sh, settings, background, target_rgb)
-            judged = dataclasses.replace(settings, eval_samples=samples)
+            judge = judging_samples(scene, sw, sh, settings, background, target_rgb)
+            judged = dataclasses.replace(settings, eval_samples=judge.samples)
             render_rgb = lambda s, seed=0: rendered_rgb(s, sw, sh, judged, background, seed)  # noqa: E731
             simplified = simplify_fitted(scene, goal, settings, render_rgb, target_rgb, float(settings.simplify),
-                                         int(settings.simplify_iterations), hooks, keep_alpha)
-            simplified["judged_samples"] = samples  # N of the N x N samples a pixel the joins were judged at
+                                         int(settings.simplify_iterations), hooks, keep_alpha,
+                                         rendered=judge.rendered)
+            simplified["judged_samples"] = judge.samples  # N of the N x N samples a pixel the joins were judged at
     else:
         progress.start(0)
         result = _not_optimised(scene, settings)

@@ -45,19 +45,30 @@ JUDGE_NOISE_SHARE = 0.2
 CHEAP_JUDGE = 2
 
 
+@dataclasses.dataclass
+class Judge:
+    """How the joins after a fit are judged: ``samples`` (N of N x N a pixel) and, where
+    judging_samples already rendered the scene at them, (that render, its sampling noise):
+    fitting/simplify.simplify_fitted's ``rendered``."""
+    samples: int
+    rendered: tuple | None = None
+
+
 def judging_samples(scene: Scene, width: int, height: int, settings: Settings, background,
-                    goal_rgb: np.ndarray) -> int:
-    """N of the N x N samples the joins after a fit are judged at: optimize.simplify_samples
-    where set, else 2 x 2 where their sampling noise (half the mean squared difference of
-    two seeds' renders) is at most JUDGE_NOISE_SHARE of the render's squared error against
+                    goal_rgb: np.ndarray) -> Judge:
+    """The samples the joins after a fit are judged at: optimize.simplify_samples where
+    set, else 2 x 2 where their sampling noise (half the mean squared difference of two
+    seeds' renders) is at most JUDGE_NOISE_SHARE of the render's squared error against
     ``goal_rgb``, else eval_samples."""
     if settings.simplify_samples or settings.eval_samples <= CHEAP_JUDGE:
-        return settings.simplify_samples or settings.eval_samples
+        return Judge(settings.simplify_samples or settings.eval_samples)
     cheap = dataclasses.replace(settings, eval_samples=CHEAP_JUDGE)
     first = rendered_rgb(scene, width, height, cheap, background)
     noise = 0.5 * float(((rendered_rgb(scene, width, height, cheap, background, 1) - first) ** 2).mean())
     error = float(((first - goal_rgb) ** 2).mean())
-    return CHEAP_JUDGE if noise <= JUDGE_NOISE_SHARE * error else settings.eval_samples
+    if noise <= JUDGE_NOISE_SHARE * error:
+        return Judge(CHEAP_JUDGE, (first, noise))
+    return Judge(settings.eval_samples)
 
 
 def refuse_non_finite(figures: dict, what: str = "optimised") -> None:

@@ -285,11 +285,11 @@ def test_chains_carry_the_crossings_they_pass_and_not_a_ts_junction():
     # a plus: both lines pass one crossing at (64, 64); a T: its bar may bend where the
     # stem meets it (a book's spine), so its junction is no crossing
     for chain in _chains_of('<path d="M20 64 H108 M64 20 V108" stroke-width="12"/>'):
-        assert chain.junctions.shape == (1, 3)
-        assert np.hypot(*(chain.junctions[0, :2] - (64, 64))) < 2.0
-        assert 6 <= chain.junctions[0, 2] <= 10  # the half width there (6), and more where lines cross
+        assert chain.crossings.shape == (1, 3)
+        assert np.hypot(*(chain.crossings[0, :2] - (64, 64))) < 2.0
+        assert 6 <= chain.crossings[0, 2] <= 10  # the half width there (6), and more where lines cross
     for chain in _chains_of('<path d="M20 40 H108 M64 40 V110" stroke-width="12"/>'):
-        assert chain.junctions.shape == (0, 3)
+        assert chain.crossings.shape == (0, 3)
 
 
 def test_a_crossing_at_45_degrees_that_thinning_splits_is_one_crossing():
@@ -298,8 +298,8 @@ def test_a_crossing_at_45_degrees_that_thinning_splits_is_one_crossing():
     chains = _chains_of('<path d="M40 40 L216 216" stroke-width="21.33"/><path d="M30 150 H226" '
                         'stroke-width="21.33"/>', 256)
     across = max(chains, key=lambda c: np.ptp(c.points[:, 0]) - np.ptp(c.points[:, 1]))
-    assert len(across.junctions) == 2
-    assert np.abs(across.junctions[:, :2].mean(0) - (150, 150)).max() < 3
+    assert len(across.crossings) == 2
+    assert np.abs(across.crossings[:, :2].mean(0) - (150, 150)).max() < 3
 
 
 def test_a_slash_across_a_line_comes_back_with_fewer_segments():

@@ -30,7 +30,7 @@ def test_a_picture_far_from_its_target_is_judged_at_2x2():
     scene = _scene()
     settings = _settings(eval_samples=4, simplify_samples=0)
     goal = np.clip(rendered_rgb(scene, SIZE, SIZE, settings, WHITE) + 0.2, 0, 1)
-    assert judging_samples(scene, SIZE, SIZE, settings, WHITE, goal) == CHEAP_JUDGE
+    assert judging_samples(scene, SIZE, SIZE, settings, WHITE, goal).samples == CHEAP_JUDGE
 
 
 def test_a_picture_on_its_target_is_judged_at_eval_samples():
@@ -42,11 +42,11 @@ def test_a_picture_on_its_target_is_judged_at_eval_samples():
     first = rendered_rgb(scene, SIZE, SIZE, cheap, WHITE)
     noise = 0.5 * float(((rendered_rgb(scene, SIZE, SIZE, cheap, WHITE, 1) - first) ** 2).mean())
     assert noise > JUDGE_NOISE_SHARE * float(((first - goal) ** 2).mean())  # (the case is what it says)
-    assert judging_samples(scene, SIZE, SIZE, settings, WHITE, goal) == 4
+    assert judging_samples(scene, SIZE, SIZE, settings, WHITE, goal).samples == 4
 
 
 def test_a_setting_or_a_cheap_report_decides_without_a_render():
     scene = _scene()
     goal = np.zeros((SIZE, SIZE, 3))
-    assert judging_samples(scene, SIZE, SIZE, _settings(eval_samples=4, simplify_samples=3), WHITE, goal) == 3
-    assert judging_samples(scene, SIZE, SIZE, _settings(eval_samples=1, simplify_samples=0), WHITE, goal) == 1
+    assert judging_samples(scene, SIZE, SIZE, _settings(eval_samples=4, simplify_samples=3), WHITE, goal).samples == 3
+    assert judging_samples(scene, SIZE, SIZE, _settings(eval_samples=1, simplify_samples=0), WHITE, goal).samples == 1

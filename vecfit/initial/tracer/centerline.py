@@ -418,7 +418,7 @@ def fitted_strokes(chains, radius: np.ndarray, ink: np.ndarray, color: str, s: T
         fitted = fit_open([c.points for c in runs], s.tolerance, s.corner_angle, s.smoothing,
                           [widths[id(c)] / 2 for c in runs])
         for c, segs in zip(runs, fitted):
-            segs = straight_runs(segs, c.junctions, widths[id(c)], c.closed, s.lines)
+            segs = straight_runs(segs, c.crossings, widths[id(c)], c.closed, s.lines)
             points, degrees = open_outline(segs, s.lines)
             if c.closed:
                 points, degrees = _closed_layout(points, degrees, s.lines)
@@ -637,9 +637,9 @@ def trace_strokes(image: np.ndarray, settings: TraceSettings, progress=None) -> 
 
 
 def _moved(chain: Chain, origin) -> None:
-    """A piece's chain (points and junctions) moved from the piece's box into the image."""
+    """A piece's chain (points and crossings) moved from the piece's box into the image."""
     chain.points += origin
-    chain.junctions[:, :2] += origin
+    chain.crossings[:, :2] += origin
 
 
 def _dot(piece: np.ndarray) -> list:

@@ -41,13 +41,13 @@ OFFSETS = [(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1)]
 @dataclass
 class Chain:
     """A centerline: pixel centres [N, 2] (x, y) in order, and whether it closes;
-    ``junctions`` [J, 3]: the centre (x, y) and the line's half width there (the distance
+    ``crossings`` [J, 3]: the centre (x, y) and the line's half width there (the distance
     to the outline) of each crossing (a junction of four arms or more) the chain runs
     through or ends at, where its skeleton bends towards the other lines. (At a T the bar
     may bend for real: a book's spine meeting its cover's top in two arcs.)"""
     points: np.ndarray
     closed: bool
-    junctions: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    crossings: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
 
 THINNINGS = {"zhang-suen": cv2.ximgproc.THINNING_ZHANGSUEN, "guo-hall": cv2.ximgproc.THINNING_GUOHALL}
@@ -149,20 +149,18 @@ def _prune(skel: np.ndarray, radius: np.ndarray) -> bool:
     return removed
 
 
-def _crossings(ends_at: dict[int, list], edges: list, junction_of: dict[int, int], flat_radius: np.ndarray,
+def _crossings(ends_at: dict[int, list], edges: list, junction_of: dict[int, int], half_width: dict[int, float],
                w: int) -> set[int]:
     """The junctions where lines cross: four arms or more meet there, counting those of
-    junctions a bridge of at most BRIDGE half widths away (thinning splits a crossing at an
-    angle into two forks, each with an arm of each line, a bridge apart)."""
-    reach: dict[int, float] = {}
-    for p, j in junction_of.items():
-        reach[j] = max(reach.get(j, 0.0), float(flat_radius[p]))
+    junctions a bridge of at most BRIDGE half widths (``half_width``: each junction's)
+    away (thinning splits a crossing at an angle into two forks, each with an arm of each
+    line, a bridge apart)."""
     arms = {j: len(ends) for j, ends in ends_at.items()}
     for path in edges:
         a, b = junction_of.get(path[0]), junction_of.get(path[-1])
         if a is None or b is None or a == b:
             continue
-        if np.hypot(path[0] % w - path[-1] % w, path[0] // w - path[-1] // w) <= BRIDGE * max(reach[a], reach[b]):
+        if np.hypot(path[0] % w - path[-1] % w, path[0] // w - path[-1] // w) <= BRIDGE * max(half_width[a], half_width[b]):
             arms[a], arms[b] = arms[a] + len(ends_at[b]) - 2, arms[b] + len(ends_at[a]) - 2
     return {j for j, n in arms.items() if n >= 4}
 
@@ -203,7 +201,7 @@ def centerlines(mask: np.ndarray, radius: np.ndarray, thinning: str = "zhang-sue
         n = float(np.hypot(*v))
         return v / n if n > 1e-9 else v
 
-    crossings = _crossings(ends_at, edges, junction_of, flat_radius, w)
+    crossings = _crossings(ends_at, edges, junction_of, half_width, w)
 
     # pair the edge ends that continue each other most nearly straight, greedily
     partner: dict[tuple[int, int], tuple[int, int]] = {}
@@ -260,6 +258,6 @@ def centerlines(mask: np.ndarray, radius: np.ndarray, thinning: str = "zhang-sue
             if j is not None:
                 points[k] = centre[j]
         passed = sorted({junction_of[p] for p in pixels if p in junction_of and junction_of[p] in crossings})
-        junctions = np.array([[*centre[j], half_width[j]] for j in passed], np.float64).reshape(-1, 3)
-        out.append(Chain(points, closed, junctions))
+        crossed = np.array([[*centre[j], half_width[j]] for j in passed], np.float64).reshape(-1, 3)
+        out.append(Chain(points, closed, crossed))
     return out

@@ -4,7 +4,7 @@ Where lines cross, a skeleton bends towards the other line, so a straight line t
 crossing is fitted as several segments that wobble there by a pixel or more (the slash of
 an "-off" icon: 9 segments for the designer's 1), and the refinement keeps every one of
 them: only a line stays a line. A run of consecutive segments is one line where, clear of
-the crossings it passes (skeleton.Chain.junctions: a disk of JUNCTION_REACH times the
+the crossings it passes (skeleton.Chain.crossings: a disk of JUNCTION_REACH times the
 line's half width there), it lies within NEAR pixels of the line fitted to it, and nearer
 the crossings it runs through within the stroke's half width (the wobble stays inside the
 ink; at its ends no slack: the run may turn into another line past a crossing). The run's
@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .bezier import _basis
 from .primitives import line_like
 
 # px: how far the run's points clear of crossings may lie from its line
@@ -36,8 +37,7 @@ def _points(segs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     edges = np.linspace(0.0, 1.0, SAMPLES + 1)
 
     def at(t):
-        v = 1 - t
-        return np.einsum("mk,skd->smd", np.stack([v ** 3, 3 * v * v * t, 3 * v * t * t, t ** 3], 1), segs)
+        return np.einsum("mk,skd->smd", np.stack(_basis(t), 1), segs)
     steps = np.linalg.norm(np.diff(at(edges), axis=1), axis=-1)
     return at(u), steps
 
@@ -72,12 +72,12 @@ def _crossing(a, b) -> np.ndarray | None:
     return pa + t * da
 
 
-def straight_runs(segs: np.ndarray, junctions: np.ndarray, width: float, closed: bool = False,
+def straight_runs(segs: np.ndarray, crossings: np.ndarray, width: float, closed: bool = False,
                   tolerance: float = NEAR) -> np.ndarray:
     """The cubics [S, 4, 2] of one centerline (in order, each starting where the last
     ends; ``closed``: the last ends where the first starts) with each straight run (see the
     module docstring) as one straight cubic (control points at thirds of its chord).
-    ``junctions`` [J, 3]: the centre and half width of each crossing the centerline
+    ``crossings`` [J, 3]: the centre and half width of each crossing the centerline
     passes; ``width``: the stroke's. Each segment of a run is a line on its own (within
     ``tolerance`` of its chord: primitives.line_like, the fit's test) or passes a crossing:
     a curve that runs into a corner clear of crossings (a rounded corner drawn tight) stays
@@ -87,7 +87,7 @@ def straight_runs(segs: np.ndarray, junctions: np.ndarray, width: float, closed:
         return segs
     points, lengths = _points(segs)
     clear = np.ones(points.shape[:2], bool)
-    for x, y, half in np.asarray(junctions, np.float64).reshape(-1, 3):
+    for x, y, half in np.asarray(crossings, np.float64).reshape(-1, 3):
         clear &= np.hypot(points[..., 0] - x, points[..., 1] - y) > JUNCTION_REACH * half
     may_join = line_like(segs, tolerance) | ~clear.all(1)
 
