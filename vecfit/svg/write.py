@@ -309,7 +309,12 @@ def _add_background(root, color) -> None:
         rect.attrib.update(x="0", y="0", width="100%", height="100%")
     rect.set("id", BACKGROUND_ID)
     rect.set("fill", hex_color(color))
+    # (the root's own paint is inherited: Tabler's icons set stroke="currentColor" on it,
+    # which drew a black frame round the page)
+    rect.set("stroke", "none")
     alpha = opacity_text(color[3]) if len(color) > 3 else None
+    if alpha is None and ("fill-opacity" in root.attrib or "fill-opacity" in root.get("style", "")):
+        alpha = "1"
     if alpha is not None:
         rect.set("fill-opacity", alpha)
     rect.tail = root.text

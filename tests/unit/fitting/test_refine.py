@@ -129,6 +129,26 @@ def test_background_rect_written_where_the_svg_leaves_canvas_bare(tmp_path):
     assert report["optimized"]["psnr"] > report["initial"]["psnr"] + 5
 
 
+def test_background_rect_takes_no_paint_from_the_root(tmp_path):
+    """A root that strokes everything (Tabler's icons: stroke="currentColor", width 2 in 24)
+    must not stroke the page: the rect used to come out framed in black."""
+    resvg_py = pytest.importorskip("resvg_py")
+    Image.new("RGB", (48, 48), (255, 255, 255)).save(tmp_path / "t.png")
+    (tmp_path / "i.svg").write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="24" height="24" viewBox="0 0 24 24" fill="none" '
+        'stroke="currentColor" stroke-width="2" fill-opacity="0.5"><path d="M6 12h12"/></svg>')
+    r = run("refine", tmp_path / "t.png", tmp_path / "i.svg", "--iterations", 5, "--threads", 1, "-q",
+            "--background", "white")
+    assert r.exit_code == 0, r.output
+    out = tmp_path / "t.vecfit.svg"
+    assert 'id="vecfit-background"' in out.read_text()
+    png = bytes(resvg_py.svg_to_bytes(svg_path=str(out), width=48))
+    rgb = np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), np.float64) / 255
+    # the page's border and corners are white (a frame of stroke 2 in 24 is 4 px wide here)
+    border = np.concatenate([rgb[:3].reshape(-1, 3), rgb[-3:].reshape(-1, 3), rgb[:, :3].reshape(-1, 3)])
+    assert border.min() > 0.99, border.min()
+
+
 def test_max_size_optimises_small_and_writes_full_size(tmp_path):
     target = disc_image(tmp_path / "t.png", cx=88, cy=60, r=32, size=(160, 128))
     svg = circle_svg(tmp_path / "c.svg", cx=80, cy=64, r=24, size=(160, 128))
