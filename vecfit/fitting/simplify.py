@@ -35,6 +35,7 @@ import time
 
 import numpy as np
 
+from vecfit.fitting.fillets import round_corners, stroked
 from vecfit.scene.arrays import floats_torch, is_tensor, to_numpy
 from vecfit.scene.model import Path
 from vecfit.scene.placement import shape_matrices
@@ -476,7 +477,12 @@ def simplify_fitted(scene, goal, settings, render_rgb, target_rgb: np.ndarray, b
         stats["seconds"] += stats["seconds_refine"]
         return stats
 
-    if any(_stroked(sh) for sh in scene.shapes):
+    rounded = None
+    if any(stroked(sh) for sh in scene.shapes):
+        rounded = round_corners(scene, render_rgb, target_rgb, (w, h), image)
+        if rounded["rounded"]:
+            image = render_rgb(scene)
+            base = float(((image - target_rgb) ** 2).mean())
         fitted = [(copy.deepcopy(sh.geometry), copy.deepcopy(sh.stroke_width)) for sh in scene.shapes]
         stats = joined_and_refined(bolder=True)
         if stats["mse_refined"] > _limit(base, noise, budget_db):
@@ -488,6 +494,8 @@ def simplify_fitted(scene, goal, settings, render_rgb, target_rgb: np.ndarray, b
     else:
         stats = joined_and_refined(bolder=False)
     stats["noise"] = noise
+    if rounded is not None:
+        stats["rounded_corners"] = {"fitted": {k: rounded[k] for k in ("corners", "rounded")}}
     stats["tidied"] = tidy(scene, measure, render_rgb, (w, h), noise, max_error, lines)
     return stats
 
@@ -609,7 +617,7 @@ def straight_run_candidates(scene, shapes: dict[int, list], size: tuple[int, int
     u = np.linspace(0.0, 1.0, 17)
     out = []
     for s, subs in shapes.items():
-        if not _stroked(scene.shapes[s]):
+        if not stroked(scene.shapes[s]):
             continue
         m = mats[s]
         for j, (segs, _) in enumerate(subs):
@@ -664,11 +672,6 @@ def join_straight_runs(scene, size: tuple[int, int], tolerance: float = STRAIGHT
     for s, subs in new.items():
         scene.shapes[s].geometry = _with_segments(scene.shapes[s].geometry, subs)
     return {"candidates": len(found), "joined": len(found), "segments_removed": sum(b - a for _, _, _, a, b in found)}
-
-
-def _stroked(shape) -> bool:
-    """Whether a shape is a path drawn by its stroke alone (a line of line art)."""
-    return isinstance(shape.geometry, Path) and shape.stroke is not None and shape.fill is None
 
 
 MAX_UNSEEN_CHECKS = 200  # subpaths checked by drop_unseen, the smallest first

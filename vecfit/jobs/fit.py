@@ -187,7 +187,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         problem = cutout_problem(scene)
         if problem is not None:
             raise VecfitError(f"--stacking cutouts: {document.name}: {problem}")
-    simplified = None
+    simplified = traced_corners = None
     if is_tensor(scene.view):
         import torch
         from vecfit.fitting.loop import Target, optimize
@@ -195,6 +195,13 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         goal = Target(torch.from_numpy(small), background)
         if generated and settings.alpha == "auto" and not goal.wants_translucency:
             make_opaque(scene)
+        from vecfit.fitting.fillets import TRACED_CLEARLY_BETTER, round_corners, stroked
+        if generated and any(stroked(s_) for s_ in scene.shapes):
+            # corners a trace's centerlines drew sharp, or as curves, rounded where the picture
+            # is (fitting/fillets.py) before the fit, which cannot add the nodes they need
+            judged = dataclasses.replace(settings, eval_samples=max(4, settings.eval_samples))
+            traced_corners = round_corners(scene, lambda s_, seed=0: rendered_rgb(s_, sw, sh, judged, background, seed),
+                                           target_rgb, (sw, sh), clearly_better=TRACED_CLEARLY_BETTER)
         progress.start(settings.iterations)
         if palette is None:
             result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
@@ -215,6 +222,9 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
                                          int(settings.simplify_iterations), hooks, keep_alpha,
                                          rendered=judge.rendered)
             simplified["judged_samples"] = judge.samples  # N of the N x N samples a pixel the joins were judged at
+            if traced_corners is not None:
+                simplified.setdefault("rounded_corners", {})["traced"] = {
+                    k: traced_corners[k] for k in ("corners", "rounded")}
     else:
         progress.start(0)
         result = _not_optimised(scene, settings)

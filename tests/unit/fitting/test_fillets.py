@@ -1,0 +1,127 @@
+"""Rounded corners for strokes (vecfit/fitting/fillets.py): a fillet's geometry, and the
+render deciding which corners of a stroke are rounded and by how much."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import torch
+
+from vecfit.fitting.fillets import _arc, corners, filleted, round_corners
+from vecfit.fitting.simplify import _path_segments, _subpath_segments
+from vecfit.renderer.raster import render
+from vecfit.scene import Path, Scene, Shape, Solid
+from vecfit.scene.segments import layout_of
+
+BLACK = Solid(torch.tensor([0.0, 0.0, 0.0, 1.0]))
+WIDTH = 8.0  # the strokes' width: half width 4
+
+
+def _eval(c: np.ndarray, t: np.ndarray) -> np.ndarray:
+    return ((1 - t) ** 3)[:, None] * c[0] + (3 * t * (1 - t) ** 2)[:, None] * c[1] + \
+        (3 * t ** 2 * (1 - t))[:, None] * c[2] + (t ** 3)[:, None] * c[3]
+
+
+def stroke_scene(subpaths: list[tuple[list, bool]], size: int = 64) -> Scene:
+    points, degrees, table = [], [], []
+    for segs, closed in subpaths:
+        p, d = layout_of([np.asarray(c, float) for c in segs], closed)
+        table.append((len(degrees), len(d), closed))
+        points.append(p)
+        degrees += d
+    path = Path(points=torch.tensor(np.concatenate(points), dtype=torch.float32), degrees=np.array(degrees),
+                subpaths=table)
+    shape = Shape(path, stroke=BLACK, stroke_width=torch.tensor(WIDTH), linecap="round", linejoin="round")
+    return Scene(size, size, [shape])
+
+
+def rgb(scene: Scene, seed: int = 0) -> np.ndarray:
+    image = render(scene, int(scene.width), int(scene.height), samples=4, seed=seed, background=[1, 1, 1, 1])
+    return image.numpy()[..., :3].astype(np.float64)
+
+
+def rounded_square(x0, y0, x1, y1, r) -> list[np.ndarray]:
+    """A closed square centerline with corners of radius r (cubic arcs), starting on its top."""
+    k = 4 / 3 * math.tan(math.pi / 8) * r
+    return [np.array([[x0 + r, y0], [x1 - r, y0]]), np.array([[x1 - r, y0], [x1 - r + k, y0], [x1, y0 + r - k], [x1, y0 + r]]),
+            np.array([[x1, y0 + r], [x1, y1 - r]]), np.array([[x1, y1 - r], [x1, y1 - r + k], [x1 - r + k, y1], [x1 - r, y1]]),
+            np.array([[x1 - r, y1], [x0 + r, y1]]), np.array([[x0 + r, y1], [x0 + r - k, y1], [x0, y1 - r + k], [x0, y1 - r]]),
+            np.array([[x0, y1 - r], [x0, y0 + r]]), np.array([[x0, y0 + r], [x0, y0 + r - k], [x0 + r - k, y0], [x0 + r, y0]])]
+
+
+def test_a_fillet_is_tangent_to_both_lines_at_the_radius():
+    segs = [np.array([[0.0, 0.0], [30.0, 0.0]]), np.array([[30.0, 0.0], [30.0, 30.0]])]
+    out = filleted(segs, False, 1, 5.0)
+    assert [len(c) - 1 for c in out] == [1, 3, 1]
+    assert np.allclose(out[0][-1], [25, 0]) and np.allclose(out[2][0], [30, 5])  # trimmed by r at 90 degrees
+    arc = out[1]
+    assert np.allclose(arc[1] - arc[0], [abs(arc[1][0] - arc[0][0]), 0])  # leaves along the first line
+    pts = _eval(arc, np.linspace(0, 1, 21))
+    r = np.hypot(*(pts - [25.0, 5.0]).T)  # about the fillet's centre
+    assert np.abs(r - 5).max() < 5 * 3e-4
+
+
+def test_a_fillet_at_a_closed_subpaths_start_goes_last():
+    square = [np.array([[10.0, 10.0], [50.0, 10.0]]), np.array([[50.0, 10.0], [50.0, 50.0]]),
+              np.array([[50.0, 50.0], [10.0, 50.0]]), np.array([[10.0, 50.0], [10.0, 10.0]])]
+    out = filleted(square, True, 0, 4.0)
+    assert [len(c) - 1 for c in out] == [1, 1, 1, 1, 3]
+    assert np.allclose(out[0][0], [14, 10]) and np.allclose(out[-1][0], [10, 14]) and np.allclose(out[-1][-1], out[0][0])
+
+
+def test_a_corner_too_near_a_short_segment_is_left():
+    segs = [np.array([[0.0, 0.0], [3.0, 0.0]]), np.array([[3.0, 0.0], [3.0, 30.0]])]
+    assert filleted(segs, False, 1, 5.0) is None
+
+
+def test_the_corners_of_a_square_traced_sharp_are_rounded_as_drawn():
+    """The picture: a square frame whose centerline has corners of radius 4, the stroke's
+    half width (Tabler's rects). Traced with sharp corners, the round joins draw the
+    outside 1.7 px inside the picture's at each corner; the fillets close that."""
+    target = rgb(stroke_scene([(rounded_square(12, 12, 52, 52, 4.0), True)]))
+    sharp = [np.array([[12.0, 12.0], [52.0, 12.0]]), np.array([[52.0, 12.0], [52.0, 52.0]]),
+             np.array([[52.0, 52.0], [12.0, 52.0]]), np.array([[12.0, 52.0], [12.0, 12.0]])]
+    scene = stroke_scene([(sharp, True)])
+    before = float(((rgb(scene) - target) ** 2).mean())
+    stats = round_corners(scene, rgb, target, (64, 64))
+    after = float(((rgb(scene) - target) ** 2).mean())
+    assert stats["corners"] == 4 and stats["rounded"] == 4
+    assert after < 0.2 * before, (before, after)
+    segs, closed = _subpath_segments(scene.shapes[0].geometry)[0]
+    assert closed and sorted(len(c) - 1 for c in segs) == [1, 1, 1, 1, 3, 3, 3, 3]
+
+
+def test_sharp_corners_drawn_sharp_stay():
+    sharp = [np.array([[12.0, 12.0], [52.0, 12.0]]), np.array([[52.0, 12.0], [52.0, 52.0]]),
+             np.array([[52.0, 52.0], [12.0, 52.0]]), np.array([[12.0, 52.0], [12.0, 12.0]])]
+    target = rgb(stroke_scene([(sharp, True)]))
+    scene = stroke_scene([(sharp, True)])
+    stats = round_corners(scene, rgb, target, (64, 64))
+    assert stats["corners"] == 4 and stats["rounded"] == 0
+    assert np.allclose(scene.shapes[0].geometry.points.numpy(), stroke_scene([(sharp, True)]).shapes[0].geometry.points.numpy())
+
+
+def test_a_corner_traced_as_curves_between_two_lines_is_made_of_them():
+    """An L whose corner the trace drew as two wobbling cubics: the lines, extended to meet,
+    and a fillet of the radius the picture has."""
+    drawn = [np.array([[10.0, 12.0], [48.0, 12.0]]),
+             np.array([[48.0, 12.0], [48.0 + 4 * 0.5523, 12.0], [52.0, 16.0 - 4 * 0.5523], [52.0, 16.0]]),
+             np.array([[52.0, 16.0], [52.0, 54.0]])]
+    target = rgb(stroke_scene([(drawn, False)]))
+    traced = [np.array([[10.0, 12.0], [40.0, 12.0]]), np.array([[40.0, 12.0], [47.0, 11.0], [50.0, 11.0], [51.5, 15.0]]),
+              np.array([[51.5, 15.0], [53.0, 19.0], [52.5, 22.0], [52.0, 26.0]]), np.array([[52.0, 26.0], [52.0, 54.0]])]
+    scene = stroke_scene([(traced, False)])
+    found = corners(scene, _path_segments(scene))
+    assert [(c.vertex, c.last) for c in found] == [(1, 3)] and np.allclose(found[0].at, [52, 12], atol=1e-6)
+    before = float(((rgb(scene) - target) ** 2).mean())
+    stats = round_corners(scene, rgb, target, (64, 64))
+    after = float(((rgb(scene) - target) ** 2).mean())
+    assert stats["rounded"] == 1 and after < 0.3 * before, (before, after)
+    segs, _ = _subpath_segments(scene.shapes[0].geometry)[0]
+    assert [len(c) - 1 for c in segs] == [1, 3, 1]
+    assert np.allclose(segs[0][0], [10, 12], atol=1e-4) and np.allclose(segs[-1][-1], [52, 54], atol=1e-4)
+
+
+def test_arc_handles_are_a_circles():
+    c = _arc(np.array([10.0, 0.0]), np.array([0.0, 1.0]), np.array([0.0, 10.0]), np.array([-1.0, 0.0]))
+    assert np.allclose(c[1], [10, 10 * 4 / 3 * math.tan(math.pi / 8)])
