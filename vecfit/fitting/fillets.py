@@ -34,6 +34,8 @@ CLEARLY_BETTER = 0.7
 # (at 0.7, a sharp-cornered Tabler icon lost 6 dB: the fit cannot take a fillet back).
 TRACED_CLEARLY_BETTER = 0.35
 WINDOW = 2.0      # the window's half side: this many half widths past the trim, and 2 px
+CURVE_TURN_MIN = 60.0  # degrees: one curve turning less than this is no corner
+NEIGHBOUR_STRAIGHT = 0.25  # ... and its neighbours within this many half widths of their chords
 CURVED_MAX = 3    # a corner drawn as curves: at most this many segments between its lines
 CURVED_REACH = 5.0  # ... all within this many half widths of where the lines meet
 
@@ -49,6 +51,9 @@ class Corner:
     # A corner the trace drew as curves: the lines on either side, segments vertex - 1 and
     # `last`, meet at `at` where extended, and the curves between them go (else -1).
     last: int = -1
+    # A corner the trace drew as one curve (between anything): the curve's end tangents,
+    # extended, meet at `at`; `last` is `vertex`, the curve.
+    one_curve: bool = False
 
 
 def stroked(shape) -> bool:
@@ -110,7 +115,16 @@ def filleted(segs: list[np.ndarray], closed: bool, vertex: int, radius: float,
     of ``radius``; None where a segment beside it is too short for the trim. A corner drawn
     as curves (``corner.last`` >= 0) is made of its two lines, extended to meet, first
     (radius 0: a sharp corner there)."""
-    if corner is not None and corner.last >= 0:
+    if corner is not None and corner.one_curve:
+        c = segs[vertex]
+        lines = [np.stack([c[0], corner.at]), np.stack([corner.at, c[-1]])]
+        if min(np.hypot(*(q[1] - q[0])) for q in lines) <= 1e-6:
+            return None
+        segs = segs[:vertex] + lines + segs[vertex + 1:]
+        if radius <= 0:
+            return segs
+        vertex += 1
+    elif corner is not None and corner.last >= 0:
         n = len(segs)
         a, b = segs[vertex - 1], segs[corner.last % n]
         lines = [np.stack([a[0], corner.at]), np.stack([corner.at, b[-1]])]
@@ -153,6 +167,13 @@ def corners(scene, shapes: dict[int, list]) -> list[Corner]:
             curved = _curved_corners(s, j, segs, closed, hw)
             taken = {v % len(segs) for c in curved for v in range(c.vertex, c.last + 1)}  # (their vertices are theirs)
             out += curved
+            for k in range(0 if closed else 1, len(segs) - 1):  # (a closed subpath's last curve: no)
+                if k in taken or (k + 1) % len(segs) in taken or _is_line(segs[k]):
+                    continue
+                one = _one_curve_corner(s, j, k, segs, hw)
+                if one is not None:
+                    out.append(one)
+                    taken |= {k, (k + 1) % len(segs)}
             for v in range(0 if closed else 1, len(segs)):
                 if (v == 0 and len(segs) < 2) or v in taken:
                     continue
@@ -161,6 +182,40 @@ def corners(scene, shapes: dict[int, list]) -> list[Corner]:
                 if lo <= turn <= hi:
                     out.append(Corner(s, j, v, turn, hw, np.array(c_out[0])))
     return out
+
+
+def _straightness(c: np.ndarray) -> float:
+    """How far a segment's control points stray from its chord (px, shape units)."""
+    d = c[-1] - c[0]
+    length = float(np.hypot(*d))
+    if length <= 1e-9:
+        return np.inf
+    return float(np.abs((c - c[0]) @ np.array([-d[1], d[0]])).max() / length)
+
+
+def _one_curve_corner(shape: int, subpath: int, k: int, segs: list[np.ndarray], hw: float) -> Corner | None:
+    """A curve that is a corner (a square's corner the trace drew as one cubic): between
+    two all but straight segments (within NEIGHBOUR_STRAIGHT half widths of their chords)
+    whose chords turn CURVE_TURN_MIN to TURN_MAX degrees and, drawn on from the curve's
+    ends, meet within CURVED_REACH half widths of both; else None. (The curve's own end
+    tangents point off: the fit bent the neighbours' last pixels into it.)"""
+    n = len(segs)
+    before, after = segs[k - 1], segs[(k + 1) % n]
+    if max(_straightness(before), _straightness(after)) > NEIGHBOUR_STRAIGHT * hw:
+        return None
+    c = segs[k]
+    a, b = c[0], c[-1]
+    u, v = _unit(before[-1] - before[0]), _unit(after[-1] - after[0])
+    turn = float(np.arccos(np.clip(u @ v, -1.0, 1.0)))
+    if not np.radians(CURVE_TURN_MIN) <= turn <= np.radians(TURN_MAX):
+        return None
+    m = np.array([u, v]).T  # a + s u = b - t v
+    if abs(np.linalg.det(m)) < 1e-9:
+        return None
+    s_, t_ = np.linalg.solve(m, b - a)
+    if not (0 < s_ <= CURVED_REACH * hw and 0 < t_ <= CURVED_REACH * hw):
+        return None
+    return Corner(shape, subpath, k, turn, hw, a + s_ * u, last=k, one_curve=True)
 
 
 def _is_line(c: np.ndarray) -> bool:
@@ -254,7 +309,7 @@ def round_corners(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, in
     best = {i: (float(base[window(c, max(RADII) * c.half_width)].sum()), None) for i, c in enumerate(found)}
     sharp = {i: e for i, (e, _) in best.items()}
     for factor in (0.0,) + RADII:
-        apply({i: factor for i in range(len(found)) if factor > 0 or found[i].last >= 0})
+        apply({i: factor for i in range(len(found)) if factor > 0 or found[i].last >= 0})  # (0: sharp, where the lines meet)
         err = ((render_rgb(scene) - target_rgb) ** 2).sum(-1)
         stats["renders"] += 1
         for i, c in enumerate(found):

@@ -508,11 +508,87 @@ def tidy(scene, measure, render_rgb, size: tuple[int, int], noise: float, max_er
     from where they were); ``budget_db`` for both, measured as reduce_nodes measures."""
     base = measure(scene)
     limit = _limit(base, noise, budget_db)
+    ends = tidy_stroke_ends(scene, measure, limit)
     straight = straighten(scene, measure, size, limit, lines)
     joins = reduce_nodes(scene, measure, render_rgb(scene), size, budget_db, max_error, lines, rounds=1,
                          noise=noise, base=base, hidden_error=HIDDEN_ERROR)
-    return {"straightened": straight["straightened"], "joined": joins["joined"], "mse_before": base,
-            "mse_after": joins["mse_after"]}
+    return {"hooks": ends["hooks"], "dots": ends["dots"], "straightened": straight["straightened"],
+            "joined": joins["joined"], "mse_before": base, "mse_after": joins["mse_after"]}
+
+
+HOOK_TURN = 120.0  # degrees: a stroke's end segment turning back more than this ...
+HOOK_LENGTH = 1.0  # ... and no longer than this many half widths lies under its cap: a hook
+DOT_LENGTH = 0.25  # px: a stroke that is one line shorter than this is a dot (zero length)
+
+
+def _end_hooks(segs: list[np.ndarray], hw: float) -> list[int]:
+    """Indices of an open subpath's end segments that are hooks (HOOK_TURN, HOOK_LENGTH):
+    the fit folds a line's last few pixels back under its round cap, where nothing shows
+    them but the file."""
+    found = []
+    if len(segs) < 2:
+        return found
+    for k, nb, at_end in ((0, 1, False), (len(segs) - 1, len(segs) - 2, True)):
+        c, n = segs[k], segs[nb]
+        chord = (c[-1] - c[0]) if at_end else (c[0] - c[-1])  # away from the rest of the line
+        length = float(np.hypot(*chord))
+        if length > HOOK_LENGTH * hw:
+            continue
+        onward = (n[-1] - n[-2]) if at_end else (n[0] - n[1])  # the line's direction into the end
+        norm = float(np.hypot(*onward))
+        if norm <= 0:
+            continue
+        # the hook's whole course: its control polygon's steps against the line's direction
+        steps = np.diff(c if at_end else c[::-1], axis=0)
+        steps = steps[np.hypot(*steps.T) > 1e-9]
+        if len(steps) == 0:
+            continue
+        cos = (steps @ onward) / (np.hypot(*steps.T) * norm)
+        if cos.min() <= np.cos(np.radians(HOOK_TURN)):
+            found.append(k)
+    return sorted(set(found), reverse=True)
+
+
+def tidy_stroke_ends(scene, measure, limit: float) -> dict:
+    """Strokes' ends cleaned, in place, where ``measure(scene)`` stays within ``limit``:
+    end segments that are hooks (_end_hooks) dropped, and a stroke that is one line
+    shorter than DOT_LENGTH made a dot of no length at its middle (written `h0`, as the
+    trace writes dots, not `l.01-.11`). All at once, else none. Returns counts."""
+    shapes = _path_segments(scene)
+    stats = {"hooks": 0, "dots": 0}
+    new: dict[int, list] = {}
+    for s, subs in shapes.items():
+        sh = scene.shapes[s]
+        if not stroked(sh) or sh.linecap != "round":
+            continue
+        hw = 0.5 * float(np.asarray(to_numpy(sh.stroke_width)).reshape(-1)[0])
+        changed = False
+        out = []
+        for segs, closed in subs:
+            segs = list(segs)
+            if not closed:
+                for k in _end_hooks(segs, hw):
+                    del segs[k]
+                    stats["hooks"] += 1
+                    changed = True
+                if len(segs) == 1 and len(segs[0]) == 2 and 0 < np.hypot(*(segs[0][1] - segs[0][0])) < DOT_LENGTH:
+                    middle = segs[0].mean(0)
+                    segs = [np.stack([middle, middle])]
+                    stats["dots"] += 1
+                    changed = True
+            out.append((segs, closed))
+        if changed:
+            new[s] = out
+    if not new:
+        return stats
+    originals = {s: scene.shapes[s].geometry for s in new}
+    for s, subs in new.items():
+        scene.shapes[s].geometry = _with_segments(originals[s], subs)
+    if measure(scene) > limit:
+        for s, g in originals.items():
+            scene.shapes[s].geometry = g
+        return {"hooks": 0, "dots": 0}
+    return stats
 
 
 def _largest_within(count: int, within, coarse: int = 0) -> int:

@@ -197,11 +197,15 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
             make_opaque(scene)
         from vecfit.fitting.fillets import TRACED_CLEARLY_BETTER, round_corners, stroked
         if generated and any(stroked(s_) for s_ in scene.shapes):
-            # corners a trace's centerlines drew sharp, or as curves, rounded where the picture
-            # is (fitting/fillets.py) before the fit, which cannot add the nodes they need
+            # a trace's centerlines' corners, before the fit, which cannot add the nodes they
+            # need: small rings made the polygons they are (fitting/polygons.py), then
+            # corners drawn sharp or as curves rounded where the picture is (fitting/fillets.py)
+            from vecfit.fitting.polygons import sharpen_loops
             judged = dataclasses.replace(settings, eval_samples=max(4, settings.eval_samples))
-            traced_corners = round_corners(scene, lambda s_, seed=0: rendered_rgb(s_, sw, sh, judged, background, seed),
-                                           target_rgb, (sw, sh), clearly_better=TRACED_CLEARLY_BETTER)
+            judge_rgb = lambda s_, seed=0: rendered_rgb(s_, sw, sh, judged, background, seed)  # noqa: E731
+            loops = sharpen_loops(scene, judge_rgb, target_rgb, (sw, sh))
+            traced_corners = round_corners(scene, judge_rgb, target_rgb, (sw, sh), clearly_better=TRACED_CLEARLY_BETTER)
+            traced_corners["polygons"] = loops["sharpened"]
         progress.start(settings.iterations)
         if palette is None:
             result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
@@ -224,7 +228,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
             simplified["judged_samples"] = judge.samples  # N of the N x N samples a pixel the joins were judged at
             if traced_corners is not None:
                 simplified.setdefault("rounded_corners", {})["traced"] = {
-                    k: traced_corners[k] for k in ("corners", "rounded")}
+                    k: traced_corners[k] for k in ("corners", "rounded", "polygons")}
     else:
         progress.start(0)
         result = _not_optimised(scene, settings)

@@ -125,3 +125,25 @@ def test_a_corner_traced_as_curves_between_two_lines_is_made_of_them():
 def test_arc_handles_are_a_circles():
     c = _arc(np.array([10.0, 0.0]), np.array([0.0, 1.0]), np.array([0.0, 10.0]), np.array([-1.0, 0.0]))
     assert np.allclose(c[1], [10, 10 * 4 / 3 * math.tan(math.pi / 8)])
+
+
+def test_a_square_corner_traced_as_one_cubic_is_made_sharp_again():
+    """A diamond's corner the trace drew as one round cubic (tabler-088's): the curve's end
+    tangents, extended, meet at the corner, and two lines with a round join draw it."""
+    drawn = [np.array([[12.0, 32.0], [32.0, 12.0]]), np.array([[32.0, 12.0], [52.0, 32.0]]),
+             np.array([[52.0, 32.0], [32.0, 52.0]])]
+    target = rgb(stroke_scene([(drawn, False)]))
+    # (its neighbours curves too, straight as drawn: else it is a corner between two lines)
+    traced = [np.array([[12.0, 32.0], [32.0, 12.0]]), np.array([[32.0, 12.0], [35.0, 15.0], [37.0, 17.0], [40.0, 20.0]]),
+              np.array([[40.0, 20.0], [49.0, 29.0], [49.0, 35.0], [40.0, 44.0]]),
+              np.array([[40.0, 44.0], [37.0, 47.0], [35.0, 49.0], [32.0, 52.0]])]
+    scene = stroke_scene([(traced, False)])
+    found = corners(scene, _path_segments(scene))
+    assert any(c.one_curve and c.vertex == 2 and np.allclose(c.at, [52, 32]) for c in found)
+    before = float(((rgb(scene) - target) ** 2).mean())
+    stats = round_corners(scene, rgb, target, (64, 64))
+    after = float(((rgb(scene) - target) ** 2).mean())
+    assert stats["rounded"] >= 1 and after < 0.1 * before, (before, after)
+    segs, _ = _subpath_segments(scene.shapes[0].geometry)[0]
+    corner = [k for k, c in enumerate(segs) if len(c) == 2 and np.allclose(c[1], [52, 32], atol=1e-3)]
+    assert corner and len(segs[corner[0] + 1]) == 2  # two lines, the corner sharp where they meet

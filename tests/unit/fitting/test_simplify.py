@@ -9,7 +9,8 @@ import pytest
 import torch
 
 import vecfit
-from vecfit.fitting.simplify import (_apart, _subpath_segments, drop_unseen, fit_pairs, join_straight_runs, reduce_nodes,
+from vecfit.fitting.simplify import (_apart, _end_hooks, _subpath_segments, drop_unseen, fit_pairs, join_straight_runs,
+                                     reduce_nodes, tidy_stroke_ends,
                                      straight_run_candidates, straighten)
 from vecfit.renderer.raster import render
 from vecfit.scene import Path, Scene, Shape, Solid
@@ -276,3 +277,45 @@ def test_a_stroke_a_hair_off_its_line_is_not_joined_beyond_the_tolerance():
     found = straight_run_candidates(scene, {0: _subpath_segments(scene.shapes[0].geometry)}, (64, 64))
     runs = [(a, b) for _, _, _, a, b in found]
     assert runs and all(a >= 1 for a, _ in runs)  # the line off the others joins none of them
+
+
+def _stroke(segs, width=8.0, size=64) -> Scene:
+    points, degrees = layout_of([np.asarray(c, float) for c in segs], False)
+    path = Path(points=torch.tensor(points, dtype=torch.float32), degrees=np.array(degrees),
+                subpaths=[(0, len(segs), False)])
+    black = Solid(torch.tensor([0.0, 0.0, 0.0, 1.0]))
+    return Scene(size, size, [Shape(path, stroke=black, stroke_width=torch.tensor(width), linecap="round",
+                                    linejoin="round")])
+
+
+def _measure_against(target):
+    def measure(scene):
+        return float(((render(scene, 64, 64, samples=4, background=[1, 1, 1, 1]).numpy()[..., :3] - target) ** 2).mean())
+    return measure
+
+
+def test_a_hook_under_a_round_cap_is_dropped_and_a_tiny_line_made_a_dot():
+    line = [np.array([[10.0, 20.0], [50.0, 20.0]])]
+    target = render(_stroke(line), 64, 64, samples=4, background=[1, 1, 1, 1]).numpy()[..., :3]
+    # the fit's hook: the line's last 2 px folded back under its cap (half width 4)
+    hooked = _stroke(line + [np.array([[50.0, 20.0], [51.0, 20.5], [49.5, 21.0], [48.5, 20.5]])])
+    measure = _measure_against(target)
+    stats = tidy_stroke_ends(hooked, measure, measure(hooked) * 1.01 + 1e-6)
+    assert stats == {"hooks": 1, "dots": 0}
+    assert list(hooked.shapes[0].geometry.degrees) == [1]
+    dot = _stroke([np.array([[30.0, 30.0], [30.01, 30.11]])])
+    stats = tidy_stroke_ends(dot, _measure_against(target), 1.0)
+    assert stats == {"hooks": 0, "dots": 1}
+    p = dot.shapes[0].geometry.points.numpy()
+    assert np.allclose(p[0], p[1]) and np.allclose(p[0], [30.005, 30.055], atol=1e-4)
+
+
+def test_a_short_end_going_on_is_no_hook_and_a_change_past_the_budget_is_undone():
+    line = [np.array([[10.0, 20.0], [50.0, 20.0]]), np.array([[50.0, 20.0], [52.0, 21.0]])]
+    assert _end_hooks([np.asarray(c) for c in line], 4.0) == []
+    hooked = _stroke([np.array([[10.0, 20.0], [50.0, 20.0]]), np.array([[50.0, 20.0], [46.0, 20.0]])])
+    target = render(_stroke([np.array([[10.0, 20.0], [50.0, 20.0]])]), 64, 64, samples=4,
+                    background=[1, 1, 1, 1]).numpy()[..., :3]
+    before = hooked.shapes[0].geometry.points.clone()
+    stats = tidy_stroke_ends(hooked, _measure_against(target), -1.0)  # (no change can be within a negative limit)
+    assert stats == {"hooks": 0, "dots": 0} and torch.equal(hooked.shapes[0].geometry.points, before)
