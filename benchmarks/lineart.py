@@ -2,7 +2,7 @@
 
     python benchmarks/lineart.py [--styles fills,strokes,mixed] [--effort quick]
                                  [--half tuned|held-out|all] [--limit N] [--no-vtracer]
-                                 [--no-degraded] [--threads 2] [--out lineart.tsv]
+                                 [--no-degraded] [--threads 2] [--out lineart.tsv] [--svgs DIR]
 
 The icons: ../shared/lineart (or $VECFIT_SHARED/lineart): 120 Tabler icons, each the
 designer's stroke-drawn SVG and its 256 px render over white (the target). The first 60 by
@@ -111,6 +111,7 @@ def main():
     ap.add_argument("--no-degraded", action="store_true", help="leave out the scan row")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--out", type=Path, help="a row per icon and row (TSV)")
+    ap.add_argument("--svgs", type=Path, help="keep each written SVG in this folder (NAME.ROW.svg)")
     args = ap.parse_args()
 
     import vecfit
@@ -161,6 +162,9 @@ def main():
                             written = trace(png, row)
                         seconds = time.perf_counter() - start
                         r = {**measure(written, target, folder, designer), "seconds": seconds}
+                        if args.svgs:
+                            args.svgs.mkdir(parents=True, exist_ok=True)
+                            (args.svgs / f"{name}.{row.replace(' ', '-')}.svg").write_text(written, encoding="utf-8")
                     except Exception as e:  # one icon's failure is reported, not the end of the run
                         print(f"FAILED {name} {row}: {type(e).__name__}: {e}")
                         r = {"error": f"{type(e).__name__}: {e}"}
