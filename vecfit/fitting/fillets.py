@@ -258,6 +258,17 @@ def _curved_corners(shape: int, subpath: int, segs: list[np.ndarray], closed: bo
     return out
 
 
+def traced_corners(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, int]) -> dict:
+    """A trace's strokes before the fit, in place: small rings made polygons
+    (polygons.py), then corners rounded where far better (round_corners at
+    TRACED_CLEARLY_BETTER). Returns counts."""
+    from .polygons import sharpen_loops
+
+    loops = sharpen_loops(scene, render_rgb, target_rgb, size)
+    stats = round_corners(scene, render_rgb, target_rgb, size, clearly_better=TRACED_CLEARLY_BETTER)
+    return {"corners": stats["corners"], "rounded": stats["rounded"], "polygons": loops["sharpened"]}
+
+
 def round_corners(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, int], image=None,
                   clearly_better: float = CLEARLY_BETTER) -> dict:
     """Fillets at the corners of ``scene``'s strokes, in place, where the render says (see

@@ -187,7 +187,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         problem = cutout_problem(scene)
         if problem is not None:
             raise VecfitError(f"--stacking cutouts: {document.name}: {problem}")
-    simplified = traced_corners = None
+    simplified = corners = None
     if is_tensor(scene.view):
         import torch
         from vecfit.fitting.loop import Target, optimize
@@ -195,17 +195,14 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         goal = Target(torch.from_numpy(small), background)
         if generated and settings.alpha == "auto" and not goal.wants_translucency:
             make_opaque(scene)
-        from vecfit.fitting.fillets import TRACED_CLEARLY_BETTER, round_corners, stroked
+        from vecfit.fitting.fillets import stroked, traced_corners
         if generated and any(stroked(s_) for s_ in scene.shapes):
             # a trace's centerlines' corners, before the fit, which cannot add the nodes they
-            # need: small rings made the polygons they are (fitting/polygons.py), then
-            # corners drawn sharp or as curves rounded where the picture is (fitting/fillets.py)
-            from vecfit.fitting.polygons import sharpen_loops
+            # need: small rings made the polygons they are, corners drawn sharp or as curves
+            # rounded where the picture is (fitting/fillets.py, fitting/polygons.py)
             judged = dataclasses.replace(settings, eval_samples=max(4, settings.eval_samples))
-            judge_rgb = lambda s_, seed=0: rendered_rgb(s_, sw, sh, judged, background, seed)  # noqa: E731
-            loops = sharpen_loops(scene, judge_rgb, target_rgb, (sw, sh))
-            traced_corners = round_corners(scene, judge_rgb, target_rgb, (sw, sh), clearly_better=TRACED_CLEARLY_BETTER)
-            traced_corners["polygons"] = loops["sharpened"]
+            corners = traced_corners(scene, lambda s_, seed=0: rendered_rgb(s_, sw, sh, judged, background, seed),
+                                     target_rgb, (sw, sh))
         progress.start(settings.iterations)
         if palette is None:
             result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
@@ -226,9 +223,8 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
                                          int(settings.simplify_iterations), hooks, keep_alpha,
                                          rendered=judge.rendered)
             simplified["judged_samples"] = judge.samples  # N of the N x N samples a pixel the joins were judged at
-            if traced_corners is not None:
-                simplified.setdefault("rounded_corners", {})["traced"] = {
-                    k: traced_corners[k] for k in ("corners", "rounded", "polygons")}
+            if corners is not None:
+                simplified.setdefault("rounded_corners", {})["traced"] = corners
     else:
         progress.start(0)
         result = _not_optimised(scene, settings)
