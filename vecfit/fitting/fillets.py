@@ -261,12 +261,33 @@ def _curved_corners(shape: int, subpath: int, segs: list[np.ndarray], closed: bo
 def traced_corners(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, int]) -> dict:
     """A trace's strokes before the fit, in place: small rings made polygons
     (polygons.py), then corners rounded where far better (round_corners at
-    TRACED_CLEARLY_BETTER). Returns counts."""
+    TRACED_CLEARLY_BETTER). Both need round joins. Where the tracer chose another join for
+    its strokes (centerline._choose_caps: a bevel draws a rounded corner's outside nearer
+    than a round join on the sharp corner thinning leaves), the strokes are tried with
+    round joins and both passes, the fillets at CLEARLY_BETTER (the corners are likely
+    round there), and kept so unless the tracer's join, on the trace as it was, is still
+    clearly better (JOIN_CLEARLY_BETTER). Returns counts."""
     from .polygons import sharpen_loops
 
+    others = [sh for sh in scene.shapes if stroked(sh) and sh.linejoin != "round"]
+    saved = [(sh.geometry, sh.linejoin) for sh in scene.shapes]
+    before = float(((render_rgb(scene) - target_rgb) ** 2).mean()) if others else 0.0
+    for sh in others:
+        sh.linejoin = "round"
     loops = sharpen_loops(scene, render_rgb, target_rgb, size)
-    stats = round_corners(scene, render_rgb, target_rgb, size, clearly_better=TRACED_CLEARLY_BETTER)
-    return {"corners": stats["corners"], "rounded": stats["rounded"], "polygons": loops["sharpened"]}
+    rounded = round_corners(scene, render_rgb, target_rgb, size,
+                            clearly_better=CLEARLY_BETTER if others else TRACED_CLEARLY_BETTER)
+    stats = {"corners": rounded["corners"], "rounded": rounded["rounded"], "polygons": loops["sharpened"]}
+    if others:
+        stats["joins_made_round"] = float(((render_rgb(scene) - target_rgb) ** 2).mean()) * JOIN_CLEARLY_BETTER <= before
+        if not stats["joins_made_round"]:
+            for sh, (geometry, join) in zip(scene.shapes, saved):
+                sh.geometry, sh.linejoin = geometry, join
+            stats.update(rounded=0, polygons=0)
+    return stats
+
+
+JOIN_CLEARLY_BETTER = 0.8  # another join than round stays where its render has this share of round's error or less
 
 
 def round_corners(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, int], image=None,

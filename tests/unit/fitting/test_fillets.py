@@ -147,3 +147,31 @@ def test_a_square_corner_traced_as_one_cubic_is_made_sharp_again():
     segs, _ = _subpath_segments(scene.shapes[0].geometry)[0]
     corner = [k for k, c in enumerate(segs) if len(c) == 2 and np.allclose(c[1], [52, 32], atol=1e-3)]
     assert corner and len(segs[corner[0] + 1]) == 2  # two lines, the corner sharp where they meet
+
+
+def test_a_frame_with_round_corners_is_traced_with_them(tmp_path):
+    """Tabler's frames: a rect whose corners have the stroke's half width for radius. It
+    thins to sharp corners, on which a bevel beat round joins; the trace now comes back
+    round-joined, each corner a quarter arc of that radius (the tracer chose bevel before,
+    and the fit kept the corners cut)."""
+    from PIL import Image
+
+    import vecfit
+    (tmp_path / "frame.svg").write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="128" height="128"><path fill="none" stroke="#202020" '
+        'stroke-width="12" d="M30 25 H98 A6 6 0 0 1 104 31 V97 A6 6 0 0 1 98 103 H30 A6 6 0 0 1 24 97 V31 '
+        'A6 6 0 0 1 30 25 Z"/></svg>')
+    image = vecfit.render(vecfit.load_svg(tmp_path / "frame.svg"), 128, 128, samples=4,
+                          background=[1, 1, 1, 1]).numpy()
+    Image.fromarray((np.clip(image, 0, 1) * 255 + 0.5).astype(np.uint8)).save(tmp_path / "frame.png")
+    written, report = vecfit.trace(tmp_path / "frame.png", settings={"optimize": {"threads": 1}}, effort="quick",
+                                   style="strokes")
+    assert 'stroke-linejoin="round"' in written
+    assert report["simplified"]["rounded_corners"]["traced"]["rounded"] == 4
+    (tmp_path / "traced.svg").write_text(written)
+    path = [s for s in vecfit.load_svg(tmp_path / "traced.svg").shapes if s.stroke is not None][0].geometry
+    segs, closed = _subpath_segments(path)[0]
+    arcs = [c for c in segs if len(c) == 4]
+    assert closed and len(arcs) == 4 and sum(len(c) == 2 for c in segs) in (4, 5)  # (a side split where the loop starts)
+    for c in arcs:  # a quarter arc of radius 6: its ends 6 sqrt(2) apart
+        assert abs(np.hypot(*(c[3] - c[0])) - 6 * math.sqrt(2)) < 1.0, c

@@ -101,6 +101,12 @@ CAPS = ("round", "butt", "square")  # (the first of each is the default)
 # default's or less.
 CLEARLY_BETTER = 0.8
 JOINS = ("round", "miter", "bevel")
+# A join other than round, further: a round-cornered drawing (Tabler's corners of radius
+# 1 at width 2) thins to sharp corners, whose round joins draw the outside too round and
+# bevels too flat, and bevels came out 0.63-0.77 of round there (three Tabler letters,
+# which the fit then kept bevelled, 11-17 dB below their ceiling); the corners' fillets
+# (fitting/fillets.py) need round joins.
+JOIN_CLEARLY_BETTER = 0.6
 
 
 @dataclasses.dataclass
@@ -505,14 +511,14 @@ def _choose_caps(strokes: list[Stroke], w: int, h: int, background, image: np.nd
     # round unless another is clearly better: thinning leaves ends and acute corners short
     # of where they are, which a square cap or a miter covers at first, and the refinement
     # then moves them out (a miter's spike and a square's corners overshoot)
-    def best(options, err):
+    def best(options, err, clearly_better):
         errors = {o: err(o) for o in options}
         choice = min(errors, key=errors.get)
-        return choice if errors[choice] < CLEARLY_BETTER * errors[options[0]] else options[0]
+        return choice if errors[choice] < clearly_better * errors[options[0]] else options[0]
 
     has_ends = any(st.tag == "path" and not st.geometry["d"].rstrip().lower().endswith("z") for st in strokes)
-    cap = best(CAPS, lambda c: error(c, "round")) if has_ends else "round"
-    join = best(JOINS, lambda j: error(cap, j))
+    cap = best(CAPS, lambda c: error(c, "round"), CLEARLY_BETTER) if has_ends else "round"
+    join = best(JOINS, lambda j: error(cap, j), JOIN_CLEARLY_BETTER)
     return cap, join
 
 
