@@ -84,6 +84,16 @@ def test_stroke_patterns_come_back_as_strokes(elements, count, width, tag):
     assert psnr(rendered(result.svg), image[..., :3]) > 24
 
 
+def test_a_stub_shorter_than_its_width_is_kept():
+    """A line half its width long on a frame (Tabler's `M18 4l0 1` over a square) thins to
+    nothing past the frame's own centerline; its ink, which no stroke drew, gets a dot."""
+    image, result = traced('<rect x="40" y="50" width="48" height="40" stroke-width="10"/>'
+                           '<path d="M64 45 V50" stroke-width="10"/>')
+    starts = [tuple(float(v) for v in re.match(r"M\s*([-\d.]+)[ ,]([-\d.]+)", f["d"]).groups())
+              for f in strokes_of(result.svg) if f["tag"] == "path"]
+    assert any(abs(x - 64) < 2 and abs(y - 44) < 2 for x, y in starts), result.svg
+
+
 def test_a_closed_outline_closes_and_an_open_line_does_not():
     _, rect = traced('<rect x="25" y="30" width="80" height="60" stroke-width="5"/>')
     _, line = traced('<path d="M20 30 L108 90" stroke-width="8"/>')

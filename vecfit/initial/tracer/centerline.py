@@ -93,6 +93,12 @@ NOISE_FLOOR = 0.12
 # paper and ink of a scan or a photo of a drawing come out a shade off (noise clipped at
 # white and black, JPEG), where a designer's are pure.
 SNAP = 0.04
+# Ink a piece's strokes leave undrawn (more than a pixel from them) gets a dot stroke where
+# it is at least this share of a disc of the piece's half width, and as wide as this
+# share of it: a stub shorter than its width (Tabler's `M18 4l0 1` over a square) thins to
+# nothing and was lost, 15 dB on its icon.
+MISSING_AREA = 0.3
+MISSING_WIDTH = 0.6
 # A corner sharper than this many degrees (its sides as they leave it) is acute: a wide
 # line's skeleton falls short of its apex by more than thinning's few pixels (see _apex).
 ACUTE = 80.0
@@ -581,6 +587,7 @@ def trace_strokes(image: np.ndarray, settings: TraceSettings, progress=None) -> 
                     chains, fits = other, True
             if fits:
                 own = piece_color(rgb[ys, xs], lab[ys, xs], piece & (r >= CORE_RADIUS), color)
+                chains = chains + _missing_dots(chains, piece, r, (xs.start, ys.start))
                 strokes += fitted_strokes(chains, np.where(pieces == k, radius, 0), ink_cover, hex_color(own), s)
                 good[ys, xs] |= piece
             else:
@@ -648,6 +655,64 @@ def _moved(chain: Chain, origin) -> None:
     chain.crossings[:, :2] += origin
 
 
+def _drawn_locally(chains, piece: np.ndarray, radius: np.ndarray, origin) -> np.ndarray:
+    """What strokes along ``chains`` draw of the piece's box (``origin`` its top left),
+    their open ends moved on as the fit moves them (_extended)."""
+    inside = piece.astype(np.float32)
+    local = [dataclasses.replace(c, points=c.points - origin if c.closed else
+                                 _extended(c.points - origin, inside, _half_width(c.points - origin, radius)))
+             for c in chains]
+    return drawn_mask(local, radius)
+
+
+def _missing_dots(chains, piece: np.ndarray, radius: np.ndarray, origin) -> list:
+    """Dot chains (image coordinates) for the piece's ink that strokes along ``chains`` leave
+    undrawn (MISSING_AREA, MISSING_WIDTH): each at the undrawn part's deepest point, the
+    centre of the widest disc inside the piece there."""
+    hw = np.median([_half_width(c.points - origin, radius) for c in chains])
+    near = cv2.dilate(_drawn_locally(chains, piece, radius, origin).astype(np.uint8), np.ones((3, 3), np.uint8))
+    undrawn = (piece & ~near.astype(bool)).astype(np.uint8)
+    count, parts, stats, _ = cv2.connectedComponentsWithStats(undrawn, connectivity=8)
+    dots = []
+    for k in range(1, count):
+        if stats[k, cv2.CC_STAT_AREA] < MISSING_AREA * np.pi * hw * hw:
+            continue
+        depth = np.where(parts == k, radius, 0)
+        y, x = np.unravel_index(int(np.argmax(depth)), depth.shape)
+        at = np.array([x + 0.5, y + 0.5]) + origin
+        if depth[y, x] - 0.5 >= MISSING_WIDTH * hw and _beside(chains, at, hw):
+            dots.append(Chain(points=at[None], closed=False))
+    return dots
+
+
+def _beside(chains, at: np.ndarray, hw: float) -> bool:
+    """Whether ``at`` lies past an open chain's end (thinning stopped short of the line's
+    end) or beside the chain, square to it on both sides of the nearest point (within 60
+    degrees): a stub standing on a line. Not beyond a corner: thinning leaves an acute
+    apex undrawn too, but the fit draws that out (centerline._apex), and dots there cost
+    Tabler icons 2-12 dB."""
+    best = None
+    for c in chains:
+        d = np.hypot(*(c.points - at).T)
+        i = int(np.argmin(d))
+        if best is None or d[i] < best[0]:
+            best = (d[i], c, i)
+    _, c, i = best
+    n, k = len(c.points), max(2, int(round(hw)))
+    if not c.closed and (i < k or i >= n - k):
+        return True  # (past a line's end, where thinning stopped short)
+    before, after = c.points[(i - k) % n], c.points[(i + k) % n]
+    away = at - c.points[i]
+    norm = float(np.hypot(*away))
+    if norm <= 0:
+        return False
+    for t in (c.points[i] - before, after - c.points[i]):
+        length = float(np.hypot(*t))
+        if length <= 0 or abs(float(away @ t)) / (norm * length) > 0.5:
+            return False
+    return True
+
+
 def _dot(piece: np.ndarray) -> list:
     """A piece whose skeleton thins to nothing (a round blob: a Tabler dot, a full stop)
     as one dot at its centre, which _fits then judges: a dot stroke where the piece is
@@ -680,11 +745,7 @@ def _fits(chains, piece: np.ndarray, radius: np.ndarray, origin, widest: float, 
         return False
     # thinning stops short of a line's ends (a short line's skeleton is a fraction of it):
     # the ends are judged as the strokes draw them, moved on as _extended moves them
-    inside = piece.astype(np.float32)
-    local = [dataclasses.replace(c, points=c.points - origin if c.closed else
-                                 _extended(c.points - origin, inside, _half_width(c.points - origin, radius)))
-             for c in chains]
-    drawn = drawn_mask(local, radius)
+    drawn = _drawn_locally(chains, piece, radius, origin)
     # judged a pixel either way: a thin line's width is rounded to whole pixels here
     near_drawn = cv2.dilate(drawn.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
     near_piece = cv2.dilate(piece.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
