@@ -137,6 +137,8 @@ def main():
 
     trace(degraded(cases("all", 1)[0][2].read_bytes(), 0), "strokes")  # warm-up (torch's import)
     records = []
+    if args.svgs:
+        args.svgs.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         for half in (["tuned", "held-out"] if args.half == "all" else [args.half]):
@@ -163,7 +165,6 @@ def main():
                         seconds = time.perf_counter() - start
                         r = {**measure(written, target, folder, designer), "seconds": seconds}
                         if args.svgs:
-                            args.svgs.mkdir(parents=True, exist_ok=True)
                             (args.svgs / f"{name}.{row.replace(' ', '-')}.svg").write_text(written, encoding="utf-8")
                     except Exception as e:  # one icon's failure is reported, not the end of the run
                         print(f"FAILED {name} {row}: {type(e).__name__}: {e}")

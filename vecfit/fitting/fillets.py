@@ -20,7 +20,7 @@ import numpy as np
 from vecfit.scene.arrays import to_numpy
 from vecfit.scene.model import Path
 from vecfit.scene.placement import shape_matrices
-from vecfit.scene.segments import split_at
+from vecfit.scene.segments import path_segments, points_at, split_at, with_segments
 
 # The fillets' radii tried, as multiples of the stroke's half width.
 RADII = (0.5, 1.0, 1.5, 2.0)
@@ -61,6 +61,11 @@ def stroked(shape) -> bool:
     return isinstance(shape.geometry, Path) and shape.stroke is not None and shape.fill is None
 
 
+def half_width(shape) -> float:
+    """A stroke's half width, shape units."""
+    return 0.5 * float(np.asarray(to_numpy(shape.stroke_width)).reshape(-1)[0])
+
+
 def _unit(v: np.ndarray) -> np.ndarray:
     n = float(np.hypot(*v))
     return v / n if n > 0 else v * 0
@@ -77,11 +82,9 @@ def _end_tangent(c: np.ndarray, at_end: bool) -> np.ndarray:
 
 
 def _length_table(c: np.ndarray, n: int = 32) -> tuple[np.ndarray, np.ndarray]:
+    """Parameters t [n + 1] along the segment and the arc length to each."""
     t = np.linspace(0.0, 1.0, n + 1)
-    deg = len(c) - 1
-    from math import comb
-    basis = np.stack([comb(deg, i) * t ** i * (1 - t) ** (deg - i) for i in range(deg + 1)], 1)
-    pts = basis @ c
+    pts = points_at(c, t)
     return t, np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
 
 
@@ -155,14 +158,14 @@ def filleted(segs: list[np.ndarray], closed: bool, vertex: int, radius: float,
 
 def corners(scene, shapes: dict[int, list]) -> list[Corner]:
     """Every corner (a vertex turning TURN_MIN to TURN_MAX degrees) of the stroked paths
-    of ``shapes`` (shape index -> simplify._subpath_segments)."""
+    of ``shapes`` (shape index -> scene.segments.subpath_segments)."""
     out = []
     lo, hi = np.radians(TURN_MIN), np.radians(TURN_MAX)
     for s, subs in shapes.items():
         sh = scene.shapes[s]
         if not stroked(sh) or sh.linejoin != "round":
             continue
-        hw = 0.5 * float(np.asarray(to_numpy(sh.stroke_width)).reshape(-1)[0])
+        hw = half_width(sh)
         for j, (segs, closed) in enumerate(subs):
             curved = _curved_corners(s, j, segs, closed, hw)
             taken = {v % len(segs) for c in curved for v in range(c.vertex, c.last + 1)}  # (their vertices are theirs)
@@ -271,15 +274,18 @@ def traced_corners(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, i
 
     others = [sh for sh in scene.shapes if stroked(sh) and sh.linejoin != "round"]
     saved = [(sh.geometry, sh.linejoin) for sh in scene.shapes]
-    before = float(((render_rgb(scene) - target_rgb) ** 2).mean()) if others else 0.0
-    for sh in others:
-        sh.linejoin = "round"
-    loops = sharpen_loops(scene, render_rgb, target_rgb, size)
-    rounded = round_corners(scene, render_rgb, target_rgb, size,
-                            clearly_better=CLEARLY_BETTER if others else TRACED_CLEARLY_BETTER)
+    image = render_rgb(scene)
+    before = float(((image - target_rgb) ** 2).mean())
+    if others:
+        for sh in others:
+            sh.linejoin = "round"
+        image = render_rgb(scene)
+    loops, image = sharpen_loops(scene, render_rgb, target_rgb, size, image)
+    rounded, image = round_corners(scene, render_rgb, target_rgb, size, image,
+                                   clearly_better=CLEARLY_BETTER if others else TRACED_CLEARLY_BETTER)
     stats = {"corners": rounded["corners"], "rounded": rounded["rounded"], "polygons": loops["sharpened"]}
     if others:
-        stats["joins_made_round"] = float(((render_rgb(scene) - target_rgb) ** 2).mean()) * JOIN_CLEARLY_BETTER <= before
+        stats["joins_made_round"] = float(((image - target_rgb) ** 2).mean()) * JOIN_CLEARLY_BETTER <= before
         if not stats["joins_made_round"]:
             for sh, (geometry, join) in zip(scene.shapes, saved):
                 sh.geometry, sh.linejoin = geometry, join
@@ -291,35 +297,33 @@ JOIN_CLEARLY_BETTER = 0.8  # another join than round stays where its render has 
 
 
 def round_corners(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, int], image=None,
-                  clearly_better: float = CLEARLY_BETTER) -> dict:
+                  clearly_better: float = CLEARLY_BETTER) -> tuple[dict, np.ndarray]:
     """Fillets at the corners of ``scene``'s strokes, in place, where the render says (see
     the module's text). ``image``: ``render_rgb(scene)`` where the caller has it. Returns
-    counts and the MSE before and after."""
-    from .simplify import _path_segments, _with_segments
-
-    shapes = _path_segments(scene)
+    counts, and the render of the scene as it is left."""
+    shapes = path_segments(scene)
     for s, subs in shapes.items():  # closed subpaths start at a line, where they have one (_curved_corners)
         for j, (segs, closed) in enumerate(subs):
             first = next((k for k, c in enumerate(segs) if _is_line(c)), 0)
             if closed and first:
                 subs[j] = (segs[first:] + segs[:first], closed)
     found = corners(scene, shapes)
-    stats = {"corners": len(found), "rounded": 0, "renders": 0}
-    if not found:
-        return stats
-    originals = {c.shape: scene.shapes[c.shape].geometry for c in found}
-    mats = np.asarray(to_numpy(shape_matrices(scene, size[0], size[1])), np.float64)
+    stats = {"corners": len(found), "rounded": 0}
     if image is None:
         image = render_rgb(scene)
-        stats["renders"] += 1
+    if not found:
+        return stats, image
+    originals = {c.shape: scene.shapes[c.shape].geometry for c in found}
+    mats = np.asarray(to_numpy(shape_matrices(scene, size[0], size[1])), np.float64)
     base = ((image - target_rgb) ** 2).sum(-1)
     h, w = base.shape
 
-    def window(c: Corner, radius: float) -> tuple[slice, slice]:
+    def window(c: Corner) -> tuple[slice, slice]:
+        """About the corner, wide enough for the largest fillet's trim."""
         m = mats[c.shape]
         scale = float(np.sqrt(abs(np.linalg.det(m[:2, :2]))))
         p = m[:2, :2] @ c.at + m[:2, 2]
-        half = scale * (radius * np.tan(c.turn / 2) + WINDOW * c.half_width) + 2
+        half = scale * c.half_width * (max(RADII) * np.tan(c.turn / 2) + WINDOW) + 2
         x0, x1 = int(max(0, np.floor(p[0] - half))), int(min(w, np.ceil(p[0] + half)))
         y0, y1 = int(max(0, np.floor(p[1] - half))), int(min(h, np.ceil(p[1] + half)))
         return slice(y0, y1), slice(x0, x1)
@@ -336,29 +340,25 @@ def round_corners(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, in
             if made is not None:
                 subs[c.subpath] = (made, closed)
         for s, g in originals.items():
-            scene.shapes[s].geometry = _with_segments(g, subs_of[s]) if s in subs_of else g
+            scene.shapes[s].geometry = with_segments(g, subs_of[s]) if s in subs_of else g
 
-    best = {i: (float(base[window(c, max(RADII) * c.half_width)].sum()), None) for i, c in enumerate(found)}
-    sharp = {i: e for i, (e, _) in best.items()}
+    windows = [window(c) for c in found]
+    sharp = [float(base[win].sum()) for win in windows]
+    best = {i: (e, None) for i, e in enumerate(sharp)}
     for factor in (0.0,) + RADII:
         apply({i: factor for i in range(len(found)) if factor > 0 or found[i].last >= 0})  # (0: sharp, where the lines meet)
         err = ((render_rgb(scene) - target_rgb) ** 2).sum(-1)
-        stats["renders"] += 1
-        for i, c in enumerate(found):
-            e = float(err[window(c, max(RADII) * c.half_width)].sum())
+        for i, win in enumerate(windows):
+            e = float(err[win].sum())
             if e <= clearly_better * sharp[i] and e < best[i][0]:
                 best[i] = (e, factor)
     choice = {i: f for i, (_, f) in best.items() if f is not None}
-    stats["mse_before"] = float(base.mean()) / 3
     if choice:
         apply(choice)
-        after = float(((render_rgb(scene) - target_rgb) ** 2).mean())
-        stats["renders"] += 1
-        if after < stats["mse_before"]:
+        after = render_rgb(scene)
+        if ((after - target_rgb) ** 2).mean() < base.mean() / 3:
             stats["rounded"] = len(choice)
-            stats["mse_after"] = after
-            return stats
+            return stats, after
     for s, g in originals.items():
         scene.shapes[s].geometry = g
-    stats["mse_after"] = stats["mse_before"]
-    return stats
+    return stats, image

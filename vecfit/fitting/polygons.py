@@ -15,6 +15,9 @@ import numpy as np
 
 from vecfit.scene.arrays import to_numpy
 from vecfit.scene.placement import shape_matrices
+from vecfit.scene.segments import path_segments, points_at, with_segments
+
+from .fillets import half_width, stroked
 
 SIDES = (3, 8)          # polygons of this many sides are tried
 DP_TOLERANCES = (0.5, 1.0)  # half widths: Douglas-Peucker's tolerances, finding the sides (each tried)
@@ -26,14 +29,8 @@ SAMPLES = 24            # points a segment
 
 def _points(segs: list[np.ndarray]) -> np.ndarray:
     """A closed subpath's points, SAMPLES a segment (each segment's end left to the next)."""
-    from math import comb
     t = np.linspace(0.0, 1.0, SAMPLES, endpoint=False)
-    out = []
-    for c in segs:
-        deg = len(c) - 1
-        basis = np.stack([comb(deg, i) * t ** i * (1 - t) ** (deg - i) for i in range(deg + 1)], 1)
-        out.append(basis @ c)
-    return np.concatenate(out)
+    return np.concatenate([points_at(c, t) for c in segs])
 
 
 def _line(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -80,21 +77,19 @@ def polygon_of(segs: list[np.ndarray], hw: float, tolerance: float = DP_TOLERANC
     return [np.stack([corners[i], corners[(i + 1) % k]]) for i in range(k)]
 
 
-def sharpen_loops(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, int], image=None) -> dict:
+def sharpen_loops(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, int],
+                  image=None) -> tuple[dict, np.ndarray]:
     """Closed, round-joined strokes of ``scene`` made the polygons they are, in place,
     where the render says (see the module's text). ``image``: ``render_rgb(scene)`` where
-    the caller has it. Returns counts."""
-    from .fillets import stroked
-    from .simplify import _path_segments, _with_segments
-
-    shapes = _path_segments(scene)
+    the caller has it. Returns counts, and the render of the scene as it is left."""
+    shapes = path_segments(scene)
     mats = np.asarray(to_numpy(shape_matrices(scene, size[0], size[1])), np.float64)
     found = {}  # (shape, subpath) -> ({tolerance index: polygon}, the box in pixels of them all)
     for s, subs in shapes.items():
         sh = scene.shapes[s]
         if not stroked(sh) or sh.linejoin != "round":
             continue
-        hw = 0.5 * float(np.asarray(to_numpy(sh.stroke_width)).reshape(-1)[0])
+        hw = half_width(sh)
         m = mats[s]
         scale = float(np.sqrt(abs(np.linalg.det(m[:2, :2]))))
         for j, (segs, closed) in enumerate(subs):
@@ -108,11 +103,11 @@ def sharpen_loops(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, in
             pad = scale * hw + 2
             found[(s, j)] = (tried, (both.min(0) - pad, both.max(0) + pad))
     stats = {"loops": len(found), "sharpened": 0}
-    if not found:
-        return stats
-    originals = {s: scene.shapes[s].geometry for s, _ in found}
     if image is None:
         image = render_rgb(scene)
+    if not found:
+        return stats, image
+    originals = {s: scene.shapes[s].geometry for s, _ in found}
     base = ((image - target_rgb) ** 2).sum(-1)
     h, w = base.shape
 
@@ -121,7 +116,7 @@ def sharpen_loops(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, in
         for s in originals:
             subs = [(found[(s, j)][0][choice[(s, j)]] if (s, j) in choice else segs, closed)
                     for j, (segs, closed) in enumerate(shapes[s])]
-            scene.shapes[s].geometry = _with_segments(originals[s], subs)
+            scene.shapes[s].geometry = with_segments(originals[s], subs)
 
     def window(box) -> tuple[slice, slice]:
         (x0, y0), (x1, y1) = box
@@ -142,9 +137,10 @@ def sharpen_loops(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, in
     choice = {key: i for key, (_, i) in best.items() if i is not None}
     if choice:
         apply(choice)
-        if float(((render_rgb(scene) - target_rgb) ** 2).mean()) < float(base.mean()) / 3:
+        after = render_rgb(scene)
+        if ((after - target_rgb) ** 2).mean() < base.mean() / 3:
             stats["sharpened"] = len(choice)
-            return stats
+            return stats, after
     for s, g in originals.items():
         scene.shapes[s].geometry = g
-    return stats
+    return stats, image

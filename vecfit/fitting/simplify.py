@@ -35,11 +35,11 @@ import time
 
 import numpy as np
 
-from vecfit.fitting.fillets import round_corners, stroked
-from vecfit.scene.arrays import floats_torch, is_tensor, to_numpy
+from vecfit.fitting.fillets import half_width, round_corners, stroked
+from vecfit.scene.arrays import is_tensor, to_numpy
 from vecfit.scene.model import Path
 from vecfit.scene.placement import shape_matrices
-from vecfit.scene.segments import layout_of, segments_of
+from vecfit.scene.segments import path_segments, subpath_segments, with_segments
 
 SAMPLES = 12      # per segment of a pair
 REPARAM = 2       # Newton reparameterisations after the split's search
@@ -197,40 +197,10 @@ class _Candidate:
     cost: float
 
 
-def _subpath_segments(path: Path) -> list[tuple[list[np.ndarray], bool]]:
-    pts = np.asarray(to_numpy(path.points), np.float64)
-    out = []
-    for (first, count, closed), (p0, n) in zip(path.subpaths, path.subpath_point_ranges()):
-        degs = [int(d) for d in path.degrees[first:first + count]]
-        out.append((segments_of(pts[p0:p0 + n], degs, closed) if count else [], bool(closed)))
-    return out
-
-
 def _limit(base: float, noise: float, budget_db: float) -> float:
     """The MSE a pass may reach from ``base``: ``budget_db`` of the part that is not the
     renderer's sampling noise."""
     return base + max(base - noise, 0.0) * (10 ** (budget_db / 10) - 1)
-
-
-def _path_segments(scene) -> dict[int, list[tuple[list[np.ndarray], bool]]]:
-    """Shape index -> _subpath_segments of each of ``scene``'s paths of one width (what the
-    joins may change)."""
-    return {i: _subpath_segments(sh.geometry) for i, sh in enumerate(scene.shapes)
-            if isinstance(sh.geometry, Path) and sh.geometry.widths is None}
-
-
-def _with_segments(path: Path, subs: list[tuple[list[np.ndarray], bool]]) -> Path:
-    points, degrees, table = [], [], []
-    for segs, closed in subs:
-        if not segs:
-            continue
-        p, d = layout_of(segs, closed)
-        table.append((len(degrees), len(d), closed))
-        points.append(p)
-        degrees += d
-    flat = np.concatenate(points).astype(np.float32)
-    return Path(points=floats_torch(flat) if is_tensor(path.points) else flat,
-                degrees=np.array(degrees, np.int64), subpaths=table)
 
 
 def _sample(image: np.ndarray, xy: np.ndarray) -> np.ndarray:
@@ -252,7 +222,7 @@ def _jumps(image: np.ndarray, pts: np.ndarray) -> np.ndarray:
 
 def candidates(scene, shapes: dict[int, list], image: np.ndarray, size: tuple[int, int], max_error: float,
                lines: float, changed: dict[int, set] | None = None, hidden_error: float = 0.0) -> list[_Candidate]:
-    """Every node of the paths ``shapes`` (shape index -> _subpath_segments) that can go,
+    """Every node of the paths ``shapes`` (shape index -> scene.segments.subpath_segments) that can go,
     priced; with ``changed`` ((shape, subpath) -> segment indices made last round), only
     nodes next to those."""
     mats = np.asarray(to_numpy(shape_matrices(scene, size[0], size[1])), np.float64)
@@ -367,7 +337,7 @@ def reduce_nodes(scene, measure, image: np.ndarray, size: tuple[int, int], budge
     now = measure(scene) if current is None else current
     base = now if base is None else base
     limit = _limit(base, noise, budget_db)
-    shapes = _path_segments(scene)
+    shapes = path_segments(scene)
     before = sum(len(segs) for subs in shapes.values() for segs, _ in subs)
     renders, joined, mse = int(current is None), 0, now
     originals = {i: scene.shapes[i].geometry for i in shapes}
@@ -380,7 +350,7 @@ def reduce_nodes(scene, measure, image: np.ndarray, size: tuple[int, int], budge
         def trial(k):
             new, made = _apply(shapes, chosen[:k])
             for s, subs in new.items():
-                scene.shapes[s].geometry = _with_segments(originals[s], subs)
+                scene.shapes[s].geometry = with_segments(originals[s], subs)
             value = measure(scene)
             for s in new:  # back as it was
                 scene.shapes[s].geometry = originals[s]
@@ -404,7 +374,7 @@ def reduce_nodes(scene, measure, image: np.ndarray, size: tuple[int, int], budge
         mse, new, made = best
         shapes.update(new)
         for s in new:
-            scene.shapes[s].geometry = _with_segments(originals[s], shapes[s])
+            scene.shapes[s].geometry = with_segments(originals[s], shapes[s])
             originals[s] = scene.shapes[s].geometry
         joined += lo
         changed = made
@@ -479,9 +449,8 @@ def simplify_fitted(scene, goal, settings, render_rgb, target_rgb: np.ndarray, b
 
     rounded = None
     if any(stroked(sh) for sh in scene.shapes):
-        rounded = round_corners(scene, render_rgb, target_rgb, (w, h), image)
+        rounded, image = round_corners(scene, render_rgb, target_rgb, (w, h), image)
         if rounded["rounded"]:
-            image = render_rgb(scene)
             base = float(((image - target_rgb) ** 2).mean())
         fitted = [(copy.deepcopy(sh.geometry), copy.deepcopy(sh.stroke_width)) for sh in scene.shapes]
         stats = joined_and_refined(bolder=True)
@@ -495,7 +464,7 @@ def simplify_fitted(scene, goal, settings, render_rgb, target_rgb: np.ndarray, b
         stats = joined_and_refined(bolder=False)
     stats["noise"] = noise
     if rounded is not None:
-        stats["rounded_corners"] = {"fitted": {k: rounded[k] for k in ("corners", "rounded")}}
+        stats["rounded_corners"] = rounded
     stats["tidied"] = tidy(scene, measure, render_rgb, (w, h), noise, max_error, lines)
     return stats
 
@@ -554,14 +523,14 @@ def tidy_stroke_ends(scene, measure, limit: float) -> dict:
     end segments that are hooks (_end_hooks) dropped, and a stroke that is one line
     shorter than DOT_LENGTH made a dot of no length at its middle (written `h0`, as the
     trace writes dots, not `l.01-.11`). All at once, else none. Returns counts."""
-    shapes = _path_segments(scene)
+    shapes = path_segments(scene)
     stats = {"hooks": 0, "dots": 0}
     new: dict[int, list] = {}
     for s, subs in shapes.items():
         sh = scene.shapes[s]
         if not stroked(sh) or sh.linecap != "round":
             continue
-        hw = 0.5 * float(np.asarray(to_numpy(sh.stroke_width)).reshape(-1)[0])
+        hw = half_width(sh)
         changed = False
         out = []
         for segs, closed in subs:
@@ -583,7 +552,7 @@ def tidy_stroke_ends(scene, measure, limit: float) -> dict:
         return stats
     originals = {s: scene.shapes[s].geometry for s in new}
     for s, subs in new.items():
-        scene.shapes[s].geometry = _with_segments(originals[s], subs)
+        scene.shapes[s].geometry = with_segments(originals[s], subs)
     if measure(scene) > limit:
         for s, g in originals.items():
             scene.shapes[s].geometry = g
@@ -613,7 +582,7 @@ STRAIGHT = 0.25  # px: a cubic that strays no further than this from its chord i
 def straight_candidates(scene, shapes: dict[int, list], size: tuple[int, int],
                         tolerance: float = STRAIGHT) -> list[tuple[float, int, int, int]]:
     """(area between the curve and its chord in px², shape, subpath, segment) of every cubic
-    of ``shapes`` (shape index -> _subpath_segments) whose points all lie within ``tolerance``
+    of ``shapes`` (shape index -> scene.segments.subpath_segments) whose points all lie within ``tolerance``
     pixels of its chord (the segment between its ends: a flat cubic whose control points run
     past an end, drawing a hair's overshoot, counts by how far it goes), cheapest first."""
     mats = np.asarray(to_numpy(shape_matrices(scene, size[0], size[1])), np.float64)
@@ -647,7 +616,7 @@ def straighten(scene, measure, size: tuple[int, int], limit: float, tolerance: f
     MSE of a render, the same samples every call) within ``limit``, cheapest first (by
     bisection). A line is four numbers fewer in the file, and lines that go on in one
     direction join into one (reduce_nodes). Returns counts."""
-    shapes = _path_segments(scene)
+    shapes = path_segments(scene)
     found = straight_candidates(scene, shapes, size, tolerance)
     stats = {"candidates": len(found), "straightened": 0, "renders": 0}
     if not found:
@@ -661,7 +630,7 @@ def straighten(scene, measure, size: tuple[int, int], limit: float, tolerance: f
             c = subs[j][0][i]
             subs[j][0][i] = c[[0, 3]]
         for s, subs in new.items():
-            scene.shapes[s].geometry = _with_segments(originals[s], subs)
+            scene.shapes[s].geometry = with_segments(originals[s], subs)
 
     def within(k):
         made(k)
@@ -684,7 +653,7 @@ def straight_run_candidates(scene, shapes: dict[int, list], size: tuple[int, int
                             tolerance: float = STRAIGHT_RUN) -> list[tuple[float, int, int, int, int]]:
     """(area between the run and its chord in px², shape, subpath, first segment, last
     segment) of the longest runs of two or more consecutive segments of stroked, unfilled
-    paths (``shapes``: shape index -> _subpath_segments) whose points all lie within
+    paths (``shapes``: shape index -> scene.segments.subpath_segments) whose points all lie within
     ``tolerance`` pixels of the chord from the run's start to its end, and go along it
     (each point's place on the chord no further back than the last's, less the tolerance:
     no spike doubling back); cheapest first. Runs do not overlap (each the longest from
@@ -738,7 +707,7 @@ def join_straight_runs(scene, size: tuple[int, int], tolerance: float = STRAIGHT
     centerline comes back from the fit as several segments along one line (the slash of an
     "-off" icon), which pairwise joins leave: each moves the line by a hair, which its
     render tells. Returns counts."""
-    shapes = _path_segments(scene)
+    shapes = path_segments(scene)
     found = straight_run_candidates(scene, shapes, size, tolerance)
     new: dict[int, list] = {}
     for _, s, j, a, b in sorted(found, key=lambda r: -r[3]):  # later runs first: the indices hold
@@ -746,7 +715,7 @@ def join_straight_runs(scene, size: tuple[int, int], tolerance: float = STRAIGHT
         segs = subs[j][0]
         segs[a:b + 1] = [np.stack([segs[a][0], segs[b][-1]])]
     for s, subs in new.items():
-        scene.shapes[s].geometry = _with_segments(scene.shapes[s].geometry, subs)
+        scene.shapes[s].geometry = with_segments(scene.shapes[s].geometry, subs)
     return {"candidates": len(found), "joined": len(found), "segments_removed": sum(b - a for _, _, _, a, b in found)}
 
 
@@ -769,7 +738,7 @@ def _unseen_candidates(scene, size: tuple[int, int]) -> list[tuple[float, int, i
                 or len(g.subpaths) < 2 or float(to_numpy(shape.opacity)) < 1 or float(to_numpy(shape.fill_opacity)) < 1):
             continue
         m = mats[s]
-        subs = _subpath_segments(g)
+        subs = subpath_segments(g)
         areas = []
         for segs, closed in subs:
             if not (closed and segs):
@@ -824,14 +793,14 @@ def drop_unseen(scene, render, target_rgb: np.ndarray, budget_db: float = 0.01) 
     if not found:
         return stats
     originals = {s: scene.shapes[s].geometry for _, s, _, _ in found}
-    subs_of = {s: _subpath_segments(g) for s, g in originals.items()}
+    subs_of = {s: subpath_segments(g) for s, g in originals.items()}
 
     def without(pairs):
         gone: dict[int, set] = {}
         for s, j in pairs:
             gone.setdefault(s, set()).add(j)
         for s, js in gone.items():
-            scene.shapes[s].geometry = _with_segments(originals[s], [x for j, x in enumerate(subs_of[s]) if j not in js])
+            scene.shapes[s].geometry = with_segments(originals[s], [x for j, x in enumerate(subs_of[s]) if j not in js])
 
     def restore():
         for s, g in originals.items():

@@ -142,6 +142,19 @@ def _as_fitted(final_rgb: np.ndarray, target_rgb: np.ndarray, settings: Settings
     return {"as_fitted": {"target_blur": blur, **compare(blurred.astype(final_rgb.dtype), target_rgb)}}
 
 
+def _traced_corners(scene: Scene, settings: Settings, size: tuple[int, int], background, target_rgb) -> dict | None:
+    """A stroke trace's corners before the fit, which cannot add the nodes they need: small
+    rings made the polygons they are, corners drawn sharp or as curves rounded where the
+    picture is (fitting/fillets.traced_corners), judged on renders of 4 x 4 samples or
+    more. None where the scene has no strokes."""
+    from vecfit.fitting.fillets import stroked, traced_corners
+    if not any(stroked(s) for s in scene.shapes):
+        return None
+    judged = dataclasses.replace(settings, eval_samples=max(4, settings.eval_samples))
+    w, h = size
+    return traced_corners(scene, lambda s, seed=0: rendered_rgb(s, w, h, judged, background, seed), target_rgb, size)
+
+
 def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, config: dict, outputs: Outputs,
                   progress=None, inputs: dict | None = None, hooks=(), keep_alpha=(),
                   generated: bool = False, removed_background: tuple | None = None) -> dict:
@@ -195,14 +208,8 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         goal = Target(torch.from_numpy(small), background)
         if generated and settings.alpha == "auto" and not goal.wants_translucency:
             make_opaque(scene)
-        from vecfit.fitting.fillets import stroked, traced_corners
-        if generated and any(stroked(s_) for s_ in scene.shapes):
-            # a trace's centerlines' corners, before the fit, which cannot add the nodes they
-            # need: small rings made the polygons they are, corners drawn sharp or as curves
-            # rounded where the picture is (fitting/fillets.py, fitting/polygons.py)
-            judged = dataclasses.replace(settings, eval_samples=max(4, settings.eval_samples))
-            corners = traced_corners(scene, lambda s_, seed=0: rendered_rgb(s_, sw, sh, judged, background, seed),
-                                     target_rgb, (sw, sh))
+        if generated:
+            corners = _traced_corners(scene, settings, (sw, sh), background, target_rgb)
         progress.start(settings.iterations)
         if palette is None:
             result = optimize(scene, goal, settings, progress=progress, hooks=hooks, keep_alpha=keep_alpha)
@@ -223,8 +230,6 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
                                          int(settings.simplify_iterations), hooks, keep_alpha,
                                          rendered=judge.rendered)
             simplified["judged_samples"] = judge.samples  # N of the N x N samples a pixel the joins were judged at
-            if corners is not None:
-                simplified.setdefault("rounded_corners", {})["traced"] = corners
     else:
         progress.start(0)
         result = _not_optimised(scene, settings)
@@ -264,6 +269,7 @@ def fit_and_write(scene: Scene, document: SvgDocument, target: np.ndarray, confi
         save_comparison(outputs.comparison, target_rgb, initial_rgb, final_rgb)
     outcome = {
         **_as_fitted(final_rgb, target_rgb, settings),  # a blurred target (a scan): the figures the fit saw
+        **({} if corners is None else {"traced_corners": corners}),  # a stroke trace's corners and rings before the fit
         "simplified": simplified,  # nodes dropped after the fit (fitting/simplify.py), or None
         "untangled_outlines": untangled,  # outlines the fit made cross themselves, cut into simple loops
         **({} if cut is None else {"cutouts": cut}),  # --stacking cutouts: pieces, chains, and the file's score

@@ -8,7 +8,7 @@ import numpy as np
 import torch
 
 from vecfit.fitting.fillets import _arc, corners, filleted, round_corners
-from vecfit.fitting.simplify import _path_segments, _subpath_segments
+from vecfit.scene.segments import path_segments, subpath_segments
 from vecfit.renderer.raster import render
 from vecfit.scene import Path, Scene, Shape, Solid
 from vecfit.scene.segments import layout_of
@@ -83,11 +83,11 @@ def test_the_corners_of_a_square_traced_sharp_are_rounded_as_drawn():
              np.array([[52.0, 52.0], [12.0, 52.0]]), np.array([[12.0, 52.0], [12.0, 12.0]])]
     scene = stroke_scene([(sharp, True)])
     before = float(((rgb(scene) - target) ** 2).mean())
-    stats = round_corners(scene, rgb, target, (64, 64))
+    stats, _ = round_corners(scene, rgb, target, (64, 64))
     after = float(((rgb(scene) - target) ** 2).mean())
     assert stats["corners"] == 4 and stats["rounded"] == 4
     assert after < 0.2 * before, (before, after)
-    segs, closed = _subpath_segments(scene.shapes[0].geometry)[0]
+    segs, closed = subpath_segments(scene.shapes[0].geometry)[0]
     assert closed and sorted(len(c) - 1 for c in segs) == [1, 1, 1, 1, 3, 3, 3, 3]
 
 
@@ -96,7 +96,7 @@ def test_sharp_corners_drawn_sharp_stay():
              np.array([[52.0, 52.0], [12.0, 52.0]]), np.array([[12.0, 52.0], [12.0, 12.0]])]
     target = rgb(stroke_scene([(sharp, True)]))
     scene = stroke_scene([(sharp, True)])
-    stats = round_corners(scene, rgb, target, (64, 64))
+    stats, _ = round_corners(scene, rgb, target, (64, 64))
     assert stats["corners"] == 4 and stats["rounded"] == 0
     assert np.allclose(scene.shapes[0].geometry.points.numpy(), stroke_scene([(sharp, True)]).shapes[0].geometry.points.numpy())
 
@@ -111,13 +111,13 @@ def test_a_corner_traced_as_curves_between_two_lines_is_made_of_them():
     traced = [np.array([[10.0, 12.0], [40.0, 12.0]]), np.array([[40.0, 12.0], [47.0, 11.0], [50.0, 11.0], [51.5, 15.0]]),
               np.array([[51.5, 15.0], [53.0, 19.0], [52.5, 22.0], [52.0, 26.0]]), np.array([[52.0, 26.0], [52.0, 54.0]])]
     scene = stroke_scene([(traced, False)])
-    found = corners(scene, _path_segments(scene))
+    found = corners(scene, path_segments(scene))
     assert [(c.vertex, c.last) for c in found] == [(1, 3)] and np.allclose(found[0].at, [52, 12], atol=1e-6)
     before = float(((rgb(scene) - target) ** 2).mean())
-    stats = round_corners(scene, rgb, target, (64, 64))
+    stats, _ = round_corners(scene, rgb, target, (64, 64))
     after = float(((rgb(scene) - target) ** 2).mean())
     assert stats["rounded"] == 1 and after < 0.3 * before, (before, after)
-    segs, _ = _subpath_segments(scene.shapes[0].geometry)[0]
+    segs, _ = subpath_segments(scene.shapes[0].geometry)[0]
     assert [len(c) - 1 for c in segs] == [1, 3, 1]
     assert np.allclose(segs[0][0], [10, 12], atol=1e-4) and np.allclose(segs[-1][-1], [52, 54], atol=1e-4)
 
@@ -138,13 +138,13 @@ def test_a_square_corner_traced_as_one_cubic_is_made_sharp_again():
               np.array([[40.0, 20.0], [49.0, 29.0], [49.0, 35.0], [40.0, 44.0]]),
               np.array([[40.0, 44.0], [37.0, 47.0], [35.0, 49.0], [32.0, 52.0]])]
     scene = stroke_scene([(traced, False)])
-    found = corners(scene, _path_segments(scene))
+    found = corners(scene, path_segments(scene))
     assert any(c.one_curve and c.vertex == 2 and np.allclose(c.at, [52, 32]) for c in found)
     before = float(((rgb(scene) - target) ** 2).mean())
-    stats = round_corners(scene, rgb, target, (64, 64))
+    stats, _ = round_corners(scene, rgb, target, (64, 64))
     after = float(((rgb(scene) - target) ** 2).mean())
     assert stats["rounded"] >= 1 and after < 0.1 * before, (before, after)
-    segs, _ = _subpath_segments(scene.shapes[0].geometry)[0]
+    segs, _ = subpath_segments(scene.shapes[0].geometry)[0]
     corner = [k for k, c in enumerate(segs) if len(c) == 2 and np.allclose(c[1], [52, 32], atol=1e-3)]
     assert corner and len(segs[corner[0] + 1]) == 2  # two lines, the corner sharp where they meet
 
@@ -167,10 +167,10 @@ def test_a_frame_with_round_corners_is_traced_with_them(tmp_path):
     written, report = vecfit.trace(tmp_path / "frame.png", settings={"optimize": {"threads": 1}}, effort="quick",
                                    style="strokes")
     assert 'stroke-linejoin="round"' in written
-    assert report["simplified"]["rounded_corners"]["traced"]["rounded"] == 4
+    assert report["traced_corners"]["rounded"] == 4
     (tmp_path / "traced.svg").write_text(written)
     path = [s for s in vecfit.load_svg(tmp_path / "traced.svg").shapes if s.stroke is not None][0].geometry
-    segs, closed = _subpath_segments(path)[0]
+    segs, closed = subpath_segments(path)[0]
     arcs = [c for c in segs if len(c) == 4]
     assert closed and len(arcs) == 4 and sum(len(c) == 2 for c in segs) in (4, 5)  # (a side split where the loop starts)
     for c in arcs:  # a quarter arc of radius 6: its ends 6 sqrt(2) apart

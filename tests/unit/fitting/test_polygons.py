@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from vecfit.fitting.polygons import polygon_of, sharpen_loops
-from vecfit.fitting.simplify import _subpath_segments
+from vecfit.scene.segments import subpath_segments
 from test_fillets import rgb, stroke_scene
 
 DIAMOND = [np.array([[32.0, 12.0], [52.0, 32.0]]), np.array([[52.0, 32.0], [32.0, 52.0]]),
@@ -28,11 +28,11 @@ def test_a_diamond_traced_round_is_made_its_polygon():
     loop = rounded_loop(np.array([[32.0, 12.0], [52.0, 32.0], [32.0, 52.0], [12.0, 32.0]]), 0.8)
     scene = stroke_scene([(loop, True)])
     before = float(((rgb(scene) - target) ** 2).mean())
-    stats = sharpen_loops(scene, rgb, target, (64, 64))
+    stats, _ = sharpen_loops(scene, rgb, target, (64, 64))
     after = float(((rgb(scene) - target) ** 2).mean())
     assert stats == {"loops": 1, "sharpened": 1}
     assert after < 0.5 * before, (before, after)
-    segs, closed = _subpath_segments(scene.shapes[0].geometry)[0]
+    segs, closed = subpath_segments(scene.shapes[0].geometry)[0]
     assert closed and len(segs) == 4 and all(len(c) == 2 for c in segs)
     corners = np.array([c[0] for c in segs])
     for true in ([32, 12], [52, 32], [32, 52], [12, 32]):  # each corner within 1.5 px of the drawn one (the fit goes on)
@@ -49,7 +49,7 @@ def test_a_ring_that_is_round_stays_round():
     target = rgb(stroke_scene([(circle, True)]))
     scene = stroke_scene([(circle, True)])
     before = scene.shapes[0].geometry.points.clone()
-    stats = sharpen_loops(scene, rgb, target, (64, 64))
+    stats, _ = sharpen_loops(scene, rgb, target, (64, 64))
     assert stats["sharpened"] == 0
     assert np.array_equal(scene.shapes[0].geometry.points.numpy(), before.numpy())
 

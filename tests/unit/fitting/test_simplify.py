@@ -9,12 +9,12 @@ import pytest
 import torch
 
 import vecfit
-from vecfit.fitting.simplify import (_apart, _end_hooks, _subpath_segments, drop_unseen, fit_pairs, join_straight_runs,
+from vecfit.fitting.simplify import (_apart, _end_hooks, drop_unseen, fit_pairs, join_straight_runs,
                                      reduce_nodes, tidy_stroke_ends,
                                      straight_run_candidates, straighten)
 from vecfit.renderer.raster import render
 from vecfit.scene import Path, Scene, Shape, Solid
-from vecfit.scene.segments import layout_of, split_at
+from vecfit.scene.segments import layout_of, split_at, subpath_segments
 from vecfit.svg.stats import design_stats
 
 
@@ -253,7 +253,7 @@ def stroked_scene(filled: bool = False) -> Scene:
 
 def test_a_strokes_straight_run_is_one_line_and_its_corner_stays():
     scene = stroked_scene()
-    found = straight_run_candidates(scene, {0: _subpath_segments(scene.shapes[0].geometry)}, (64, 64))
+    found = straight_run_candidates(scene, {0: subpath_segments(scene.shapes[0].geometry)}, (64, 64))
     assert [(a, b) for _, _, _, a, b in found] == [(0, 3)]  # the run of 4; not round the corner
     stats = join_straight_runs(scene, (64, 64))
     assert stats == {"candidates": 1, "joined": 1, "segments_removed": 3}
@@ -274,7 +274,7 @@ def test_a_stroke_a_hair_off_its_line_is_not_joined_beyond_the_tolerance():
     points = g.points.clone()
     points[1, 1] = 21.0  # the first line's end 1 px off: beyond STRAIGHT_RUN (0.5)
     scene.shapes[0].geometry = Path(points=points, degrees=g.degrees, subpaths=g.subpaths)
-    found = straight_run_candidates(scene, {0: _subpath_segments(scene.shapes[0].geometry)}, (64, 64))
+    found = straight_run_candidates(scene, {0: subpath_segments(scene.shapes[0].geometry)}, (64, 64))
     runs = [(a, b) for _, _, _, a, b in found]
     assert runs and all(a >= 1 for a, _ in runs)  # the line off the others joins none of them
 
