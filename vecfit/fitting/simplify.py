@@ -652,9 +652,10 @@ STRAIGHT_RUN = 0.5  # px: a stroke's run of segments within this of its chord is
 def straight_run_candidates(scene, shapes: dict[int, list], size: tuple[int, int],
                             tolerance: float = STRAIGHT_RUN) -> list[tuple[float, int, int, int, int]]:
     """(area between the run and its chord in px², shape, subpath, first segment, last
-    segment) of the longest runs of two or more consecutive segments of stroked, unfilled
-    paths (``shapes``: shape index -> scene.segments.subpath_segments) whose points all lie within
-    ``tolerance`` pixels of the chord from the run's start to its end, and go along it
+    segment) of the longest runs of two or more consecutive segments (or a cubic alone,
+    within STRAIGHT of its chord) of stroked, unfilled paths (``shapes``: shape index ->
+    scene.segments.subpath_segments) whose points all lie within ``tolerance`` pixels of
+    the chord from the run's start to its end, and go along it
     (each point's place on the chord no further back than the last's, less the tolerance:
     no spike doubling back); cheapest first. Runs do not overlap (each the longest from
     where the last ended)."""
@@ -666,7 +667,7 @@ def straight_run_candidates(scene, shapes: dict[int, list], size: tuple[int, int
             continue
         m = mats[s]
         for j, (segs, _) in enumerate(subs):
-            if len(segs) < 2:
+            if not segs:
                 continue
             px = np.stack([_cubic(c) for c in segs]) @ m[:2, :2].T + m[:2, 2]
             pts = _eval(px, np.broadcast_to(u, (len(px), len(u))))  # [S, 17, 2]
@@ -685,7 +686,7 @@ def straight_run_candidates(scene, shapes: dict[int, list], size: tuple[int, int
                 across = np.abs((q - start) @ np.array([-d[1], d[0]])) / length
                 return float(across.max()), float(across.mean()) * length
             a = 0
-            while a < len(segs) - 1:
+            while a < len(segs):
                 best = None
                 for b in range(a + 1, len(segs)):
                     found = off_chord(a, b)
@@ -693,6 +694,11 @@ def straight_run_candidates(scene, shapes: dict[int, list], size: tuple[int, int
                         break
                     best = (b, found[1])
                 if best is None:
+                    # one cubic alone, within STRAIGHT: a line (a curve at 0.5 px could be a
+                    # tight round corner, which a line makes sharp)
+                    found = off_chord(a, a) if len(segs[a]) == 4 else None
+                    if found is not None and found[0] <= min(tolerance, STRAIGHT):
+                        out.append((found[1], s, j, a, a))
                     a += 1
                     continue
                 out.append((best[1], s, j, a, best[0]))

@@ -319,3 +319,15 @@ def test_a_short_end_going_on_is_no_hook_and_a_change_past_the_budget_is_undone(
     before = hooked.shapes[0].geometry.points.clone()
     stats = tidy_stroke_ends(hooked, _measure_against(target), -1.0)  # (no change can be within a negative limit)
     assert stats == {"hooks": 0, "dots": 0} and torch.equal(hooked.shapes[0].geometry.points, before)
+
+
+def test_a_strokes_single_cubic_within_a_quarter_pixel_is_a_line_and_a_round_corner_stays():
+    """A refined stroke's straight line often comes back as one cubic a hair off its chord
+    (tabler-056's cross: 0.09 px); alone it is a line too, where a quarter arc is not."""
+    k = 4 / 3 * math.tan(math.pi / 8) * 6
+    scene = _stroke([np.array([[10.0, 10.0], [14.86, 14.73], [47.52, 47.62], [52.0, 52.0]]),
+                     np.array([[52.0, 52.0], [52.0, 52 - k], [58 - k, 46.0], [58.0, 46.0]])])
+    stats = join_straight_runs(scene, (64, 64))
+    assert stats["joined"] == 1
+    assert list(scene.shapes[0].geometry.degrees) == [1, 3]
+    assert np.allclose(scene.shapes[0].geometry.points.numpy()[:2], [[10, 10], [52, 52]])
