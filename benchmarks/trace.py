@@ -17,7 +17,10 @@ stays transparent; PSNR over white). --overlap-check also traces at the default 
 under their neighbours (overlap 0), which shows the seams that overlap closes. --refine B
 runs the whole `vecfit trace` job (trace, then refine with the defaults) at budget B and
 scores the written SVG as resvg renders it, next to vecfit's own figures, with wall times,
-and where each run's iterations spend their time at its start and its end.
+how much dearer the last tenth of the iterations is than the first (wall and CPU time),
+what the loop would take were every iteration as cheap as the first tenth (a flat loop's
+floor, against which a time target can be judged), and where each run's iterations spend
+their time at its start and its end.
 --colors-scan FIRST:LAST:STEP traces each image at the default budget with each colour
 count (the k of the k-means) and scores the trace as resvg renders it: a colour count
 where a photo's PSNR falls well below its neighbours' shows a tracer bug that a
@@ -28,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import statistics
 import tempfile
 import time
 from pathlib import Path
@@ -232,8 +236,8 @@ def refine_table(budgets, images, iterations, threads, sets=(), unit=None):
 
     unit = unit or machine_unit()
     print("| image | budget | paths | PSNR trace | PSNR refined (vecfit) | PSNR refined (resvg) "
-          "| trace s | refine s | s/iter | total |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+          "| trace s | refine s | s/iter | growth (wall / CPU) | the loop at its start's cost | total |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     means = {b: [] for b in budgets}
     breakdowns = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -249,8 +253,15 @@ def refine_table(budgets, images, iterations, threads, sets=(), unit=None):
                     overrides["optimize"]["iterations"] = iterations
                 config = resolve("trace", overrides=overrides)
                 out = Outputs.beside(target, Path(tmp) / f"{name}_{b}.svg")
+                cpu = []  # the process's CPU time after each iteration
+
+                def progress(p, cpu=cpu) -> None:
+                    if hasattr(p, "iterations"):
+                        cpu.append(time.process_time())
+
                 with Stopwatch() as watch:
-                    rep = trace(Inputs(image=target), config, out)
+                    rep = trace(Inputs(image=target), config, out, progress=progress)
+                growth, flat = loop_growth(rep["seconds"]["iterations"], cpu)
                 breakdowns.append((f"{name} at {b} paths", watch.laps, rep.get("coarse_iterations", 0)))
                 bg = parse_background(rep["background"])
                 theirs = resvg_rgb(out.svg, image.shape[1], bg)
@@ -260,11 +271,27 @@ def refine_table(budgets, images, iterations, threads, sets=(), unit=None):
                 print(f"| {name} {image.shape[1]}x{image.shape[0]} | {b} | {rep['trace']['paths']} "
                       f"| {rep['initial']['psnr']:.2f} | {rep['optimized']['psnr']:.2f} | {resvg_psnr:.2f} "
                       f"| {rep['trace']['seconds']:.1f} | {opt:.1f} | {rep['seconds']['per_iteration']:.3f} "
-                      f"| {in_r(rep['seconds']['total'], unit)} |", flush=True)
+                      f"| {growth} | {in_r(flat, unit)} | {in_r(rep['seconds']['total'], unit)} |", flush=True)
     for b in budgets:
         print(f"mean PSNR (resvg) at {b} paths: {np.mean(means[b]):.2f} dB")
     for label, laps, coarse in breakdowns:
         print_breakdown(label, laps, coarse)
+
+
+def loop_growth(times: list, cpu: list) -> tuple[str, float]:
+    """How much dearer the loop's last tenth of iterations is than its first (medians),
+    in wall time and in the process's CPU time (``cpu``: its clock after each iteration;
+    a machine shared with other work disturbs it less), and what the loop would take at its
+    first tenth's cost throughout: what a perfectly flat loop of this many iterations costs."""
+    if not times:
+        return "", 0.0
+    n = max(1, len(times) // 10)
+    first = statistics.median(times[:n])
+    wall = statistics.median(times[-n:]) / first
+    steps = [b - a for a, b in zip(cpu, cpu[1:])]  # (the first iteration's also holds the set-up: left out)
+    k = max(1, len(steps) // 10)
+    ratio = f"{statistics.median(steps[-k:]) / statistics.median(steps[:k]):.2f}x" if len(steps) >= 2 else "-"
+    return f"{wall:.2f}x / {ratio}", first * len(times)
 
 
 if __name__ == "__main__":
