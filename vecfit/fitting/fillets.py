@@ -22,6 +22,8 @@ from vecfit.scene.model import Path
 from vecfit.scene.placement import shape_matrices
 from vecfit.scene.segments import path_segments, points_at, split_at, with_segments
 
+from .windows import choose_in_windows
+
 # The fillets' radii tried, as multiples of the stroke's half width.
 RADII = (0.5, 1.0, 1.5, 2.0)
 TURN_MIN = 30.0   # degrees: a vertex turning less than this is no corner
@@ -33,6 +35,9 @@ CLEARLY_BETTER = 0.7
 # corner where the picture's is sharp: only a corner far better filleted is rounded then
 # (at 0.7, a sharp-cornered Tabler icon lost 6 dB: the fit cannot take a fillet back).
 TRACED_CLEARLY_BETTER = 0.35
+# The tracer's join other than round (centerline.JOIN_CLEARLY_BETTER chose it) comes back
+# after the passes tried with round joins where its render has this share of theirs or less.
+TRACER_JOIN_KEPT = 0.8
 WINDOW = 2.0      # the window's half side: this many half widths past the trim, and 2 px
 CURVE_TURN_MIN = 60.0  # degrees: one curve turning less than this is no corner
 NEIGHBOUR_STRAIGHT = 0.25  # ... and its neighbours within this many half widths of their chords
@@ -269,7 +274,7 @@ def traced_corners(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, i
     than a round join on the sharp corner thinning leaves), the strokes are tried with
     round joins and both passes, the fillets at CLEARLY_BETTER (the corners are likely
     round there), and kept so unless the tracer's join, on the trace as it was, is still
-    clearly better (JOIN_CLEARLY_BETTER). Returns counts."""
+    clearly better (TRACER_JOIN_KEPT). Returns counts."""
     from .polygons import sharpen_loops
 
     others = [sh for sh in scene.shapes if stroked(sh) and sh.linejoin != "round"]
@@ -285,15 +290,12 @@ def traced_corners(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, i
                                    clearly_better=CLEARLY_BETTER if others else TRACED_CLEARLY_BETTER)
     stats = {"corners": rounded["corners"], "rounded": rounded["rounded"], "polygons": loops["sharpened"]}
     if others:
-        stats["joins_made_round"] = float(((image - target_rgb) ** 2).mean()) * JOIN_CLEARLY_BETTER <= before
+        stats["joins_made_round"] = float(((image - target_rgb) ** 2).mean()) * TRACER_JOIN_KEPT <= before
         if not stats["joins_made_round"]:
             for sh, (geometry, join) in zip(scene.shapes, saved):
                 sh.geometry, sh.linejoin = geometry, join
             stats.update(rounded=0, polygons=0)
     return stats
-
-
-JOIN_CLEARLY_BETTER = 0.8  # another join than round stays where its render has this share of round's error or less
 
 
 def round_corners(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, int], image=None,
@@ -315,8 +317,7 @@ def round_corners(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, in
         return stats, image
     originals = {c.shape: scene.shapes[c.shape].geometry for c in found}
     mats = np.asarray(to_numpy(shape_matrices(scene, size[0], size[1])), np.float64)
-    base = ((image - target_rgb) ** 2).sum(-1)
-    h, w = base.shape
+    h, w = image.shape[:2]
 
     def window(c: Corner) -> tuple[slice, slice]:
         """About the corner, wide enough for the largest fillet's trim."""
@@ -342,23 +343,13 @@ def round_corners(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, in
         for s, g in originals.items():
             scene.shapes[s].geometry = with_segments(g, subs_of[s]) if s in subs_of else g
 
-    windows = [window(c) for c in found]
-    sharp = [float(base[win].sum()) for win in windows]
-    best = {i: (e, None) for i, e in enumerate(sharp)}
-    for factor in (0.0,) + RADII:
-        apply({i: factor for i in range(len(found)) if factor > 0 or found[i].last >= 0})  # (0: sharp, where the lines meet)
-        err = ((render_rgb(scene) - target_rgb) ** 2).sum(-1)
-        for i, win in enumerate(windows):
-            e = float(err[win].sum())
-            if e <= clearly_better * sharp[i] and e < best[i][0]:
-                best[i] = (e, factor)
-    choice = {i: f for i, (_, f) in best.items() if f is not None}
-    if choice:
-        apply(choice)
-        after = render_rgb(scene)
-        if ((after - target_rgb) ** 2).mean() < base.mean() / 3:
-            stats["rounded"] = len(choice)
-            return stats, after
-    for s, g in originals.items():
-        scene.shapes[s].geometry = g
+    def restore() -> None:
+        for s, g in originals.items():
+            scene.shapes[s].geometry = g
+
+    choice, image = choose_in_windows(
+        scene, render_rgb, target_rgb, image, {i: window(c) for i, c in enumerate(found)}, (0.0,) + RADII,
+        lambda i, factor: factor > 0 or found[i].last >= 0,  # (0: sharp, where the lines meet)
+        apply, restore, clearly_better)
+    stats["rounded"] = len(choice)
     return stats, image

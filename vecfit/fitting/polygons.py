@@ -18,6 +18,7 @@ from vecfit.scene.placement import shape_matrices
 from vecfit.scene.segments import path_segments, points_at, with_segments
 
 from .fillets import half_width, stroked
+from .windows import choose_in_windows
 
 SIDES = (3, 8)          # polygons of this many sides are tried
 DP_TOLERANCES = (0.5, 1.0)  # half widths: Douglas-Peucker's tolerances, finding the sides (each tried)
@@ -108,8 +109,7 @@ def sharpen_loops(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, in
     if not found:
         return stats, image
     originals = {s: scene.shapes[s].geometry for s, _ in found}
-    base = ((image - target_rgb) ** 2).sum(-1)
-    h, w = base.shape
+    h, w = image.shape[:2]
 
     def apply(choice: dict) -> None:
         """choice: (shape, subpath) -> tolerance index."""
@@ -118,29 +118,17 @@ def sharpen_loops(scene, render_rgb, target_rgb: np.ndarray, size: tuple[int, in
                     for j, (segs, closed) in enumerate(shapes[s])]
             scene.shapes[s].geometry = with_segments(originals[s], subs)
 
+    def restore() -> None:
+        for s, g in originals.items():
+            scene.shapes[s].geometry = g
+
     def window(box) -> tuple[slice, slice]:
         (x0, y0), (x1, y1) = box
         return (slice(int(max(0, np.floor(y0))), int(min(h, np.ceil(y1)))),
                 slice(int(max(0, np.floor(x0))), int(min(w, np.ceil(x1)))))
 
-    best = {key: (CLEARLY_BETTER * float(base[window(box)].sum()), None) for key, (_, box) in found.items()}
-    for i in range(len(DP_TOLERANCES)):
-        trying = {key: i for key, (tried, _) in found.items() if i in tried}
-        if not trying:
-            continue
-        apply(trying)
-        err = ((render_rgb(scene) - target_rgb) ** 2).sum(-1)
-        for key in trying:
-            e = float(err[window(found[key][1])].sum())
-            if e <= best[key][0]:
-                best[key] = (e, i)
-    choice = {key: i for key, (_, i) in best.items() if i is not None}
-    if choice:
-        apply(choice)
-        after = render_rgb(scene)
-        if ((after - target_rgb) ** 2).mean() < base.mean() / 3:
-            stats["sharpened"] = len(choice)
-            return stats, after
-    for s, g in originals.items():
-        scene.shapes[s].geometry = g
+    choice, image = choose_in_windows(
+        scene, render_rgb, target_rgb, image, {key: window(box) for key, (_, box) in found.items()},
+        range(len(DP_TOLERANCES)), lambda key, i: i in found[key][0], apply, restore, CLEARLY_BETTER)
+    stats["sharpened"] = len(choice)
     return stats, image
